@@ -1,0 +1,1 @@
+//! Device traits, drivers, the session controller and the session store. See the README table for what exists.

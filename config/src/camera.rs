@@ -1,0 +1,224 @@
+//! The camera: driver, intrinsics (thesis §3.2), lens falloff (§4.7.2) and
+//! sensor limits.
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+use crate::validate::{Validate, Validator};
+
+/// Which driver talks to the camera.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(proptest_derive::Arbitrary))]
+pub enum CameraDriver {
+    /// The simulated camera of the `sim` crate.
+    Sim,
+    /// A V4L2 camera through the `v4l` crate (cargo feature `v4l`).
+    V4l,
+    /// A camera through `nokhwa` (cargo feature `nokhwa`).
+    Nokhwa,
+}
+
+/// How to find the camera device.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(proptest_derive::Arbitrary))]
+pub enum DeviceRef {
+    /// A device path such as "/dev/video0".
+    Path(String),
+    /// A device index as the driver enumerates them.
+    Index(u32),
+}
+
+/// Image size in pixels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(proptest_derive::Arbitrary))]
+#[serde(deny_unknown_fields)]
+pub struct Resolution {
+    /// Width in pixels, in [1, 65536].
+    pub width: u32,
+    /// Height in pixels, in [1, 65536].
+    pub height: u32,
+}
+
+/// The focal length, either directly in pixels or through a field of view.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(proptest_derive::Arbitrary))]
+pub enum Focal {
+    /// Focal length in pixels, in (0, 1e6].
+    Pixels(f64),
+    /// Horizontal field of view in degrees, in (0, 180).
+    HorizontalFovDeg(f64),
+}
+
+impl Focal {
+    /// The focal length in pixels for an image `width` pixels wide.
+    pub fn pixels(self, width: u32) -> f64 {
+        match self {
+            Focal::Pixels(f) => f,
+            Focal::HorizontalFovDeg(fov) => 0.5 * f64::from(width) / (0.5 * fov.to_radians()).tan(),
+        }
+    }
+}
+
+/// Pinhole intrinsics with radial distortion and vignetting falloff.
+///
+/// With `r` the distance from the principal point divided by the focal
+/// length, a point at ideal normalized radius `r` is imaged at
+/// `r (1 + k1 r² + k2 r⁴)`, and its recorded intensity is scaled by
+/// `1 + a r² + b r⁴` (thesis §4.7.2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(proptest_derive::Arbitrary))]
+#[serde(deny_unknown_fields)]
+pub struct Intrinsics {
+    /// The focal length.
+    pub focal: Focal,
+    /// Principal point `(x, y)` in pixels; the image centre when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub principal_point_px: Option<(f64, f64)>,
+    /// Radial distortion coefficients `(k1, k2)`, each in [-2, 2].
+    #[serde(default)]
+    pub distortion: (f64, f64),
+    /// Falloff coefficients `(a, b)` of `1 + a r² + b r⁴`, each in [-2, 2].
+    #[serde(default)]
+    pub falloff: (f64, f64),
+}
+
+/// A closed interval of exposure times in seconds.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(proptest_derive::Arbitrary))]
+#[serde(deny_unknown_fields)]
+pub struct ExposureLimits {
+    /// Shortest exposure in seconds, > 0.
+    pub min_s: f64,
+    /// Longest exposure in seconds, ≥ `min_s` and ≤ 3600.
+    pub max_s: f64,
+}
+
+/// A closed interval of analogue gains in dB.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(proptest_derive::Arbitrary))]
+#[serde(deny_unknown_fields)]
+pub struct GainLimits {
+    /// Lowest gain in dB, in [0, 60].
+    pub min_db: f64,
+    /// Highest gain in dB, in [`min_db`, 60].
+    pub max_db: f64,
+}
+
+/// The camera as the station drives it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(proptest_derive::Arbitrary))]
+#[serde(deny_unknown_fields)]
+pub struct Camera {
+    /// The driver.
+    pub driver: CameraDriver,
+    /// The device, for real drivers; ignored by `Sim`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub device: Option<DeviceRef>,
+    /// Frame size.
+    pub resolution: Resolution,
+    /// Geometric and photometric intrinsics.
+    pub intrinsics: Intrinsics,
+    /// Bits per sample of the raw frames: 8, 10, 12, 14 or 16.
+    pub bit_depth: u8,
+    /// Exposure time limits.
+    pub exposure: ExposureLimits,
+    /// Gain limits.
+    pub gain: GainLimits,
+    /// A previously recovered response curve (CSV from `campanile hdr
+    /// calibrate`), relative to this file; recovered anew when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(test, proptest(strategy = "crate::arbitrary::opt_path()"))]
+    pub response_curve: Option<PathBuf>,
+}
+
+impl Validate for Camera {
+    fn validate(&self, v: &mut Validator) {
+        match (&self.driver, &self.device) {
+            (CameraDriver::Sim, _) => {}
+            (_, None) => v.invalid(
+                "device",
+                "nothing".into(),
+                "a device for a real camera driver, e.g. `device: Some(Path(\"/dev/video0\"))`",
+            ),
+            (_, Some(DeviceRef::Path(p))) => {
+                v.at("device", |v| v.non_empty(0, p));
+            }
+            (_, Some(DeviceRef::Index(_))) => {}
+        }
+        v.at("resolution", |v| {
+            v.range_u(
+                "width",
+                self.resolution.width.into(),
+                1,
+                65536,
+                "an image width in pixels",
+            );
+            v.range_u(
+                "height",
+                self.resolution.height.into(),
+                1,
+                65536,
+                "an image height in pixels",
+            );
+        });
+        v.at("intrinsics", |v| {
+            let i = &self.intrinsics;
+            match i.focal {
+                Focal::Pixels(f) => v.at("focal", |v| {
+                    v.range_open_low(0, f, 0.0, 1e6, "a focal length in pixels")
+                }),
+                Focal::HorizontalFovDeg(fov) => v.at("focal", |v| {
+                    v.range_open(0, fov, 0.0, 180.0, "a horizontal field of view in degrees")
+                }),
+            }
+            if let Some((x, y)) = i.principal_point_px {
+                v.at("principal_point_px", |v| {
+                    let (w, h) = (f64::from(self.resolution.width), f64::from(self.resolution.height));
+                    v.range(0, x, 0.0, w, "a principal point x inside the image, in pixels");
+                    v.range(1, y, 0.0, h, "a principal point y inside the image, in pixels");
+                });
+            }
+            v.at("distortion", |v| {
+                v.range(0, i.distortion.0, -2.0, 2.0, "a radial distortion coefficient k1");
+                v.range(1, i.distortion.1, -2.0, 2.0, "a radial distortion coefficient k2");
+            });
+            v.at("falloff", |v| {
+                v.range(0, i.falloff.0, -2.0, 2.0, "a falloff coefficient a");
+                v.range(1, i.falloff.1, -2.0, 2.0, "a falloff coefficient b");
+            });
+        });
+        if ![8, 10, 12, 14, 16].contains(&self.bit_depth) {
+            v.invalid(
+                "bit_depth",
+                self.bit_depth.to_string(),
+                "one of 8, 10, 12, 14 or 16 bits",
+            );
+        }
+        v.at("exposure", |v| {
+            let e = self.exposure;
+            v.range_open_low("min_s", e.min_s, 0.0, 3600.0, "an exposure time in seconds");
+            v.range(
+                "max_s",
+                e.max_s,
+                e.min_s.max(0.0),
+                3600.0,
+                "an exposure time in seconds (at least min_s)",
+            );
+        });
+        v.at("gain", |v| {
+            let g = self.gain;
+            v.range("min_db", g.min_db, 0.0, 60.0, "a gain in dB");
+            v.range(
+                "max_db",
+                g.max_db,
+                g.min_db.max(0.0),
+                60.0,
+                "a gain in dB (at least min_db)",
+            );
+        });
+        if let Some(p) = &self.response_curve {
+            v.existing_file("response_curve", p, "a response curve CSV");
+        }
+    }
+}

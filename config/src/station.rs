@@ -1,0 +1,87 @@
+//! The station: a site and the devices that stand on it.
+
+use serde::{Deserialize, Serialize};
+
+use crate::camera::Camera;
+use crate::filter_wheel::FilterWheel;
+use crate::head::PanTiltHead;
+use crate::lights::Lights;
+use crate::site::Site;
+use crate::validate::{Validate, Validator};
+
+/// Settings of the simulated world, for stations whose devices are simulated.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(proptest_derive::Arbitrary))]
+#[serde(deny_unknown_fields)]
+pub struct Simulation {
+    /// Seed of every random process in the simulated world.
+    pub seed: u64,
+    /// Chance that a byte on a simulated serial link is dropped, in [0, 0.5].
+    #[serde(default)]
+    pub link_drop_chance: f64,
+    /// Chance that a byte on a simulated serial link is corrupted, in [0, 0.5].
+    #[serde(default)]
+    pub link_corrupt_chance: f64,
+}
+
+/// A station: where it stands and what it drives.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(proptest_derive::Arbitrary))]
+#[serde(deny_unknown_fields)]
+pub struct Station {
+    /// A name for logs and reports.
+    pub name: String,
+    /// Where the station stands.
+    pub site: Site,
+    /// The camera.
+    pub camera: Camera,
+    /// The pan-tilt head.
+    pub head: PanTiltHead,
+    /// The ND filter wheel, if any (needed for sun shots).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filter_wheel: Option<FilterWheel>,
+    /// The light controller, if any (needed for indoor light sequences).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lights: Option<Lights>,
+    /// The simulated world, when any device is simulated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub simulation: Option<Simulation>,
+}
+
+impl Station {
+    /// Whether any device of this station is simulated.
+    pub fn uses_simulation(&self) -> bool {
+        use crate::camera::CameraDriver;
+        self.camera.driver == CameraDriver::Sim
+            || self.head.link.is_simulated()
+            || self.filter_wheel.as_ref().is_some_and(|w| w.link.is_simulated())
+            || self.lights.as_ref().is_some_and(|l| l.link.is_simulated())
+    }
+}
+
+impl Validate for Station {
+    fn validate(&self, v: &mut Validator) {
+        v.non_empty("name", &self.name);
+        v.at("site", |v| self.site.validate(v));
+        v.at("camera", |v| self.camera.validate(v));
+        v.at("head", |v| self.head.validate(v));
+        if let Some(w) = &self.filter_wheel {
+            v.at("filter_wheel", |v| w.validate(v));
+        }
+        if let Some(l) = &self.lights {
+            v.at("lights", |v| l.validate(v));
+        }
+        match &self.simulation {
+            Some(s) => v.at("simulation", |v| {
+                v.range("link_drop_chance", s.link_drop_chance, 0.0, 0.5, "a probability");
+                v.range("link_corrupt_chance", s.link_corrupt_chance, 0.0, 0.5, "a probability");
+            }),
+            None if self.uses_simulation() => v.invalid(
+                "simulation",
+                "nothing".into(),
+                "a `simulation: Some((seed: N))` section, since a device is simulated (driver Sim or a `sim:` port)",
+            ),
+            None => {}
+        }
+    }
+}

@@ -1,0 +1,1 @@
+//! The simulated station. See the README table for what exists.
