@@ -2,15 +2,9 @@
 //! shipped examples and on broken files, exit codes, and help.
 
 use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn campanile(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_campanile"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("the binary runs")
-}
+use common::campanile;
 
 fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()

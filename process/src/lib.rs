@@ -1,1 +1,16 @@
 //! The science: pure, synchronous, deterministic solvers. See the README table for what exists.
+//!
+//! - [`camera`]: the photographic model of a camera (response curve, sensor
+//!   noise, quantization, saturation). The simulator photographs its scenes
+//!   through this model, and the HDR tests use it as ground truth.
+//! - [`hdr`]: camera response recovery (Debevec–Malik, Robertson), HDR
+//!   assembly, lens falloff, and the checks on the input images.
+//! - [`exr_io`]: OpenEXR output and input of radiance maps.
+
+pub mod camera;
+pub mod csv_cell;
+pub mod environment;
+pub mod exr_io;
+pub mod hdr;
+pub mod sky;
+pub mod sun;

@@ -1,7 +1,10 @@
 //! Argument parsing and dispatch. One module per subcommand.
 
 mod config_check;
+mod hdr;
 mod logging;
+mod sky;
+mod sun;
 
 use std::process::ExitCode;
 
@@ -43,6 +46,32 @@ pub enum Command {
         #[command(subcommand)]
         action: config_check::ConfigCommand,
     },
+    /// Camera response recovery, HDR merging and lens calibration on plain files.
+    Hdr {
+        #[command(subcommand)]
+        action: hdr::HdrCommand,
+    },
+    /// Where the sun is: one instant, or a CSV table of instants and sites.
+    Sun(sun::SunArgs),
+    /// Sky models: fit them to sky samples, evaluate them.
+    Sky {
+        #[command(subcommand)]
+        action: sky::SkyCommand,
+    },
+}
+
+/// Exit code for a failure while doing the work.
+pub const EXIT_FAILURE: u8 = 1;
+
+/// Prints an error chain and maps it to an exit code.
+fn report(result: anyhow::Result<()>) -> u8 {
+    match result {
+        Ok(()) => EXIT_OK,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            EXIT_FAILURE
+        }
+    }
 }
 
 /// Parses the command line, sets up logging and runs the subcommand.
@@ -58,6 +87,9 @@ pub fn run() -> ExitCode {
     logging::init(&cli.logging);
     let code = match cli.command {
         Command::Config { action } => config_check::run(action),
+        Command::Hdr { action } => hdr::run(action),
+        Command::Sun(args) => report(sun::run(args)),
+        Command::Sky { action } => report(sky::run(action)),
     };
     ExitCode::from(code)
 }

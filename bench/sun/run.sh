@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Solar position against pvlib, same grid, same run. Prints one Markdown row
+# for BENCHMARKS.md.   Usage: bench/sun/run.sh [INSTANTS] [SITES_PER_INSTANT]
+# SITES_PER_INSTANT=1 makes every row its own instant (no sharing of the
+# time-dependent terms); the default grid shares them across 50 sites.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+m="${1:-200}"
+s="${2:-50}"
+venv="$(bench/venv.sh pvlib numpy)"
+cargo build --release -q -p campanile-process --example sun_throughput
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+"$venv/bin/python" bench/sun/compare.py "$m" "$s" "$work" target/release/examples/sun_throughput

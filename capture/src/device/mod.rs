@@ -1,0 +1,29 @@
+//! Device traits: the few methods the controller needs from a pan-tilt
+//! head, a filter wheel and a set of lights, with units in the types.
+//!
+//! Like embedded-hal, drivers are generic over these small traits, so the
+//! same controller code runs against real hardware (drivers in
+//! [`crate::driver`] over a serial port) or against the simulator's
+//! firmware emulators, and the conformance suites in [`crate::conformance`]
+//! run against any of them.
+//!
+//! **Async, tokio-flavoured.** Every method that talks to a device returns
+//! a `Send` future: the controller is a tokio program, and waiting on a
+//! serial line must not block a thread. The traits do not name tokio, but
+//! the drivers here use tokio's clock, so a test under paused time runs a
+//! whole session in moments. Methods are generic (`impl PanTilt`), not
+//! object-safe; wrap in an enum when a runtime choice is needed.
+//!
+//! A `Camera` trait is not defined here yet (the capture issue owns it).
+
+pub mod error;
+pub mod filter_wheel;
+pub mod lights;
+pub mod pan_tilt;
+pub mod units;
+
+pub use error::DeviceError;
+pub use filter_wheel::FilterWheel;
+pub use lights::{LightChannel, Lights};
+pub use pan_tilt::{AxisRange, HeadStatus, PanTilt, PanTiltLimits};
+pub use units::{Angle, AngularSpeed, Level, Pose};

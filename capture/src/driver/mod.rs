@@ -1,0 +1,23 @@
+//! Host drivers: the device traits of [`crate::device`] implemented over
+//! the protocols of `campanile-firmware-link`. Each is generic over its
+//! byte transport, so it does not know whether it talks to a real tty or a
+//! simulated firmware.
+//!
+//! | driver | protocol | traits |
+//! | --- | --- | --- |
+//! | [`link::LinkController`] | campanile-link | `PanTilt`, `FilterWheel`, `Lights` |
+//! | [`pelco_d::PelcoHead`] | Pelco-D | `PanTilt` |
+//! | [`flir_ptu::FlirHead`] | FLIR PTU ASCII | `PanTilt` |
+//! | [`fw102c::Fw102cWheel`] | Thorlabs FW102C | `FilterWheel` |
+//! | [`enttec::DmxLights`] | Enttec DMX USB Pro | `Lights` |
+
+pub mod enttec;
+pub mod flir_ptu;
+pub mod fw102c;
+pub mod link;
+pub mod pelco_d;
+
+use std::time::Duration;
+
+/// How often drivers poll a head that is still moving.
+pub const POLL: Duration = Duration::from_millis(20);

@@ -1,0 +1,114 @@
+//! A coarse latitude-longitude environment map (§5.3.3): the sphere cut
+//! into rectangular regions along elevation and azimuth, each holding the
+//! mean radiance of the samples that fell in it, with their count and
+//! variance (Welford's running update, stable in one pass).
+
+/// Running statistics of one region, per channel.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RegionStats {
+    /// Samples.
+    pub count: u64,
+    /// Mean radiance per channel.
+    pub mean: [f64; 3],
+    m2: [f64; 3],
+}
+
+impl RegionStats {
+    /// Adds one sample.
+    pub fn add(&mut self, rgb: [f64; 3]) {
+        self.count += 1;
+        let n = self.count as f64;
+        for ((x, mean), m2) in rgb.iter().zip(&mut self.mean).zip(&mut self.m2) {
+            let delta = x - *mean;
+            *mean += delta / n;
+            *m2 += delta * (x - *mean);
+        }
+    }
+
+    /// Sample variance per channel (zero below two samples).
+    pub fn variance(&self) -> [f64; 3] {
+        if self.count < 2 {
+            return [0.0; 3];
+        }
+        let d = (self.count - 1) as f64;
+        [self.m2[0] / d, self.m2[1] / d, self.m2[2] / d]
+    }
+}
+
+/// The map: `rows` elevation bands from −90° to 90°, `cols` azimuth
+/// sectors from north through east.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnvironmentMap {
+    /// Elevation bands.
+    pub rows: usize,
+    /// Azimuth sectors.
+    pub cols: usize,
+    /// Row-major regions, row 0 the lowest band.
+    pub regions: Vec<RegionStats>,
+}
+
+impl EnvironmentMap {
+    /// An empty map; at least one row and column.
+    pub fn new(rows: usize, cols: usize) -> EnvironmentMap {
+        let (rows, cols) = (rows.max(1), cols.max(1));
+        EnvironmentMap {
+            rows,
+            cols,
+            regions: vec![RegionStats::default(); rows * cols],
+        }
+    }
+
+    /// The region index of a unit direction (world frame, z up).
+    pub fn region_of(&self, dir: [f64; 3]) -> usize {
+        let elevation = dir[2].clamp(-1.0, 1.0).asin();
+        let azimuth = dir[0].atan2(dir[1]).rem_euclid(std::f64::consts::TAU);
+        let row = (((elevation + std::f64::consts::FRAC_PI_2) / std::f64::consts::PI) * self.rows as f64) as usize;
+        let col = ((azimuth / std::f64::consts::TAU) * self.cols as f64) as usize;
+        row.min(self.rows - 1) * self.cols + col.min(self.cols - 1)
+    }
+
+    /// The unit direction of a region's centre.
+    pub fn region_centre(&self, index: usize) -> [f64; 3] {
+        let (row, col) = (index / self.cols, index % self.cols);
+        let el = -std::f64::consts::FRAC_PI_2 + (row as f64 + 0.5) * std::f64::consts::PI / self.rows as f64;
+        let az = (col as f64 + 0.5) * std::f64::consts::TAU / self.cols as f64;
+        [el.cos() * az.sin(), el.cos() * az.cos(), el.sin()]
+    }
+
+    /// Adds one radiance sample seen toward `dir`; non-finite samples are skipped.
+    pub fn add(&mut self, dir: [f64; 3], rgb: [f64; 3]) {
+        if dir.iter().chain(rgb.iter()).all(|v| v.is_finite()) {
+            let i = self.region_of(dir);
+            self.regions[i].add(rgb);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn welford_matches_two_pass_statistics() {
+        let xs = [3.0, 4.5, 1e9 + 1.0, 1e9 + 2.0, -2.0];
+        let mut s = RegionStats::default();
+        for &x in &xs {
+            s.add([x, 2.0 * x, 0.0]);
+        }
+        let mean = xs.iter().sum::<f64>() / 5.0;
+        let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / 4.0;
+        assert!((s.mean[0] - mean).abs() < 1e-6 && (s.variance()[0] / var - 1.0).abs() < 1e-12);
+        assert!((s.variance()[1] / (4.0 * var) - 1.0).abs() < 1e-12 && s.variance()[2] == 0.0);
+    }
+
+    #[test]
+    fn directions_land_in_the_right_region_and_centres_round_trip() {
+        let m = EnvironmentMap::new(6, 12);
+        for i in 0..m.regions.len() {
+            assert_eq!(m.region_of(m.region_centre(i)), i);
+        }
+        // Due east, slightly below the horizon: row 2 (−30°..0°), column 3 (90°..120°).
+        let d = [(-0.1f64).cos(), 0.0, (-0.1f64).sin()];
+        assert_eq!(m.region_of(d), 2 * 12 + 3);
+    }
+}

@@ -1,0 +1,169 @@
+//! OpenEXR output and input of merged radiance maps.
+//!
+//! Channels (all f32, one layer, sorted by name as OpenEXR requires):
+//! `R`, `G`, `B` (radiance), `variance.R`, `variance.G`, `variance.B`,
+//! `valid` (1 where every channel is valid, else 0) and `mask` (the merge's
+//! bit field as a small integer: saturated `1 << c`, underexposed `8 << c`).
+//! OpenImageIO and Blender read `R`, `G`, `B` as the colour and the rest as
+//! extra channels.
+
+use std::path::Path;
+
+use exr::prelude::*;
+
+use crate::camera::image::RadianceImage;
+use crate::hdr::HdrError;
+use crate::hdr::merge::RadianceMap;
+
+/// Writes `map` to `path` as OpenEXR (ZIP-compressed scan lines).
+pub fn write_radiance_exr(map: &RadianceMap, path: &Path) -> std::result::Result<(), HdrError> {
+    let n = map.width * map.height;
+    let plane = |src: &[f32], c: usize| -> Vec<f32> { (0..n).map(|p| src[p * 3 + c]).collect() };
+    let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::with_capacity(8);
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        channels.push(AnyChannel::new(*name, FlatSamples::F32(plane(&map.rgb, c))));
+        channels.push(AnyChannel::new(
+            format!("variance.{name}").as_str(),
+            FlatSamples::F32(plane(&map.variance, c)),
+        ));
+    }
+    channels.push(AnyChannel::new(
+        "valid",
+        FlatSamples::F32(map.mask.iter().map(|&m| f32::from(u8::from(m == 0))).collect()),
+    ));
+    channels.push(AnyChannel::new(
+        "mask",
+        FlatSamples::F32(map.mask.iter().map(|&m| f32::from(m)).collect()),
+    ));
+    let layer = Layer::new(
+        (map.width, map.height),
+        LayerAttributes::named("radiance"),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(SmallVec::from_vec(channels)),
+    );
+    Image::from_layer(layer)
+        .write()
+        .to_file(path)
+        .map_err(|cause| HdrError::Exr {
+            path: path.to_path_buf(),
+            cause,
+        })
+}
+
+/// Reads a file written by [`write_radiance_exr`].
+pub fn read_radiance_exr(path: &Path) -> std::result::Result<RadianceMap, HdrError> {
+    let image = read_all_flat_layers_from_file(path).map_err(|cause| HdrError::Exr {
+        path: path.to_path_buf(),
+        cause,
+    })?;
+    let layer = image.layer_data.first().ok_or_else(|| HdrError::BadImage {
+        image: path.display().to_string(),
+        what: "no layer: expected one radiance layer".into(),
+    })?;
+    let (w, h) = (layer.size.width(), layer.size.height());
+    let get = |name: &str| -> std::result::Result<Vec<f32>, HdrError> {
+        layer
+            .channel_data
+            .list
+            .iter()
+            .find(|ch| ch.name.to_string() == name)
+            .map(|ch| ch.sample_data.values_as_f32().collect())
+            .ok_or_else(|| HdrError::BadImage {
+                image: path.display().to_string(),
+                what: format!("no channel '{name}': expected R, G, B, variance.R/G/B, valid, mask"),
+            })
+    };
+    let mut rgb = vec![0.0; w * h * 3];
+    let mut variance = vec![0.0; w * h * 3];
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        for (p, v) in get(name)?.into_iter().enumerate() {
+            rgb[p * 3 + c] = v;
+        }
+        for (p, v) in get(&format!("variance.{name}"))?.into_iter().enumerate() {
+            variance[p * 3 + c] = v;
+        }
+    }
+    let mask = get("mask")?.into_iter().map(|v| v as u8).collect();
+    Ok(RadianceMap {
+        width: w,
+        height: h,
+        rgb,
+        variance,
+        mask,
+    })
+}
+
+/// Reads the `R`, `G`, `B` channels of the first layer of any OpenEXR file
+/// (e.g. a flat-field radiance map for `hdr lens`).
+pub fn read_rgb_exr(path: &Path) -> std::result::Result<RadianceImage, HdrError> {
+    let image = read_all_flat_layers_from_file(path).map_err(|cause| HdrError::Exr {
+        path: path.to_path_buf(),
+        cause,
+    })?;
+    let layer = image.layer_data.first().ok_or_else(|| HdrError::BadImage {
+        image: path.display().to_string(),
+        what: "no layer: expected an RGB layer".into(),
+    })?;
+    let (w, h) = (layer.size.width(), layer.size.height());
+    let mut data = vec![0.0f32; w * h * 3];
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        let ch = layer
+            .channel_data
+            .list
+            .iter()
+            .find(|ch| ch.name.to_string() == *name)
+            .ok_or_else(|| HdrError::BadImage {
+                image: path.display().to_string(),
+                what: format!("no channel '{name}': expected R, G and B"),
+            })?;
+        for (p, v) in ch.sample_data.values_as_f32().enumerate() {
+            data[p * 3 + c] = v;
+        }
+    }
+    Ok(RadianceImage {
+        width: w,
+        height: h,
+        data,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exr_round_trip_checks_channels_and_values_with_the_exr_crate() {
+        let (w, h) = (5, 3);
+        let rgb: Vec<f32> = (0..w * h * 3).map(|i| 0.001 * (i as f32 + 1.0).powi(3)).collect();
+        let variance: Vec<f32> = rgb.iter().map(|v| v * 1e-4).collect();
+        let mut mask = vec![0u8; w * h];
+        mask[4] = 0b101;
+        let map = RadianceMap {
+            width: w,
+            height: h,
+            rgb,
+            variance,
+            mask,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.exr");
+        write_radiance_exr(&map, &path).unwrap();
+        // Independent read with the exr crate's generic reader: channel names and exact values.
+        let img = read_all_flat_layers_from_file(&path).unwrap();
+        let layer = &img.layer_data[0];
+        let names: Vec<String> = layer.channel_data.list.iter().map(|c| c.name.to_string()).collect();
+        assert_eq!(
+            names,
+            ["B", "G", "R", "mask", "valid", "variance.B", "variance.G", "variance.R"]
+        );
+        let r: Vec<f32> = layer.channel_data.list[2].sample_data.values_as_f32().collect();
+        assert_eq!(r[7], map.rgb[7 * 3]);
+        let valid: Vec<f32> = layer.channel_data.list[4].sample_data.values_as_f32().collect();
+        assert_eq!(valid[4], 0.0);
+        assert_eq!(valid[3], 1.0);
+        let back = read_radiance_exr(&path).unwrap();
+        assert_eq!(back, map, "lossless round trip");
+        let rgb = read_rgb_exr(&path).unwrap();
+        assert_eq!(rgb.data, map.rgb);
+    }
+}

@@ -1,0 +1,31 @@
+//! Camera response recovery and HDR assembly.
+//!
+//! - [`bracket`]: a validated exposure bracket (sizes, bit depths, times).
+//! - [`bracket_list`]: bracket list files and `1/30`-style times.
+//! - [`sampling`]: seeded, intensity-stratified, edge- and motion-free sample selection.
+//! - [`debevec`]: Debevec–Malik response recovery (f64 Schur-complement normal equations).
+//! - [`robertson`]: Robertson–Borman–Stevenson iterative recovery, for comparison.
+//! - [`noise_bias`]: bootstrap correction of the dark end's noise bias.
+//! - [`curve`]: the recovered response curve, its uncertainty, CSV I/O and error metrics.
+//! - [`curve_plot`]: SVG plot of a curve with its uncertainty band.
+//! - [`merge`]: the single-pass, LUT-driven, noise-optimal radiance merge.
+//! - [`lens`]: the radial falloff and distortion model `1 + a r² + b r⁴` and its fit.
+//! - [`resampled`]: detection of resampled (downscaled) 8-bit input.
+//! - [`image_file`]: reading brackets from PNG/TIFF files.
+//! - [`error`]: the typed errors of all of the above.
+
+pub mod bracket;
+pub mod bracket_list;
+pub mod curve;
+pub mod curve_plot;
+pub mod debevec;
+pub mod error;
+pub mod image_file;
+pub mod lens;
+pub mod merge;
+pub mod noise_bias;
+pub mod resampled;
+pub mod robertson;
+pub mod sampling;
+
+pub use error::HdrError;

@@ -1,0 +1,176 @@
+//! Detection of 8-bit images that were resampled (downscaled, filtered) after
+//! capture.
+//!
+//! A resampled 8-bit image averages codes in the camera's *nonlinear* code
+//! domain, which breaks the relation `Z = f(E·t)` that response recovery fits:
+//! such input gives a wrong curve, so it is refused.
+//!
+//! **The statistic.** Sensor noise is independent from pixel to pixel. The
+//! second difference `d(x) = Z(x−1) − 2 Z(x) + Z(x+1)` of white noise has a
+//! lag-1 autocorrelation of exactly `−4/6 = −2/3`; smooth image content adds
+//! almost nothing to `d` (it cancels linear trends), and edges are excluded
+//! (|d| above 6× the median |d|; clipped codes are excluded too). Every
+//! resampling filter that mixes neighbouring pixels with overlapping kernels
+//! (bilinear, bicubic, Lanczos, area at non-integer factors) correlates the
+//! noise and raises this autocorrelation toward 0 or above. The check
+//! measures it along rows and columns of the middle exposure's green channel
+//! and refuses the bracket when the mean exceeds [`RESAMPLED_THRESHOLD`]
+//! (−0.5, halfway between white noise and a typical 2:1 triangle filter).
+//!
+//! **Limits.** An exact integer box downscale (block averaging) keeps the
+//! noise white and is not detected; nor are images too flat or too clean to
+//! carry noise (then the check passes for lack of evidence). Cameras that
+//! demosaic or sharpen their own output also correlate their noise: for them,
+//! the calibration options carry an override (`allow_resampled`).
+
+use super::HdrError;
+use super::bracket::Bracket;
+use crate::camera::image::CodeImage;
+
+/// Mean lag-1 autocorrelation of second differences above which an image is
+/// considered resampled.
+pub const RESAMPLED_THRESHOLD: f64 = -0.5;
+
+/// Side of the central crop that the check examines.
+const CHECK_SIZE: usize = 512;
+
+/// Fewest second-difference pairs for a verdict.
+const MIN_PAIRS: usize = 500;
+
+/// Lag-1 autocorrelation of the second differences of channel `c` of `img`,
+/// along rows and along columns, with the number of pairs used; `None` when
+/// there are fewer than `MIN_PAIRS` usable pairs.
+pub fn second_difference_autocorrelation(img: &CodeImage, c: usize) -> Option<(f64, f64, usize)> {
+    let (w, h) = (img.width, img.height);
+    let maxc = i32::from(img.max_code());
+    let (lo, hi) = (maxc / 25, maxc - maxc / 25);
+    let z = |x: usize, y: usize| i32::from(img.data[(y * w + x) * 3 + c]);
+    let mut out = [(0.0f64, 0.0f64, 0usize); 2];
+    for (dir, o) in out.iter_mut().enumerate() {
+        let (len, lines) = if dir == 0 { (w, h) } else { (h, w) };
+        let at = |i: usize, line: usize| if dir == 0 { z(i, line) } else { z(line, i) };
+        // Second differences along each line, None where clipped.
+        let mut all: Vec<Vec<Option<i32>>> = Vec::with_capacity(lines);
+        let mut mags = Vec::new();
+        for line in 0..lines {
+            let mut d = vec![None; len];
+            for (i, di) in d.iter_mut().enumerate().take(len.saturating_sub(1)).skip(1) {
+                let (a, b, cc) = (at(i - 1, line), at(i, line), at(i + 1, line));
+                if [a, b, cc].iter().all(|v| (lo..=hi).contains(v)) {
+                    let v = a - 2 * b + cc;
+                    *di = Some(v);
+                    mags.push(v.unsigned_abs());
+                }
+            }
+            all.push(d);
+        }
+        if mags.is_empty() {
+            return None;
+        }
+        let mid = mags.len() / 2;
+        let med = *mags.select_nth_unstable(mid).1;
+        let edge = f64::from(6 * med.max(1));
+        for d in &all {
+            for pair in d.windows(2) {
+                if let [Some(a), Some(b)] = pair {
+                    let (a, b) = (f64::from(*a), f64::from(*b));
+                    if a.abs() <= edge && b.abs() <= edge {
+                        o.0 += a * b;
+                        o.1 += 0.5 * (a * a + b * b);
+                        o.2 += 1;
+                    }
+                }
+            }
+        }
+    }
+    let n = out[0].2.min(out[1].2);
+    if n < MIN_PAIRS || out[0].1 <= 0.0 || out[1].1 <= 0.0 {
+        return None;
+    }
+    Some((out[0].0 / out[0].1, out[1].0 / out[1].1, n))
+}
+
+/// Refuses an 8-bit bracket whose middle exposure looks resampled. Deeper
+/// brackets pass (the concern is re-quantized 8-bit output).
+pub fn check_not_resampled(bracket: &Bracket) -> Result<(), HdrError> {
+    if bracket.bits() != 8 {
+        return Ok(());
+    }
+    let img = &bracket.images()[bracket.len() / 2];
+    // A central crop of at most CHECK_SIZE² pixels is plenty of evidence.
+    let (cw, ch) = (img.width.min(CHECK_SIZE), img.height.min(CHECK_SIZE));
+    let (x0, y0) = ((img.width - cw) / 2, (img.height - ch) / 2);
+    let mut data = Vec::with_capacity(cw * ch * 3);
+    for y in y0..y0 + ch {
+        data.extend_from_slice(&img.data[(y * img.width + x0) * 3..(y * img.width + x0 + cw) * 3]);
+    }
+    let crop = CodeImage {
+        width: cw,
+        height: ch,
+        bits: img.bits,
+        data,
+        label: img.label.clone(),
+    };
+    if let Some((rh, rv, n)) = second_difference_autocorrelation(&crop, 1) {
+        let mean = 0.5 * (rh + rv);
+        if mean > RESAMPLED_THRESHOLD {
+            return Err(HdrError::Resampled {
+                image: img.label.clone(),
+                evidence: format!(
+                    "noise second-difference autocorrelation {mean:.3} (rows {rh:.3}, columns {rv:.3}, {n} pairs); \
+                     native sensor noise gives −0.667, the limit is {RESAMPLED_THRESHOLD}"
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::sensor::CameraModel;
+    use crate::camera::test_chart::{SEVEN_STOP_TIMES_S, hdr_chart};
+    use image::imageops::FilterType;
+
+    fn downscale(img: &CodeImage, w: u32, h: u32, filter: FilterType) -> CodeImage {
+        let buf: Vec<u8> = img.data.iter().map(|&z| z as u8).collect();
+        let rgb = image::RgbImage::from_raw(img.width as u32, img.height as u32, buf).unwrap();
+        let small = image::imageops::resize(&rgb, w, h, filter);
+        CodeImage {
+            width: w as usize,
+            height: h as usize,
+            bits: 8,
+            data: small.into_raw().into_iter().map(u16::from).collect(),
+            label: format!("{} resized", img.label),
+        }
+    }
+
+    #[test]
+    fn native_noise_is_white_and_resampled_is_refused() {
+        let cam = CameraModel::typical(8);
+        let scene = hdr_chart(192, 128);
+        let native: Vec<CodeImage> = SEVEN_STOP_TIMES_S
+            .iter()
+            .enumerate()
+            .map(|(j, &t)| cam.photograph(&scene, t, j as u64))
+            .collect();
+        let (rh, rv, _) = second_difference_autocorrelation(&native[3], 1).unwrap();
+        assert!(
+            (rh + 2.0 / 3.0).abs() < 0.12 && (rv + 2.0 / 3.0).abs() < 0.12,
+            "native: {rh} {rv}"
+        );
+        let b = Bracket::new(native.clone(), SEVEN_STOP_TIMES_S.to_vec()).unwrap();
+        check_not_resampled(&b).unwrap();
+        for (w, h, f) in [
+            (96, 64, FilterType::Triangle),
+            (128, 85, FilterType::CatmullRom),
+            (120, 80, FilterType::Lanczos3),
+        ] {
+            let small: Vec<CodeImage> = native.iter().map(|im| downscale(im, w, h, f)).collect();
+            let b = Bracket::new(small, SEVEN_STOP_TIMES_S.to_vec()).unwrap();
+            let e = check_not_resampled(&b).unwrap_err();
+            assert!(e.to_string().contains("looks resampled"), "{w}x{h} {f:?}: {e}");
+        }
+    }
+}

@@ -1,0 +1,24 @@
+//! Sky radiance models (thesis §5.3.2): the seven-parameter all-weather
+//! model the station fits (eq. 5.9), and the fifteen CIE standard general
+//! skies (CIE S 011/E:2003, ISO 15469) the fit is tested against and may
+//! choose between.
+//!
+//! Angles: ξ is a sky element's zenith angle, γ its angular distance from
+//! the sun, both in radians.
+
+mod cie;
+mod file;
+mod fit;
+mod geometry;
+mod predict;
+mod seven_parameter;
+
+pub use cie::{CieSky, CieSkyType};
+pub use file::{ChannelSky, SampleTable, SampleTableError, SkyFile, read_directions, read_samples};
+pub use fit::{
+    AUREOLE_SEEN_RAD, Candidate, OUTLIER_FLOOR, RobustSkyFit, SkyFit, SkyFitError, SkyModelKind, SkySample,
+    WEIGHT_FLOOR, fit_sky, fit_sky_robust,
+};
+pub use geometry::{angle_between, sky_angles};
+pub use predict::{KnownSky, OvercastSky, PredictError, predict_sky, redden};
+pub use seven_parameter::{COS_XI_FLOOR, SkyModel};

@@ -1,0 +1,352 @@
+//! `campanile hdr calibrate|merge|lens`: camera response recovery, HDR
+//! merging and lens calibration on plain files. The science lives in
+//! `campanile_process::hdr`; this module parses arguments, reads and writes
+//! files, and maps errors to exit codes.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, anyhow};
+use campanile_process::exr_io::{read_rgb_exr, write_radiance_exr};
+use campanile_process::hdr::HdrError;
+use campanile_process::hdr::bracket::Bracket;
+use campanile_process::hdr::bracket_list::{load_bracket, parse_time_s, read_bracket_list};
+use campanile_process::hdr::curve::ResponseCurve;
+use campanile_process::hdr::curve_plot::curve_plot_svg;
+use campanile_process::hdr::debevec::{DEFAULT_LAMBDA, DebevecOptions, Smoothness, calibrate_debevec};
+use campanile_process::hdr::lens::{LensModel, fit_distortion, fit_falloff, undistort_map};
+use campanile_process::hdr::merge::{MergeOptions, NoiseModel, merge};
+use campanile_process::hdr::robertson::{RobertsonOptions, calibrate_robertson};
+use campanile_process::hdr::sampling::SampleOptions;
+use clap::{Args, Subcommand, ValueEnum};
+
+use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
+
+#[derive(Debug, Subcommand)]
+pub enum HdrCommand {
+    /// Recover the camera response curve from an exposure bracket.
+    ///
+    /// Writes the curve as CSV (g(z) = ln relative exposure per code and
+    /// channel, with its 1σ uncertainty and support) and an SVG plot with the
+    /// ±2σ band. 8-bit images that were resampled after capture are refused.
+    #[command(verbatim_doc_comment)]
+    Calibrate(CalibrateArgs),
+    /// Merge an exposure bracket into an OpenEXR radiance map.
+    ///
+    /// Channels: R, G, B (radiance), variance.R/G/B, valid (1/0) and mask
+    /// (bits: saturated 1<<c, underexposed 8<<c). Pixels clipped in every
+    /// exposure keep the darkest exposure's bound.
+    #[command(verbatim_doc_comment)]
+    Merge(MergeArgs),
+    /// Fit the lens model 1 + a r² + b r⁴ (falloff and distortion).
+    ///
+    /// Falloff from a flat-field radiance map (EXR with R, G, B; a uniformly
+    /// lit uniform target filling the view); distortion from a CSV of
+    /// "r_distorted,r_ideal" normalized radii (r = 1 at the corners).
+    #[command(verbatim_doc_comment)]
+    Lens(LensArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct BracketArgs {
+    /// Images of the bracket (PNG or TIFF, 8 or 16 bits).
+    #[arg(value_name = "IMAGE")]
+    images: Vec<PathBuf>,
+    /// Exposure times in seconds, one per image, comma separated ("1/30" allowed).
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    times: Vec<String>,
+    /// A bracket list file, one "IMAGE TIME_S" per line, instead of IMAGE… --times.
+    #[arg(long, conflicts_with_all = ["images", "times"])]
+    list: Option<PathBuf>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Method {
+    /// Debevec–Malik (smoothness-regularized least squares).
+    Debevec,
+    /// Robertson et al. (iterative maximum likelihood), for comparison.
+    Robertson,
+}
+
+#[derive(Debug, Args)]
+pub struct CalibrateArgs {
+    #[command(flatten)]
+    bracket: BracketArgs,
+    /// Output curve (CSV).
+    #[arg(long, short)]
+    out: PathBuf,
+    /// Output plot (SVG); default: the curve's path with .svg.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Recovery method.
+    #[arg(long, value_enum, default_value_t = Method::Debevec)]
+    method: Method,
+    /// Smoothness weight λ (Debevec–Malik).
+    #[arg(long, default_value_t = DEFAULT_LAMBDA)]
+    lambda: f64,
+    /// Pixels sampled per channel.
+    #[arg(long, default_value_t = 4000)]
+    samples: usize,
+    /// Seed of the sample selection.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Also fit the true exposure times (labelled times are often off by a few %).
+    #[arg(long)]
+    fit_times: bool,
+    /// Accept 8-bit images that look resampled (for cameras that filter their own output).
+    #[arg(long)]
+    allow_resampled: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    #[command(flatten)]
+    bracket: BracketArgs,
+    /// Response curve (CSV from `hdr calibrate`).
+    #[arg(long)]
+    curve: PathBuf,
+    /// Output radiance map (OpenEXR).
+    #[arg(long, short)]
+    out: PathBuf,
+    /// ND filter transmittance: one value, or R,G,B.
+    #[arg(long, value_delimiter = ',', default_value = "1")]
+    nd: Vec<f64>,
+    /// Radiometric scale (W·m⁻²·sr⁻¹ per unit of relative exposure per second): one value or R,G,B.
+    #[arg(long, value_delimiter = ',', default_value = "1")]
+    scale: Vec<f64>,
+    /// Lens model file (from `hdr lens`): divides out falloff, then undistorts.
+    #[arg(long)]
+    lens: Option<PathBuf>,
+    /// Sensor full well in electrons (noise-optimal weights).
+    #[arg(long, default_value_t = NoiseModel::default().full_well_electrons)]
+    full_well: f64,
+    /// Sensor read noise in electrons.
+    #[arg(long, default_value_t = NoiseModel::default().read_noise_electrons)]
+    read_noise: f64,
+}
+
+#[derive(Debug, Args)]
+pub struct LensArgs {
+    /// Flat-field radiance map (EXR with R, G, B) for the falloff fit.
+    #[arg(long)]
+    flat: Option<PathBuf>,
+    /// CSV of "r_distorted,r_ideal" pairs for the distortion fit.
+    #[arg(long)]
+    pairs: Option<PathBuf>,
+    /// Output lens model (text, key = value).
+    #[arg(long, short)]
+    out: PathBuf,
+}
+
+/// Runs an `hdr` subcommand; returns the exit code (0 ok, 1 failure, 2 bad input or usage).
+pub fn run(cmd: HdrCommand) -> u8 {
+    let result = match cmd {
+        HdrCommand::Calibrate(a) => calibrate(&a),
+        HdrCommand::Merge(a) => merge_cmd(&a),
+        HdrCommand::Lens(a) => lens(&a),
+    };
+    match result {
+        Ok(()) => EXIT_OK,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            exit_code(&e)
+        }
+    }
+}
+
+/// 2 for problems with the input (files, values, options), 1 for failures while working.
+fn exit_code(e: &anyhow::Error) -> u8 {
+    match e.chain().find_map(|c| c.downcast_ref::<HdrError>()) {
+        Some(HdrError::Singular { .. }) => EXIT_FAILURE,
+        Some(HdrError::Io { .. } | HdrError::Exr { .. }) if is_output_error(e) => EXIT_FAILURE,
+        Some(_) => EXIT_USAGE,
+        None if is_output_error(e) => EXIT_FAILURE,
+        None => EXIT_USAGE,
+    }
+}
+
+fn is_output_error(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| c.to_string().starts_with("writing "))
+}
+
+fn load(args: &BracketArgs) -> Result<Bracket> {
+    let (paths, times) = match &args.list {
+        Some(list) => read_bracket_list(list).with_context(|| format!("reading bracket list {}", list.display()))?,
+        None => {
+            if args.images.is_empty() {
+                return Err(anyhow!("no images: give IMAGE… --times T,… or --list FILE"));
+            }
+            let times = args
+                .times
+                .iter()
+                .map(|t| {
+                    parse_time_s(t)
+                        .ok_or_else(|| anyhow!("--times: '{t}' is not a time in seconds > 0 (e.g. 0.033 or 1/30)"))
+                })
+                .collect::<Result<Vec<_>>>()?;
+            (args.images.clone(), times)
+        }
+    };
+    load_bracket(&paths, &times).context("reading the bracket")
+}
+
+fn write(path: &Path, text: &str) -> Result<()> {
+    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+}
+
+fn calibrate(a: &CalibrateArgs) -> Result<()> {
+    let bracket = load(&a.bracket)?;
+    let sampling = SampleOptions {
+        samples: a.samples,
+        seed: a.seed,
+        ..Default::default()
+    };
+    let (curve, method) = match a.method {
+        Method::Debevec => {
+            let opts = DebevecOptions {
+                lambda: a.lambda,
+                smoothness: Smoothness::Code,
+                sampling,
+                fit_exposure_times: a.fit_times,
+                allow_resampled: a.allow_resampled,
+                ..Default::default()
+            };
+            let cal = calibrate_debevec(&bracket, &opts).context("recovering the response (Debevec–Malik)")?;
+            for (c, d) in cal.channels.iter().enumerate() {
+                println!(
+                    "channel {}: {} samples, {} observations, residual RMS {:.4}, {} nodes made monotone, \
+                     condition ≈ {:.1e}, dark-end bias correction up to {:.3}",
+                    ["R", "G", "B"][c],
+                    d.samples,
+                    d.observations,
+                    d.residual_rms,
+                    d.monotone_adjustments,
+                    d.condition_estimate,
+                    d.noise_bias.max_correction
+                );
+            }
+            if a.fit_times {
+                for (label, fitted) in bracket.times_s().iter().zip(&cal.times_s) {
+                    println!(
+                        "exposure labelled {label} s: fitted {fitted:.6} s ({:+.2} %)",
+                        100.0 * (fitted / label - 1.0)
+                    );
+                }
+            }
+            (cal.curve, cal.method)
+        }
+        Method::Robertson => {
+            let opts = RobertsonOptions {
+                sampling,
+                allow_resampled: a.allow_resampled,
+                ..Default::default()
+            };
+            let (curve, iters) = calibrate_robertson(&bracket, &opts).context("recovering the response (Robertson)")?;
+            println!("Robertson: {iters:?} iterations (R, G, B)");
+            (curve, format!("robertson samples={} seed={}", a.samples, a.seed))
+        }
+    };
+    write(&a.out, &curve.to_csv(&method))?;
+    let plot = a.plot.clone().unwrap_or_else(|| a.out.with_extension("svg"));
+    let svg = curve_plot_svg(&curve, &format!("Response curve ({method})")).context("plotting the curve")?;
+    write(&plot, &svg)?;
+    println!("wrote {} and {}", a.out.display(), plot.display());
+    Ok(())
+}
+
+fn per_channel(name: &str, v: &[f64]) -> Result<[f64; 3]> {
+    match v {
+        [x] => Ok([*x; 3]),
+        [r, g, b] => Ok([*r, *g, *b]),
+        _ => Err(anyhow!(
+            "--{name}: {} values given: expected one value or three (R,G,B)",
+            v.len()
+        )),
+    }
+}
+
+fn merge_cmd(a: &MergeArgs) -> Result<()> {
+    let bracket = load(&a.bracket)?;
+    let text = std::fs::read_to_string(&a.curve).with_context(|| format!("reading curve {}", a.curve.display()))?;
+    let curve = ResponseCurve::from_csv(&text, &a.curve).context("reading the curve")?;
+    let lens = match &a.lens {
+        Some(p) => {
+            let t = std::fs::read_to_string(p).with_context(|| format!("reading lens model {}", p.display()))?;
+            Some(LensModel::from_text(&t, p)?)
+        }
+        None => None,
+    };
+    let opts = MergeOptions {
+        noise: NoiseModel {
+            full_well_electrons: a.full_well,
+            read_noise_electrons: a.read_noise,
+        },
+        nd_transmittance: per_channel("nd", &a.nd)?,
+        radiometric_scale: per_channel("scale", &a.scale)?,
+        falloff: lens.map(|l| l.falloff),
+    };
+    let mut map = merge(&bracket, &curve, &opts).context("merging")?;
+    if let Some(l) = lens
+        && (l.distortion.a != 0.0 || l.distortion.b != 0.0)
+    {
+        map = undistort_map(&map, &l.distortion);
+    }
+    write_radiance_exr(&map, &a.out).context("writing the radiance map")?;
+    let invalid = map.mask.iter().filter(|&&m| m != 0).count();
+    println!(
+        "wrote {} ({}×{}, {} exposures; {invalid} pixels clipped in some channel in every exposure)",
+        a.out.display(),
+        map.width,
+        map.height,
+        bracket.len()
+    );
+    Ok(())
+}
+
+fn lens(a: &LensArgs) -> Result<()> {
+    if a.flat.is_none() && a.pairs.is_none() {
+        return Err(anyhow!("nothing to fit: give --flat FLAT.exr and/or --pairs PAIRS.csv"));
+    }
+    let mut model = LensModel::default();
+    if let Some(flat) = &a.flat {
+        let img = read_rgb_exr(flat).with_context(|| format!("reading flat field {}", flat.display()))?;
+        let (falloff, rms) = fit_falloff(&img).context("fitting the falloff")?;
+        println!(
+            "falloff: a = {:.6}, b = {:.6} (RMS relative residual {:.4})",
+            falloff.a, falloff.b, rms
+        );
+        model.falloff = falloff;
+    }
+    if let Some(pairs) = &a.pairs {
+        let text = std::fs::read_to_string(pairs).with_context(|| format!("reading {}", pairs.display()))?;
+        let mut v = Vec::new();
+        for (i, line) in text.lines().enumerate() {
+            let line = line.trim();
+            if line.is_empty() || line.starts_with('#') || line.starts_with('r') {
+                continue;
+            }
+            let (d, u) = line.split_once(',').ok_or_else(|| {
+                anyhow!(
+                    "{}:{}: '{line}': expected 'r_distorted,r_ideal'",
+                    pairs.display(),
+                    i + 1
+                )
+            })?;
+            let num = |s: &str| {
+                s.trim()
+                    .parse::<f64>()
+                    .map_err(|_| anyhow!("{}:{}: '{}': expected a number", pairs.display(), i + 1, s.trim()))
+            };
+            v.push((num(d)?, num(u)?));
+        }
+        model.distortion = fit_distortion(&v).context("fitting the distortion")?;
+        println!(
+            "distortion: a = {:.6}, b = {:.6} ({} pairs)",
+            model.distortion.a,
+            model.distortion.b,
+            v.len()
+        );
+    }
+    write(&a.out, &model.to_text())?;
+    println!("wrote {}", a.out.display());
+    Ok(())
+}
