@@ -12,5 +12,6 @@ pub mod csv_cell;
 pub mod environment;
 pub mod exr_io;
 pub mod hdr;
+pub mod pose;
 pub mod sky;
 pub mod sun;

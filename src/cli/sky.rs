@@ -5,9 +5,7 @@ use std::io::{BufReader, Write};
 use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
-use campanile_process::sky::{
-    ChannelSky, SkyFile, SkySample, angle_between, fit_sky_robust, read_directions, read_samples,
-};
+use campanile_process::sky::{ChannelSky, SkyFile, angle_between, fit_sky_robust, read_directions, read_samples};
 use campanile_process::sun::{Ephemeris, Observer};
 use chrono::{DateTime, Utc};
 use clap::{Args, Subcommand};
@@ -123,18 +121,8 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
             let table = read_samples(BufReader::new(file)).with_context(|| format!("{}", samples.display()))?;
             let sun_dir = direction(zs, az);
             let mut channels = Vec::new();
-            for (name, values) in table.channels.iter().zip(&table.values) {
-                let pts: Vec<SkySample> = table
-                    .directions
-                    .iter()
-                    .zip(values)
-                    .map(|(&(z, a), &v)| SkySample {
-                        xi: z,
-                        gamma: angle_between(direction(z, a), sun_dir),
-                        radiance: v,
-                    })
-                    .filter(|s| s.gamma > 0.5f64.to_radians())
-                    .collect();
+            for (c, name) in table.channels.iter().enumerate() {
+                let pts = table.sky_samples(c, sun_dir);
                 let robust =
                     fit_sky_robust(&pts, zs).with_context(|| format!("{}: channel {name}", samples.display()))?;
                 let fit = &robust.fit;

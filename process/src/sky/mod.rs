@@ -9,6 +9,7 @@
 mod cie;
 mod file;
 mod fit;
+mod frame_samples;
 mod geometry;
 mod predict;
 mod seven_parameter;
@@ -19,6 +20,7 @@ pub use fit::{
     AUREOLE_SEEN_RAD, Candidate, OUTLIER_FLOOR, RobustSkyFit, SkyFit, SkyFitError, SkyModelKind, SkySample,
     WEIGHT_FLOOR, fit_sky, fit_sky_robust,
 };
+pub use frame_samples::{FrameSampleError, MIN_ELEVATION_RAD, SkyFrame, sky_samples};
 pub use geometry::{angle_between, sky_angles};
 pub use predict::{KnownSky, OvercastSky, PredictError, predict_sky, redden};
 pub use seven_parameter::{COS_XI_FLOOR, SkyModel};

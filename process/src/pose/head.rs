@@ -1,0 +1,181 @@
+//! Pan-tilt head kinematics. Pan turns about the vertical, like azimuth
+//! (from north toward east); tilt raises the optical axis. The mount
+//! calibration gives the azimuth at pan 0, the tilt reading at the horizon,
+//! and the small roll (about north) and pitch (about east) of a base that
+//! is not quite level.
+
+/// How the head sits in the world.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Mount {
+    /// Azimuth the camera faces at pan 0, radians.
+    pub pan_zero_azimuth_rad: f64,
+    /// Tilt reading with the optical axis horizontal, radians.
+    pub tilt_zero_rad: f64,
+    /// Roll of the base about the north axis, radians.
+    pub roll_rad: f64,
+    /// Pitch of the base about the east axis, radians.
+    pub pitch_rad: f64,
+}
+
+/// A head reading.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeadPose {
+    /// Pan, radians, in the head's own reading.
+    pub pan_rad: f64,
+    /// Tilt, radians, in the head's own reading.
+    pub tilt_rad: f64,
+}
+
+fn rotate_x(v: [f64; 3], a: f64) -> [f64; 3] {
+    let (s, c) = a.sin_cos();
+    [v[0], c * v[1] - s * v[2], s * v[1] + c * v[2]]
+}
+
+fn rotate_y(v: [f64; 3], a: f64) -> [f64; 3] {
+    let (s, c) = a.sin_cos();
+    [c * v[0] + s * v[2], v[1], -s * v[0] + c * v[2]]
+}
+
+impl Mount {
+    /// The world-frame direction of a camera-frame direction `d` (x right,
+    /// y down, z forward) with the head at `pose`.
+    pub fn to_world(&self, pose: HeadPose, d: [f64; 3]) -> [f64; 3] {
+        let az = self.pan_zero_azimuth_rad + pose.pan_rad;
+        let el = pose.tilt_rad - self.tilt_zero_rad;
+        let (sa, ca) = az.sin_cos();
+        let (se, ce) = el.sin_cos();
+        let forward = [ce * sa, ce * ca, se];
+        let right = [ca, -sa, 0.0];
+        // down = forward × right
+        let down = [
+            forward[1] * right[2] - forward[2] * right[1],
+            forward[2] * right[0] - forward[0] * right[2],
+            forward[0] * right[1] - forward[1] * right[0],
+        ];
+        let level = [0, 1, 2].map(|i| d[0] * right[i] + d[1] * down[i] + d[2] * forward[i]);
+        // The base's tilt: roll about north (y), then pitch about east (x).
+        rotate_x(rotate_y(level, self.roll_rad), self.pitch_rad)
+    }
+
+    /// The camera-frame direction of a world-frame direction (the inverse
+    /// of [`Mount::to_world`]).
+    pub fn to_camera(&self, pose: HeadPose, w: [f64; 3]) -> [f64; 3] {
+        let level = rotate_y(rotate_x(w, -self.pitch_rad), -self.roll_rad);
+        let az = self.pan_zero_azimuth_rad + pose.pan_rad;
+        let el = pose.tilt_rad - self.tilt_zero_rad;
+        let (sa, ca) = az.sin_cos();
+        let (se, ce) = el.sin_cos();
+        let forward = [ce * sa, ce * ca, se];
+        let right = [ca, -sa, 0.0];
+        let down = [
+            forward[1] * right[2] - forward[2] * right[1],
+            forward[2] * right[0] - forward[0] * right[2],
+            forward[0] * right[1] - forward[1] * right[0],
+        ];
+        let dot = |a: [f64; 3]| a[0] * level[0] + a[1] * level[1] + a[2] * level[2];
+        [dot(right), dot(down), dot(forward)]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::FRAC_PI_2;
+
+    fn close(a: [f64; 3], b: [f64; 3]) -> bool {
+        a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12)
+    }
+
+    #[test]
+    fn pan_turns_like_azimuth_and_tilt_raises_the_axis() {
+        let m = Mount::default();
+        let axis = [0.0, 0.0, 1.0];
+        assert!(
+            close(
+                m.to_world(
+                    HeadPose {
+                        pan_rad: 0.0,
+                        tilt_rad: 0.0
+                    },
+                    axis
+                ),
+                [0.0, 1.0, 0.0]
+            ),
+            "north"
+        );
+        assert!(
+            close(
+                m.to_world(
+                    HeadPose {
+                        pan_rad: FRAC_PI_2,
+                        tilt_rad: 0.0
+                    },
+                    axis
+                ),
+                [1.0, 0.0, 0.0]
+            ),
+            "east"
+        );
+        assert!(
+            close(
+                m.to_world(
+                    HeadPose {
+                        pan_rad: 0.3,
+                        tilt_rad: FRAC_PI_2
+                    },
+                    axis
+                ),
+                [0.0, 0.0, 1.0]
+            ),
+            "zenith"
+        );
+        // Image right is east when facing north; image down is down.
+        assert!(close(
+            m.to_world(
+                HeadPose {
+                    pan_rad: 0.0,
+                    tilt_rad: 0.0
+                },
+                [1.0, 0.0, 0.0]
+            ),
+            [1.0, 0.0, 0.0]
+        ));
+        assert!(close(
+            m.to_world(
+                HeadPose {
+                    pan_rad: 0.0,
+                    tilt_rad: 0.0
+                },
+                [0.0, 1.0, 0.0]
+            ),
+            [0.0, 0.0, -1.0]
+        ));
+    }
+
+    #[test]
+    fn the_mount_offsets_shift_and_the_inverse_undoes_them() {
+        let m = Mount {
+            pan_zero_azimuth_rad: 0.2,
+            tilt_zero_rad: 0.014,
+            roll_rad: 0.003,
+            pitch_rad: -0.002,
+        };
+        let pose = HeadPose {
+            pan_rad: 1.1,
+            tilt_rad: 0.4,
+        };
+        for d in [[0.0f64, 0.0, 1.0], [0.3, -0.2, 0.93], [-0.5, 0.4, 0.77]] {
+            let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            let d = d.map(|x| x / n);
+            assert!(close(m.to_camera(pose, m.to_world(pose, d)), d));
+        }
+        // With a level base, the axis is at azimuth pan_zero + pan and elevation tilt − tilt_zero.
+        let level = Mount {
+            roll_rad: 0.0,
+            pitch_rad: 0.0,
+            ..m
+        };
+        let w = level.to_world(pose, [0.0, 0.0, 1.0]);
+        assert!((w[0].atan2(w[1]) - 1.3).abs() < 1e-12 && (w[2].asin() - 0.386).abs() < 1e-12);
+    }
+}
