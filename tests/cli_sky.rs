@@ -99,3 +99,80 @@ fn a_sun_below_the_horizon_is_refused_with_a_reason() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// A sky file with one channel `g` of the given eq. (5.9) parameters.
+fn sky_ron(zenith_deg: f64, azimuth_deg: f64) -> String {
+    format!(
+        "(sun_zenith_deg: {zenith_deg:.1}, sun_azimuth_deg: {azimuth_deg:.1}, channels: [(channel: \"g\", \
+         model: (lz: 0.07, a: -1.0, b: -0.4, c: 12.0, d: -3.2, e: 0.5, h: 0.9), chosen: \"SevenParameter\", \
+         reason: \"test\", rms_relative: 0.0, samples: 100, masked_fraction: 0.0)])"
+    )
+}
+
+#[test]
+fn predict_interpolates_fitted_skies_to_a_new_sun() {
+    let dir_tmp = tempfile::tempdir().expect("temp");
+    let morning = dir_tmp.path().join("morning.ron");
+    let evening = dir_tmp.path().join("evening.ron");
+    let predicted = dir_tmp.path().join("predicted.ron");
+    std::fs::write(&morning, sky_ron(60.0, 100.0)).expect("write");
+    std::fs::write(&evening, sky_ron(55.0, 250.0)).expect("write");
+    let out = campanile(&[
+        "sky",
+        "predict",
+        morning.to_str().expect("utf-8"),
+        evening.to_str().expect("utf-8"),
+        "--sun-zenith-deg",
+        "35",
+        "--sun-azimuth-deg",
+        "180",
+        "--out",
+        predicted.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    // Same shape, new sun: the predicted sky is the model's, seen from the new sun.
+    let dirs = dir_tmp.path().join("dirs.csv");
+    std::fs::write(&dirs, "zenith_deg,azimuth_deg\n35,180\n60,10\n").expect("write");
+    let out = campanile(&[
+        "sky",
+        "eval",
+        predicted.to_str().expect("utf-8"),
+        dirs.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let model = |xi: f64, gamma: f64| {
+        0.07 * (1.0 - (-0.4 / xi.cos()).exp())
+            * (1.0 + 12.0 * (-3.2 * gamma.powf(0.9)).exp() + 0.5 * gamma.cos().powi(2))
+    };
+    let rows: Vec<f64> = stdout
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(2).and_then(|v| v.parse().ok()).expect("value"))
+        .collect();
+    // Row 2: ξ = 60°, azimuth 10°, γ from the new sun at (35°, 180°).
+    let sun = dir(35f64.to_radians(), 180f64.to_radians());
+    let v = dir(60f64.to_radians(), 10f64.to_radians());
+    let gamma = (v[0] * sun[0] + v[1] * sun[1] + v[2] * sun[2]).clamp(-1.0, 1.0).acos();
+    let want = model(60f64.to_radians(), gamma);
+    assert!((rows[1] / want - 1.0).abs() < 2e-3, "{} vs {want}", rows[1]);
+
+    // Skies with different channels are refused.
+    std::fs::write(&evening, sky_ron(55.0, 250.0).replace("\"g\"", "\"r\"")).expect("write");
+    let out = campanile(&[
+        "sky",
+        "predict",
+        morning.to_str().expect("utf-8"),
+        evening.to_str().expect("utf-8"),
+        "--sun-zenith-deg",
+        "35",
+        "--sun-azimuth-deg",
+        "180",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("differ from"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

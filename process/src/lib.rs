@@ -12,6 +12,7 @@ pub mod csv_cell;
 pub mod environment;
 pub mod exr_io;
 pub mod hdr;
+pub mod model_choice;
 pub mod pose;
 pub mod sky;
 pub mod sun;

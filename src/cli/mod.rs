@@ -1,8 +1,10 @@
 //! Argument parsing and dispatch. One module per subcommand.
 
 mod config_check;
+mod env;
 mod hdr;
 mod logging;
+mod site;
 mod sky;
 mod sun;
 
@@ -53,7 +55,12 @@ pub enum Command {
     },
     /// Where the sun is: one instant, or a CSV table of instants and sites.
     Sun(sun::SunArgs),
-    /// Sky models: fit them to sky samples, evaluate them.
+    /// The environment: fit region radiance models, predict them under new light.
+    Env {
+        #[command(subcommand)]
+        action: env::EnvCommand,
+    },
+    /// Sky models: fit them to sky samples, predict them at other sun positions, evaluate them.
     Sky {
         #[command(subcommand)]
         action: sky::SkyCommand,
@@ -90,6 +97,7 @@ pub fn run() -> ExitCode {
         Command::Hdr { action } => hdr::run(action),
         Command::Sun(args) => report(sun::run(args)),
         Command::Sky { action } => report(sky::run(action)),
+        Command::Env { action } => report(env::run(action)),
     };
     ExitCode::from(code)
 }

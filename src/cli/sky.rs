@@ -5,8 +5,10 @@ use std::io::{BufReader, Write};
 use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
-use campanile_process::sky::{ChannelSky, SkyFile, angle_between, fit_sky_robust, read_directions, read_samples};
-use campanile_process::sun::{Ephemeris, Observer};
+use campanile_process::sky::{
+    ChannelSky, KnownSky, SkyFile, angle_between, fit_sky_robust, predict_sky, read_directions, read_samples,
+};
+use campanile_process::sun::Ephemeris;
 use chrono::{DateTime, Utc};
 use clap::{Args, Subcommand};
 
@@ -41,6 +43,27 @@ pub enum SkyCommand {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Predict the sky at another sun position from skies fitted at others.
+    ///
+    /// Interpolates each channel as the thesis does (§5.5.1): the scale, the
+    /// background and the aureole of the known skies are averaged separately
+    /// with weights inversely proportional to the angle between their suns
+    /// and the new sun, then a new model is fitted. Give at least one fitted
+    /// sky (RON from `sky fit`), with the same channels, and the new sun.
+    ///
+    /// Example: campanile sky predict morning.ron noon.ron evening.ron \
+    ///            --time 2026-08-28T22:00:00Z --station examples/sim-station.ron --out sky.ron
+    #[command(verbatim_doc_comment)]
+    Predict {
+        /// Fitted skies (RON), one per time.
+        #[arg(required = true)]
+        skies: Vec<PathBuf>,
+        #[command(flatten)]
+        sun: SunArgs,
+        /// Where to write the predicted sky (RON); standard output when absent.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Evaluate fitted skies (RON from `sky fit`) at directions.
     ///
     /// DIRECTIONS is a CSV with zenith_deg and azimuth_deg; the output adds
@@ -71,46 +94,55 @@ pub struct SunArgs {
 }
 
 impl SunArgs {
-    /// (zenith, azimuth) in radians.
-    fn resolve(&self) -> Result<(f64, f64)> {
+    /// (zenith, azimuth) in radians, for a sun that may be below the
+    /// horizon (the environment is lit by the sky alone then).
+    pub fn resolve_any(&self) -> Result<(f64, f64)> {
         match (self.sun_zenith_deg, self.sun_azimuth_deg, self.time, &self.station) {
-            (Some(z), Some(a), _, _) => {
-                if !(0.0..=90.0).contains(&z) {
-                    bail!(
-                        "--sun-zenith-deg {z}: expected a zenith angle in [0, 90] degrees (the sky model needs the sun up)"
-                    );
-                }
-                Ok((z.to_radians(), a.to_radians()))
-            }
+            (Some(z), Some(a), _, _) if (0.0..=180.0).contains(&z) => Ok((z.to_radians(), a.to_radians())),
+            (Some(z), Some(_), _, _) => bail!("--sun-zenith-deg {z}: expected a zenith angle in [0, 180] degrees"),
             (_, _, Some(t), Some(path)) => {
-                let s = campanile_config::load_station(path)
-                    .map_err(|e| anyhow::anyhow!("{e}"))?
-                    .value
-                    .site;
-                let obs = Observer::from_degrees(
-                    s.latitude_deg,
-                    s.longitude_deg,
-                    s.elevation_m,
-                    s.pressure_mbar,
-                    s.temperature_c,
-                );
+                let s = super::site::station_site(path)?;
+                let obs = super::site::observer(&s);
                 let p = Ephemeris::at(t, s.delta_t_s)?.position(&obs)?;
-                if p.zenith_rad > std::f64::consts::FRAC_PI_2 {
-                    bail!(
-                        "at {t} the sun is {:.2}° below the horizon at {}: no daylight sky to fit",
-                        -p.elevation_rad().to_degrees(),
-                        s.name
-                    );
-                }
                 Ok((p.zenith_rad, p.azimuth_rad))
             }
             _ => bail!("give the sun: --sun-zenith-deg and --sun-azimuth-deg, or --time and --station"),
         }
     }
+
+    /// (zenith, azimuth) in radians, for a sun above the horizon.
+    fn resolve(&self) -> Result<(f64, f64)> {
+        let (z, a) = self.resolve_any()?;
+        if z > std::f64::consts::FRAC_PI_2 {
+            bail!(
+                "the sun is {:.2}° below the horizon then: no daylight sky to fit or predict",
+                (z - std::f64::consts::FRAC_PI_2).to_degrees()
+            );
+        }
+        Ok((z, a))
+    }
 }
 
 fn direction(zenith: f64, azimuth: f64) -> [f64; 3] {
     [zenith.sin() * azimuth.sin(), zenith.sin() * azimuth.cos(), zenith.cos()]
+}
+
+fn read_sky(path: &PathBuf) -> Result<SkyFile> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    ron::from_str(&text).map_err(|e| anyhow::anyhow!("{}:{}: {}", path.display(), e.span.start, e.code))
+}
+
+fn write_sky(sky: &SkyFile, out: Option<PathBuf>) -> Result<()> {
+    let text = ron::ser::to_string_pretty(sky, ron::ser::PrettyConfig::default())?;
+    match out {
+        Some(path) => {
+            let tmp = path.with_extension("ron.partial");
+            std::fs::write(&tmp, text + "\n").with_context(|| format!("{}: cannot write", tmp.display()))?;
+            std::fs::rename(&tmp, &path).with_context(|| format!("{}: cannot write", path.display()))?;
+        }
+        None => println!("{text}"),
+    }
+    Ok(())
 }
 
 pub fn run(cmd: SkyCommand) -> Result<()> {
@@ -141,21 +173,46 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
                 sun_azimuth_deg: az.to_degrees(),
                 channels,
             };
-            let text = ron::ser::to_string_pretty(&sky, ron::ser::PrettyConfig::default())?;
-            match out {
-                Some(path) => {
-                    let tmp = path.with_extension("ron.partial");
-                    std::fs::write(&tmp, text + "\n").with_context(|| format!("{}: cannot write", tmp.display()))?;
-                    std::fs::rename(&tmp, &path).with_context(|| format!("{}: cannot write", path.display()))?;
+            write_sky(&sky, out)
+        }
+        SkyCommand::Predict { skies, sun, out } => {
+            let (zs, az) = sun.resolve()?;
+            let known: Vec<SkyFile> = skies.iter().map(read_sky).collect::<Result<_>>()?;
+            let names: Vec<&str> = known[0].channels.iter().map(|c| c.channel.as_str()).collect();
+            for (path, k) in skies.iter().zip(&known) {
+                let these: Vec<&str> = k.channels.iter().map(|c| c.channel.as_str()).collect();
+                if these != names {
+                    bail!(
+                        "{}: channels {these:?} differ from {}'s {names:?}",
+                        path.display(),
+                        skies[0].display()
+                    );
                 }
-                None => println!("{text}"),
             }
-            Ok(())
+            let sun_dir = direction(zs, az);
+            let mut channels = Vec::new();
+            for (c, name) in names.iter().enumerate() {
+                let skies_c: Vec<KnownSky> = known
+                    .iter()
+                    .map(|k| KnownSky {
+                        sun: direction(k.sun_zenith_deg.to_radians(), k.sun_azimuth_deg.to_radians()),
+                        model: k.channels[c].model,
+                    })
+                    .collect();
+                let fit = predict_sky(&skies_c, sun_dir, 3.0).with_context(|| format!("channel {name}"))?;
+                channels.push(ChannelSky::new(name, &fit, 0, 0.0));
+            }
+            write_sky(
+                &SkyFile {
+                    sun_zenith_deg: zs.to_degrees(),
+                    sun_azimuth_deg: az.to_degrees(),
+                    channels,
+                },
+                out,
+            )
         }
         SkyCommand::Eval { sky, directions } => {
-            let text = std::fs::read_to_string(&sky).with_context(|| format!("{}: cannot read", sky.display()))?;
-            let sky_file: SkyFile =
-                ron::from_str(&text).map_err(|e| anyhow::anyhow!("{}:{}: {}", sky.display(), e.span.start, e.code))?;
+            let sky_file = read_sky(&sky)?;
             let file = File::open(&directions).with_context(|| format!("{}: cannot open", directions.display()))?;
             let table = read_directions(BufReader::new(file)).with_context(|| format!("{}", directions.display()))?;
             let sun_dir = direction(

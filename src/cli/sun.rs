@@ -88,23 +88,9 @@ pub fn run(args: SunArgs) -> Result<()> {
     };
     let (observer, delta_t, zone, site_name) = match (&args.station, args.lat, args.lon) {
         (Some(path), _, _) => {
-            let st = campanile_config::load_station(path)
-                .map_err(|e| anyhow::anyhow!("{e}"))?
-                .value;
-            let s = st.site;
+            let s = super::site::station_site(path)?;
             let zone: chrono_tz::Tz = s.time_zone.parse().unwrap_or(chrono_tz::UTC);
-            (
-                Observer::from_degrees(
-                    s.latitude_deg,
-                    s.longitude_deg,
-                    s.elevation_m,
-                    s.pressure_mbar,
-                    s.temperature_c,
-                ),
-                s.delta_t_s,
-                zone,
-                s.name,
-            )
+            (super::site::observer(&s), s.delta_t_s, zone, s.name)
         }
         (None, Some(lat), Some(lon)) => (
             Observer::from_degrees(lat, lon, args.elevation_m, args.pressure_mbar, args.temperature_c),

@@ -22,6 +22,7 @@
 //! **Sky only.** A region never sunlit, or one whose sun term does not pay
 //! for its five extra parameters (by BIC), keeps only `ρ_sky`.
 
+use crate::model_choice::bic;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{DMatrix, DVector, Dyn, Matrix3xX, Owned, Vector3};
 
@@ -79,11 +80,29 @@ pub struct RegionFit {
 impl RegionFit {
     /// Predicted radiance under new light, eq. (5.13).
     pub fn radiance(&self, sky_irradiance: [f64; 3], sun_irradiance: [f64; 3], sun: [f64; 3]) -> [f64; 3] {
-        let cos = self
-            .normal
-            .map_or(0.0, |n| (n[0] * sun[0] + n[1] * sun[1] + n[2] * sun[2]).max(0.0));
-        [0, 1, 2].map(|c| self.rho_sky[c] * sky_irradiance[c] + self.rho_sun[c] * sun_irradiance[c] * cos)
+        region_radiance(
+            self.rho_sky,
+            self.rho_sun,
+            self.normal,
+            sky_irradiance,
+            sun_irradiance,
+            sun,
+        )
     }
+}
+
+/// Eq. (5.13): `ρ_sky E_sky + ρ_sun E_sun max(0, n · l)` per channel; no
+/// sun term without a normal.
+pub fn region_radiance(
+    rho_sky: [f64; 3],
+    rho_sun: [f64; 3],
+    normal: Option<[f64; 3]>,
+    sky_irradiance: [f64; 3],
+    sun_irradiance: [f64; 3],
+    sun: [f64; 3],
+) -> [f64; 3] {
+    let cos = normal.map_or(0.0, |n| (n[0] * sun[0] + n[1] * sun[1] + n[2] * sun[2]).max(0.0));
+    [0, 1, 2].map(|c| rho_sky[c] * sky_irradiance[c] + rho_sun[c] * sun_irradiance[c] * cos)
 }
 
 /// Why a region could not be fitted.
@@ -194,11 +213,6 @@ fn track_condition(obs: &[EnvironmentObservation]) -> f64 {
     let sv = m.singular_values();
     let (lo, hi) = (sv.min(), sv.max());
     if hi > 0.0 { lo / hi } else { 0.0 }
-}
-
-fn bic(rss: f64, n: usize, k: usize) -> f64 {
-    let n = n as f64;
-    n * (rss.max(1e-300) / n).ln() + k as f64 * n.ln()
 }
 
 /// Fits one region's model to its observations at several solar positions.
@@ -326,6 +340,11 @@ pub fn fit_region(obs: &[EnvironmentObservation]) -> Result<RegionFit, RegionFit
         let (lo, hi) = (sv.min(), sv.max());
         if lo > 0.0 { hi / lo } else { f64::INFINITY }
     });
+    if !jacobian_condition.is_finite() {
+        return Ok(sky_only(
+            "the sun term is not determined by these observations (singular Jacobian: the region is never sunlit or the lighting does not vary enough); sky term only".into(),
+        ));
+    }
     let v = Vector3::new(x[0], x[1], x[2]);
     let g = v.norm();
     let normal = v / g;

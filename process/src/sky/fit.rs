@@ -25,6 +25,7 @@
 //! sample lies within [`AUREOLE_SEEN_RAD`] of the sun). The smallest
 //! Bayesian information criterion `n ln(RSS/n) + k ln n` wins.
 
+use crate::model_choice::bic;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
 
@@ -283,11 +284,6 @@ fn rss_of(m: &SkyModel, samples: &[SkySample], sigma: &[f64]) -> f64 {
         .zip(sigma)
         .map(|(s, sg)| ((m.radiance(s.xi, s.gamma) - s.radiance) / sg).powi(2))
         .sum()
-}
-
-fn bic(rss: f64, n: usize, k: usize) -> f64 {
-    let n = n as f64;
-    n * (rss.max(1e-300) / n).ln() + k as f64 * n.ln()
 }
 
 /// Fits a sky to samples of one channel, with the sun at zenith angle

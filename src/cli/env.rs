@@ -1,0 +1,110 @@
+//! `campanile env`: fit environment region models, and predict regions
+//! under new light.
+
+use std::fs::File;
+use std::io::{BufReader, Write};
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use campanile_process::environment::{EnvironmentFile, RegionRecord, fit_region, read_observations};
+use clap::Subcommand;
+
+use super::sky::SunArgs;
+
+#[derive(Debug, Subcommand)]
+pub enum EnvCommand {
+    /// Fit each environment region's radiance model (thesis eq. 5.15).
+    ///
+    /// OBSERVATIONS is a CSV with one row per region and time: region (a
+    /// label), r,g,b (the region's mean radiance), sky_r,sky_g,sky_b (the
+    /// sky's flux E_sky), sun_r,sun_g,sun_b (solar irradiance E_sun),
+    /// sun_zenith_deg, sun_azimuth_deg. Each region gets ρ_sky, ρ_sun and a
+    /// normal from at least three solar positions, or the sky term alone when
+    /// it was never sunlit, the sun term does not pay for itself, or the sun
+    /// track is too nearly planar to give a normal; the output says which
+    /// and why, with the conditioning figures.
+    #[command(verbatim_doc_comment)]
+    Fit {
+        /// Region observations (CSV).
+        observations: PathBuf,
+        /// Where to write the models (RON); standard output when absent.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Predict every region's radiance under new light (eq. 5.13).
+    ///
+    /// Prints a CSV: region, r, g, b.
+    #[command(verbatim_doc_comment)]
+    Predict {
+        /// Region models (RON from `env fit`).
+        models: PathBuf,
+        /// The sky's flux E_sky per channel, "r,g,b".
+        #[arg(long, value_name = "R,G,B")]
+        sky_irradiance: String,
+        /// Solar irradiance E_sun per channel, "r,g,b".
+        #[arg(long, value_name = "R,G,B")]
+        sun_irradiance: String,
+        #[command(flatten)]
+        sun: SunArgs,
+    },
+}
+
+fn rgb(flag: &str, text: &str) -> Result<[f64; 3]> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|s| s.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("--{flag} {text:?}: expected three numbers \"r,g,b\""))?;
+    match v.as_slice() {
+        &[r, g, b] if v.iter().all(|x| x.is_finite() && *x >= 0.0) => Ok([r, g, b]),
+        _ => bail!("--{flag} {text:?}: expected three non-negative numbers \"r,g,b\""),
+    }
+}
+
+pub fn run(cmd: EnvCommand) -> Result<()> {
+    match cmd {
+        EnvCommand::Fit { observations, out } => {
+            let file = File::open(&observations).with_context(|| format!("{}: cannot open", observations.display()))?;
+            let groups =
+                read_observations(BufReader::new(file)).with_context(|| format!("{}", observations.display()))?;
+            let mut regions = Vec::new();
+            for (label, obs) in &groups {
+                let fit = fit_region(obs).with_context(|| format!("{}: region {label}", observations.display()))?;
+                tracing::info!(region = %label, model = ?fit.kind, rms = fit.rms_relative, "{}", fit.reason);
+                regions.push(RegionRecord::new(label, &fit));
+            }
+            let text = ron::ser::to_string_pretty(&EnvironmentFile { regions }, ron::ser::PrettyConfig::default())?;
+            match out {
+                Some(path) => {
+                    let tmp = path.with_extension("ron.partial");
+                    std::fs::write(&tmp, text + "\n").with_context(|| format!("{}: cannot write", tmp.display()))?;
+                    std::fs::rename(&tmp, &path).with_context(|| format!("{}: cannot write", path.display()))?;
+                }
+                None => println!("{text}"),
+            }
+            Ok(())
+        }
+        EnvCommand::Predict {
+            models,
+            sky_irradiance,
+            sun_irradiance,
+            sun,
+        } => {
+            let e_sky = rgb("sky-irradiance", &sky_irradiance)?;
+            let e_sun = rgb("sun-irradiance", &sun_irradiance)?;
+            let (z, a) = sun.resolve_any()?;
+            let l = [z.sin() * a.sin(), z.sin() * a.cos(), z.cos()];
+            let text =
+                std::fs::read_to_string(&models).with_context(|| format!("{}: cannot read", models.display()))?;
+            let env: EnvironmentFile = ron::from_str(&text)
+                .map_err(|e| anyhow::anyhow!("{}:{}: {}", models.display(), e.span.start, e.code))?;
+            let mut o = std::io::stdout().lock();
+            writeln!(o, "region,r,g,b")?;
+            for r in &env.regions {
+                let v = r.radiance(e_sky, e_sun, l);
+                writeln!(o, "{},{:.9e},{:.9e},{:.9e}", r.region, v[0], v[1], v[2])?;
+            }
+            Ok(())
+        }
+    }
+}
