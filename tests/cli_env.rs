@@ -72,7 +72,7 @@ fn fit_then_predict_a_fifth_time_of_day() {
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     let text = std::fs::read_to_string(&models).expect("written");
     assert!(
-        text.contains("model: \"SkyOnly\"") && text.contains("model: \"SkyAndSun\""),
+        text.contains("kind: SkyOnly") && text.contains("kind: SkyAndSun"),
         "{text}"
     );
 

@@ -36,3 +36,48 @@ pub fn number(
             expected,
         })
 }
+
+/// A problem with a CSV table as a whole or one of its cells.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TableError {
+    /// The CSV is malformed.
+    #[error("row {row}: {message}")]
+    Csv {
+        /// Row (the header is row 1).
+        row: u64,
+        /// What the parser said.
+        message: String,
+    },
+    /// A required column is absent.
+    #[error("the header has no `{column}` column (it has: {found})")]
+    MissingColumn {
+        /// The column.
+        column: &'static str,
+        /// The header as read.
+        found: String,
+    },
+    /// A cell cannot be read.
+    #[error(transparent)]
+    Cell(#[from] CellError),
+}
+
+impl TableError {
+    /// The parser's error at `row`.
+    pub fn csv(row: u64, e: &csv::Error) -> TableError {
+        TableError::Csv {
+            row,
+            message: e.to_string(),
+        }
+    }
+}
+
+/// The index of column `name` in `header`.
+pub fn column(header: &csv::StringRecord, name: &'static str) -> Result<usize, TableError> {
+    header
+        .iter()
+        .position(|h| h == name)
+        .ok_or_else(|| TableError::MissingColumn {
+            column: name,
+            found: header.iter().collect::<Vec<_>>().join(","),
+        })
+}

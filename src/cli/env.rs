@@ -71,7 +71,10 @@ pub fn run(cmd: EnvCommand) -> Result<()> {
             for (label, obs) in &groups {
                 let fit = fit_region(obs).with_context(|| format!("{}: region {label}", observations.display()))?;
                 tracing::info!(region = %label, model = ?fit.kind, rms = fit.rms_relative, "{}", fit.reason);
-                regions.push(RegionRecord::new(label, &fit));
+                regions.push(RegionRecord {
+                    region: label.clone(),
+                    fit,
+                });
             }
             let text = ron::ser::to_string_pretty(&EnvironmentFile { regions }, ron::ser::PrettyConfig::default())?;
             match out {
@@ -101,7 +104,7 @@ pub fn run(cmd: EnvCommand) -> Result<()> {
             let mut o = std::io::stdout().lock();
             writeln!(o, "region,r,g,b")?;
             for r in &env.regions {
-                let v = r.radiance(e_sky, e_sun, l);
+                let v = r.fit.radiance(e_sky, e_sun, l);
                 writeln!(o, "{},{:.9e},{:.9e},{:.9e}", r.region, v[0], v[1], v[2])?;
             }
             Ok(())

@@ -14,62 +14,16 @@ use std::io::Read;
 
 use serde::{Deserialize, Serialize};
 
-use super::region_model::{EnvironmentObservation, RegionFit, RegionModelKind, region_radiance};
-use crate::csv_cell::{CellError, number};
+use super::region_model::{EnvironmentObservation, RegionFit};
+use crate::csv_cell::{CellError, TableError, column, number};
 
-/// One region's fitted model.
+/// One region's fitted model, under its label.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RegionRecord {
     /// The region's label.
     pub region: String,
-    /// "SkyAndSun" or "SkyOnly".
-    pub model: String,
-    /// Why.
-    pub reason: String,
-    /// ρ_sky per channel.
-    pub rho_sky: [f64; 3],
-    /// ρ_sun per channel.
-    pub rho_sun: [f64; 3],
-    /// Unit normal, for sky-and-sun regions.
-    pub normal: Option<[f64; 3]>,
-    /// RMS relative residual.
-    pub rms_relative: f64,
-    /// σ_min / σ_max of the sun directions.
-    pub sun_track_condition: f64,
-    /// Condition number of the fit's Jacobian.
-    pub jacobian_condition: f64,
-}
-
-impl RegionRecord {
-    /// The record of a fit.
-    pub fn new(region: &str, fit: &RegionFit) -> Self {
-        RegionRecord {
-            region: region.to_owned(),
-            model: match fit.kind {
-                RegionModelKind::SkyAndSun => "SkyAndSun".into(),
-                RegionModelKind::SkyOnly => "SkyOnly".into(),
-            },
-            reason: fit.reason.clone(),
-            rho_sky: fit.rho_sky,
-            rho_sun: fit.rho_sun,
-            normal: fit.normal,
-            rms_relative: fit.rms_relative,
-            sun_track_condition: fit.sun_track_condition,
-            jacobian_condition: fit.jacobian_condition,
-        }
-    }
-
-    /// Predicted radiance under new light, eq. (5.13).
-    pub fn radiance(&self, sky_irradiance: [f64; 3], sun_irradiance: [f64; 3], sun: [f64; 3]) -> [f64; 3] {
-        region_radiance(
-            self.rho_sky,
-            self.rho_sun,
-            self.normal,
-            sky_irradiance,
-            sun_irradiance,
-            sun,
-        )
-    }
+    /// The fit.
+    pub fit: RegionFit,
 }
 
 /// Every region's model.
@@ -77,30 +31,6 @@ impl RegionRecord {
 pub struct EnvironmentFile {
     /// The regions, in label order.
     pub regions: Vec<RegionRecord>,
-}
-
-/// A problem in an observation table.
-#[derive(Debug, thiserror::Error)]
-pub enum ObservationTableError {
-    /// Malformed CSV.
-    #[error("row {row}: {message}")]
-    Csv {
-        /// Row (the header is row 1).
-        row: u64,
-        /// What the parser said.
-        message: String,
-    },
-    /// A column is missing.
-    #[error("the header has no `{column}` column (it has: {found})")]
-    MissingColumn {
-        /// The column.
-        column: &'static str,
-        /// The header.
-        found: String,
-    },
-    /// A cell is not a number in range.
-    #[error(transparent)]
-    Cell(#[from] CellError),
 }
 
 const COLUMNS: [&str; 12] = [
@@ -119,34 +49,17 @@ const COLUMNS: [&str; 12] = [
 ];
 
 /// Reads observations, grouped by region label (in label order).
-pub fn read_observations(
-    input: impl Read,
-) -> Result<BTreeMap<String, Vec<EnvironmentObservation>>, ObservationTableError> {
+pub fn read_observations(input: impl Read) -> Result<BTreeMap<String, Vec<EnvironmentObservation>>, TableError> {
     let mut rd = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(input);
-    let header = rd
-        .headers()
-        .map_err(|e| ObservationTableError::Csv {
-            row: 1,
-            message: e.to_string(),
-        })?
-        .clone();
+    let header = rd.headers().map_err(|e| TableError::csv(1, &e))?.clone();
     let mut idx = [0usize; 12];
     for (slot, name) in idx.iter_mut().zip(COLUMNS) {
-        *slot = header
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| ObservationTableError::MissingColumn {
-                column: name,
-                found: header.iter().collect::<Vec<_>>().join(","),
-            })?;
+        *slot = column(&header, name)?;
     }
     let mut out: BTreeMap<String, Vec<EnvironmentObservation>> = BTreeMap::new();
     for (k, rec) in rd.records().enumerate() {
         let row = k as u64 + 2;
-        let rec = rec.map_err(|e| ObservationTableError::Csv {
-            row,
-            message: e.to_string(),
-        })?;
+        let rec = rec.map_err(|e| TableError::csv(row, &e))?;
         let v = |i: usize, lo: f64, hi: f64, what: &'static str| number(&rec, &header, idx[i], row, (lo, hi), what);
         let rgb = |base: usize, lo: f64, what: &'static str| -> Result<[f64; 3], CellError> {
             Ok([

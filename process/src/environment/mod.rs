@@ -6,9 +6,8 @@ mod file;
 mod map;
 mod region_model;
 
-pub use file::{EnvironmentFile, ObservationTableError, RegionRecord, read_observations};
+pub use file::{EnvironmentFile, RegionRecord, read_observations};
 pub use map::{EnvironmentMap, RegionStats};
 pub use region_model::{
     EnvironmentObservation, RegionFit, RegionFitError, RegionModelKind, SUN_TRACK_MIN_CONDITION, fit_region,
-    region_radiance,
 };

@@ -46,7 +46,7 @@ pub struct EnvironmentObservation {
 }
 
 /// The model a region was given.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum RegionModelKind {
     /// Sky and sun terms, eq. (5.15).
     SkyAndSun,
@@ -55,7 +55,7 @@ pub enum RegionModelKind {
 }
 
 /// A region's fitted model.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RegionFit {
     /// Which model.
     pub kind: RegionModelKind,
@@ -78,31 +78,14 @@ pub struct RegionFit {
 }
 
 impl RegionFit {
-    /// Predicted radiance under new light, eq. (5.13).
+    /// Predicted radiance under new light, eq. (5.13):
+    /// `ρ_sky E_sky + ρ_sun E_sun max(0, n · l)` per channel.
     pub fn radiance(&self, sky_irradiance: [f64; 3], sun_irradiance: [f64; 3], sun: [f64; 3]) -> [f64; 3] {
-        region_radiance(
-            self.rho_sky,
-            self.rho_sun,
-            self.normal,
-            sky_irradiance,
-            sun_irradiance,
-            sun,
-        )
+        let cos = self
+            .normal
+            .map_or(0.0, |n| (n[0] * sun[0] + n[1] * sun[1] + n[2] * sun[2]).max(0.0));
+        [0, 1, 2].map(|c| self.rho_sky[c] * sky_irradiance[c] + self.rho_sun[c] * sun_irradiance[c] * cos)
     }
-}
-
-/// Eq. (5.13): `ρ_sky E_sky + ρ_sun E_sun max(0, n · l)` per channel; no
-/// sun term without a normal.
-pub fn region_radiance(
-    rho_sky: [f64; 3],
-    rho_sun: [f64; 3],
-    normal: Option<[f64; 3]>,
-    sky_irradiance: [f64; 3],
-    sun_irradiance: [f64; 3],
-    sun: [f64; 3],
-) -> [f64; 3] {
-    let cos = normal.map_or(0.0, |n| (n[0] * sun[0] + n[1] * sun[1] + n[2] * sun[2]).max(0.0));
-    [0, 1, 2].map(|c| rho_sky[c] * sky_irradiance[c] + rho_sun[c] * sun_irradiance[c] * cos)
 }
 
 /// Why a region could not be fitted.

@@ -37,9 +37,9 @@ fn rotate_y(v: [f64; 3], a: f64) -> [f64; 3] {
 }
 
 impl Mount {
-    /// The world-frame direction of a camera-frame direction `d` (x right,
-    /// y down, z forward) with the head at `pose`.
-    pub fn to_world(&self, pose: HeadPose, d: [f64; 3]) -> [f64; 3] {
+    /// The camera's axes in the level frame for `pose`: right, down and
+    /// forward (the optical axis), as unit vectors.
+    fn axes(&self, pose: HeadPose) -> [[f64; 3]; 3] {
         let az = self.pan_zero_azimuth_rad + pose.pan_rad;
         let el = pose.tilt_rad - self.tilt_zero_rad;
         let (sa, ca) = az.sin_cos();
@@ -52,6 +52,13 @@ impl Mount {
             forward[2] * right[0] - forward[0] * right[2],
             forward[0] * right[1] - forward[1] * right[0],
         ];
+        [right, down, forward]
+    }
+
+    /// The world-frame direction of a camera-frame direction `d` (x right,
+    /// y down, z forward) with the head at `pose`.
+    pub fn to_world(&self, pose: HeadPose, d: [f64; 3]) -> [f64; 3] {
+        let [right, down, forward] = self.axes(pose);
         let level = [0, 1, 2].map(|i| d[0] * right[i] + d[1] * down[i] + d[2] * forward[i]);
         // The base's tilt: roll about north (y), then pitch about east (x).
         rotate_x(rotate_y(level, self.roll_rad), self.pitch_rad)
@@ -61,19 +68,8 @@ impl Mount {
     /// of [`Mount::to_world`]).
     pub fn to_camera(&self, pose: HeadPose, w: [f64; 3]) -> [f64; 3] {
         let level = rotate_y(rotate_x(w, -self.pitch_rad), -self.roll_rad);
-        let az = self.pan_zero_azimuth_rad + pose.pan_rad;
-        let el = pose.tilt_rad - self.tilt_zero_rad;
-        let (sa, ca) = az.sin_cos();
-        let (se, ce) = el.sin_cos();
-        let forward = [ce * sa, ce * ca, se];
-        let right = [ca, -sa, 0.0];
-        let down = [
-            forward[1] * right[2] - forward[2] * right[1],
-            forward[2] * right[0] - forward[0] * right[2],
-            forward[0] * right[1] - forward[1] * right[0],
-        ];
         let dot = |a: [f64; 3]| a[0] * level[0] + a[1] * level[1] + a[2] * level[2];
-        [dot(right), dot(down), dot(forward)]
+        self.axes(pose).map(dot)
     }
 }
 

@@ -11,7 +11,7 @@ use std::io::Read;
 
 use serde::{Deserialize, Serialize};
 
-use crate::csv_cell::{CellError, number};
+use crate::csv_cell::{CellError, TableError, column, number};
 
 use super::fit::{SkyFit, SkyModelKind};
 use super::seven_parameter::SkyModel;
@@ -80,23 +80,21 @@ pub struct SampleTable {
 /// A problem in a sample table.
 #[derive(Debug, thiserror::Error)]
 pub enum SampleTableError {
-    /// Malformed CSV.
-    #[error("row {row}: {message}")]
-    Csv {
-        /// Row (the header is row 1).
-        row: u64,
-        /// What the parser said.
-        message: String,
-    },
-    /// A needed column is missing, or there is no channel column.
-    #[error("the header must have zenith_deg, azimuth_deg and at least one channel column (it has: {found})")]
-    Header {
+    /// The table or one of its cells.
+    #[error(transparent)]
+    Table(#[from] TableError),
+    /// No column besides the directions.
+    #[error("the header has no channel column besides zenith_deg and azimuth_deg (it has: {found})")]
+    NoChannels {
         /// The header.
         found: String,
     },
-    /// A cell is not a number in range.
-    #[error(transparent)]
-    Cell(#[from] CellError),
+}
+
+impl From<CellError> for SampleTableError {
+    fn from(e: CellError) -> Self {
+        SampleTableError::Table(TableError::Cell(e))
+    }
 }
 
 /// Reads sky samples from CSV: directions and at least one channel.
@@ -112,22 +110,11 @@ pub fn read_directions(input: impl Read) -> Result<SampleTable, SampleTableError
 
 fn read_table(input: impl Read, need_channels: bool) -> Result<SampleTable, SampleTableError> {
     let mut rd = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(input);
-    let header = rd
-        .headers()
-        .map_err(|e| SampleTableError::Csv {
-            row: 1,
-            message: e.to_string(),
-        })?
-        .clone();
-    let find = |n: &str| header.iter().position(|h| h == n);
-    let (Some(cz), Some(ca)) = (find("zenith_deg"), find("azimuth_deg")) else {
-        return Err(SampleTableError::Header {
-            found: header.iter().collect::<Vec<_>>().join(","),
-        });
-    };
+    let header = rd.headers().map_err(|e| TableError::csv(1, &e))?.clone();
+    let (cz, ca) = (column(&header, "zenith_deg")?, column(&header, "azimuth_deg")?);
     let chans: Vec<usize> = (0..header.len()).filter(|&i| i != cz && i != ca).collect();
     if need_channels && chans.is_empty() {
-        return Err(SampleTableError::Header {
+        return Err(SampleTableError::NoChannels {
             found: header.iter().collect::<Vec<_>>().join(","),
         });
     }
@@ -138,10 +125,7 @@ fn read_table(input: impl Read, need_channels: bool) -> Result<SampleTable, Samp
     };
     for (k, rec) in rd.records().enumerate() {
         let row = k as u64 + 2;
-        let rec = rec.map_err(|e| SampleTableError::Csv {
-            row,
-            message: e.to_string(),
-        })?;
+        let rec = rec.map_err(|e| TableError::csv(row, &e))?;
         let num =
             |i: usize, lo: f64, hi: f64, expected: &'static str| number(&rec, &header, i, row, (lo, hi), expected);
         let z = num(cz, 0.0, 90.0, "a zenith angle in degrees in [0, 90]")?;

@@ -18,7 +18,7 @@ pub use disc::{SunDisc, SunDiscError, SunFrame, measure_sun};
 pub use events::{SolarDay, solar_day};
 pub use extinction::{Extinction, ExtinctionError, MIN_AIR_MASS_SPAN, air_mass, fit_extinction};
 pub use position::{Ephemeris, Observer, SunError, SunPosition, delta_t_estimate, sun_position};
-pub use table::{SunAnswer, SunRequest, TableError, sun_positions, sun_table};
+pub use table::{SunAnswer, SunRequest, SunTableError, sun_positions, sun_table};
 
 /// Mean angular radius of the solar disc at 1 AU, in radians (959.63″).
 pub const SUN_ANGULAR_RADIUS_AT_1_AU_RAD: f64 = 959.63 / 3600.0 * std::f64::consts::PI / 180.0;

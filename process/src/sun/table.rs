@@ -24,7 +24,7 @@ use chrono::{DateTime, Utc};
 use rayon::prelude::*;
 
 use super::position::{Ephemeris, Observer, SunError, SunPosition};
-use crate::csv_cell::{CellError, number};
+use crate::csv_cell::{CellError, TableError, column, number};
 
 /// One row to compute.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -79,29 +79,12 @@ pub fn sun_positions(requests: &[SunRequest]) -> Vec<Result<SunAnswer, SunError>
         .collect()
 }
 
-/// A problem in a table: which row (1-based, counting the header as row 1),
-/// which column, what value, and what was expected.
+/// A problem in a table of sun requests.
 #[derive(Debug, thiserror::Error)]
-pub enum TableError {
-    /// The CSV itself is malformed.
-    #[error("row {row}: {message}")]
-    Csv {
-        /// Row.
-        row: u64,
-        /// The parser's message.
-        message: String,
-    },
-    /// A required column is absent.
-    #[error("the header has no `{column}` column (it has: {found})")]
-    MissingColumn {
-        /// Column.
-        column: &'static str,
-        /// The header as read.
-        found: String,
-    },
-    /// A cell cannot be read.
+pub enum SunTableError {
+    /// The table or one of its cells.
     #[error(transparent)]
-    Cell(#[from] CellError),
+    Table(#[from] TableError),
     /// The ephemeris refused a row.
     #[error("row {row}: {source}")]
     Sun {
@@ -115,24 +98,19 @@ pub enum TableError {
     Write(String),
 }
 
+impl From<CellError> for SunTableError {
+    fn from(e: CellError) -> Self {
+        SunTableError::Table(TableError::Cell(e))
+    }
+}
+
 /// Reads requests from CSV, computes them, and writes the table with the
 /// result columns appended. Returns the number of rows written.
-pub fn sun_table(input: impl Read, output: impl Write) -> Result<usize, TableError> {
+pub fn sun_table(input: impl Read, output: impl Write) -> Result<usize, SunTableError> {
     let mut rd = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(input);
-    let header = rd
-        .headers()
-        .map_err(|e| TableError::Csv {
-            row: 1,
-            message: e.to_string(),
-        })?
-        .clone();
+    let header = rd.headers().map_err(|e| TableError::csv(1, &e))?.clone();
     let col = |name: &'static str| header.iter().position(|h| h == name);
-    let need = |name: &'static str| {
-        col(name).ok_or_else(|| TableError::MissingColumn {
-            column: name,
-            found: header.iter().collect::<Vec<_>>().join(","),
-        })
-    };
+    let need = |name: &'static str| column(&header, name);
     let (c_time, c_lat, c_lon) = (need("time_utc")?, need("latitude_deg")?, need("longitude_deg")?);
     let (c_elev, c_p, c_t, c_dt) = (
         col("elevation_m"),
@@ -144,10 +122,7 @@ pub fn sun_table(input: impl Read, output: impl Write) -> Result<usize, TableErr
     let mut requests = Vec::new();
     for (k, rec) in rd.records().enumerate() {
         let row = k as u64 + 2;
-        let rec = rec.map_err(|e| TableError::Csv {
-            row,
-            message: e.to_string(),
-        })?;
+        let rec = rec.map_err(|e| TableError::csv(row, &e))?;
         let cell = |c: usize| rec.get(c).unwrap_or("");
         let num = |c: usize, expected: &'static str| number(&rec, &header, c, row, (f64::MIN, f64::MAX), expected);
         let opt = |c: Option<usize>, default: Option<f64>, expected: &'static str| -> Result<Option<f64>, TableError> {
@@ -185,9 +160,9 @@ pub fn sun_table(input: impl Read, output: impl Write) -> Result<usize, TableErr
         out_header.push_field(h);
     }
     wr.write_record(&out_header)
-        .map_err(|e| TableError::Write(e.to_string()))?;
+        .map_err(|e| SunTableError::Write(e.to_string()))?;
     for (k, (rec, ans)) in rows.iter().zip(answers).enumerate() {
-        let a = ans.map_err(|source| TableError::Sun {
+        let a = ans.map_err(|source| SunTableError::Sun {
             row: k as u64 + 2,
             source,
         })?;
@@ -196,9 +171,9 @@ pub fn sun_table(input: impl Read, output: impl Write) -> Result<usize, TableErr
         rec.push_field(&format!("{:.7}", a.position.azimuth_rad.to_degrees()));
         rec.push_field(&format!("{:.7}", a.position.elevation_rad().to_degrees()));
         rec.push_field(&format!("{:.10}", a.earth_sun_distance_au));
-        wr.write_record(&rec).map_err(|e| TableError::Write(e.to_string()))?;
+        wr.write_record(&rec).map_err(|e| SunTableError::Write(e.to_string()))?;
     }
-    wr.flush().map_err(|e| TableError::Write(e.to_string()))?;
+    wr.flush().map_err(|e| SunTableError::Write(e.to_string()))?;
     Ok(rows.len())
 }
 
