@@ -76,16 +76,7 @@ pub fn run(cmd: EnvCommand) -> Result<()> {
                     fit,
                 });
             }
-            let text = ron::ser::to_string_pretty(&EnvironmentFile { regions }, ron::ser::PrettyConfig::default())?;
-            match out {
-                Some(path) => {
-                    let tmp = path.with_extension("ron.partial");
-                    std::fs::write(&tmp, text + "\n").with_context(|| format!("{}: cannot write", tmp.display()))?;
-                    std::fs::rename(&tmp, &path).with_context(|| format!("{}: cannot write", path.display()))?;
-                }
-                None => println!("{text}"),
-            }
-            Ok(())
+            super::ron_output::write_ron(&EnvironmentFile { regions }, out.as_deref())
         }
         EnvCommand::Predict {
             models,

@@ -4,6 +4,7 @@ mod config_check;
 mod env;
 mod hdr;
 mod logging;
+mod ron_output;
 mod site;
 mod sky;
 mod sun;

@@ -132,19 +132,6 @@ fn read_sky(path: &PathBuf) -> Result<SkyFile> {
     ron::from_str(&text).map_err(|e| anyhow::anyhow!("{}:{}: {}", path.display(), e.span.start, e.code))
 }
 
-fn write_sky(sky: &SkyFile, out: Option<PathBuf>) -> Result<()> {
-    let text = ron::ser::to_string_pretty(sky, ron::ser::PrettyConfig::default())?;
-    match out {
-        Some(path) => {
-            let tmp = path.with_extension("ron.partial");
-            std::fs::write(&tmp, text + "\n").with_context(|| format!("{}: cannot write", tmp.display()))?;
-            std::fs::rename(&tmp, &path).with_context(|| format!("{}: cannot write", path.display()))?;
-        }
-        None => println!("{text}"),
-    }
-    Ok(())
-}
-
 pub fn run(cmd: SkyCommand) -> Result<()> {
     match cmd {
         SkyCommand::Fit { samples, sun, out } => {
@@ -173,7 +160,7 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
                 sun_azimuth_deg: az.to_degrees(),
                 channels,
             };
-            write_sky(&sky, out)
+            super::ron_output::write_ron(&sky, out.as_deref())
         }
         SkyCommand::Predict { skies, sun, out } => {
             let (zs, az) = sun.resolve()?;
@@ -202,13 +189,13 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
                 let fit = predict_sky(&skies_c, sun_dir, 3.0).with_context(|| format!("channel {name}"))?;
                 channels.push(ChannelSky::new(name, &fit, 0, 0.0));
             }
-            write_sky(
+            super::ron_output::write_ron(
                 &SkyFile {
                     sun_zenith_deg: zs.to_degrees(),
                     sun_azimuth_deg: az.to_degrees(),
                     channels,
                 },
-                out,
+                out.as_deref(),
             )
         }
         SkyCommand::Eval { sky, directions } => {
