@@ -176,3 +176,47 @@ fn predict_interpolates_fitted_skies_to_a_new_sun() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+#[test]
+fn map_writes_a_lat_long_exr_of_the_fitted_sky() {
+    let dir_tmp = tempfile::tempdir().expect("temp");
+    let sky = dir_tmp.path().join("sky.ron");
+    let exr = dir_tmp.path().join("sky.exr");
+    let one = sky_ron(40.0, 180.0);
+    let channel = &one[one.find("(channel").expect("channel")..one.rfind(']').expect("end")];
+    let three = format!(
+        "(sun_zenith_deg: 40.0, sun_azimuth_deg: 180.0, channels: [{}, {}, {}])",
+        channel.replace("\"g\"", "\"r\""),
+        channel,
+        channel.replace("\"g\"", "\"b\"")
+    );
+    std::fs::write(&sky, three).expect("write");
+    let out = campanile(&[
+        "sky",
+        "map",
+        sky.to_str().expect("utf-8"),
+        "--out",
+        exr.to_str().expect("utf-8"),
+        "--width",
+        "64",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let map = campanile_process::exr_io::read_radiance_exr(&exr).expect("readable EXR");
+    assert_eq!((map.width, map.height), (64, 16));
+    // The top row is within 3° of the zenith, where the model gives Lz Bg(0) Sa(40°).
+    let zenith = 0.07
+        * (1.0 - (-0.4f64).exp())
+        * (1.0 + 12.0 * (-3.2 * 40f64.to_radians().powf(0.9)).exp() + 0.5 * 40f64.to_radians().cos().powi(2));
+    let top: f64 = (0..64).map(|x| f64::from(map.rgb[3 * x + 1])).sum::<f64>() / 64.0;
+    assert!((top / zenith - 1.0).abs() < 0.05, "{top} vs {zenith}");
+    // Two channels are not a colour map.
+    std::fs::write(&sky, sky_ron(40.0, 180.0)).expect("write");
+    let out = campanile(&[
+        "sky",
+        "map",
+        sky.to_str().expect("utf-8"),
+        "--out",
+        exr.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+}

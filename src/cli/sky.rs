@@ -5,8 +5,11 @@ use std::io::{BufReader, Write};
 use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
+use campanile_process::exr_io::write_radiance_exr;
+use campanile_process::hdr::merge::RadianceMap;
 use campanile_process::sky::{
     ChannelSky, KnownSky, SkyFile, angle_between, fit_sky_robust, predict_sky, read_directions, read_samples,
+    render_latlong,
 };
 use campanile_process::sun::Ephemeris;
 use chrono::{DateTime, Utc};
@@ -63,6 +66,22 @@ pub enum SkyCommand {
         /// Where to write the predicted sky (RON); standard output when absent.
         #[arg(long)]
         out: Option<PathBuf>,
+    },
+    /// Render fitted skies (RON with r, g, b channels) as a lat-long OpenEXR map.
+    ///
+    /// The upper hemisphere: azimuth 0° (north) at the left edge, east at a
+    /// quarter of the width; the zenith on the top row, the horizon at the
+    /// bottom; WIDTH × WIDTH/4 pixels, radiance per channel, no sun disc.
+    #[command(verbatim_doc_comment)]
+    Map {
+        /// Fitted skies (RON).
+        sky: PathBuf,
+        /// Output map (OpenEXR).
+        #[arg(long)]
+        out: PathBuf,
+        /// Map width in pixels (the height is a quarter of it).
+        #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(4..=16384))]
+        width: u32,
     },
     /// Evaluate fitted skies (RON from `sky fit`) at directions.
     ///
@@ -197,6 +216,30 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
                 },
                 out.as_deref(),
             )
+        }
+        SkyCommand::Map { sky, out, width } => {
+            let sky_file = read_sky(&sky)?;
+            let [r, g, b] = sky_file.channels.as_slice() else {
+                bail!(
+                    "{}: {} channels; a map needs exactly three (r, g, b)",
+                    sky.display(),
+                    sky_file.channels.len()
+                );
+            };
+            let sun = direction(
+                sky_file.sun_zenith_deg.to_radians(),
+                sky_file.sun_azimuth_deg.to_radians(),
+            );
+            let (w, h, rgb) = render_latlong(&[r.model, g.model, b.model], sun, width as usize);
+            let map = RadianceMap {
+                width: w,
+                height: h,
+                variance: vec![0.0; rgb.len()],
+                mask: vec![0; w * h],
+                rgb,
+            };
+            write_radiance_exr(&map, &out).with_context(|| format!("{}: cannot write", out.display()))?;
+            Ok(())
         }
         SkyCommand::Eval { sky, directions } => {
             let sky_file = read_sky(&sky)?;

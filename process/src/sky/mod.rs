@@ -11,6 +11,7 @@ mod file;
 mod fit;
 mod frame_samples;
 mod geometry;
+mod latlong;
 mod predict;
 mod seven_parameter;
 
@@ -22,5 +23,6 @@ pub use fit::{
 };
 pub use frame_samples::{FrameSampleError, MIN_ELEVATION_RAD, SkyFrame, sky_samples};
 pub use geometry::{angle_between, sky_angles};
+pub use latlong::{latlong_direction, render_latlong};
 pub use predict::{KnownSky, OvercastSky, PredictError, predict_sky, redden};
 pub use seven_parameter::{COS_XI_FLOOR, SkyModel};
