@@ -13,9 +13,7 @@ fn cie12(z: f64, g: f64, zs: f64, lz: f64) -> f64 {
     lz * f(g) * phi(z) / (f(zs) * phi(0.0))
 }
 
-fn dir(z: f64, a: f64) -> [f64; 3] {
-    [z.sin() * a.sin(), z.sin() * a.cos(), z.cos()]
-}
+use campanile_process::sky::direction as dir;
 
 #[test]
 fn a_noisy_cie_clear_sky_is_fitted_as_cie_type_12_and_evaluates_back() {

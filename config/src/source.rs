@@ -7,7 +7,7 @@ use serde::de::DeserializeOwned;
 
 use crate::error::ConfigError;
 use crate::span_tree::{self, Node};
-use crate::validate::{FieldPath, Issue, Segment};
+use crate::validate::{Issue, Segment};
 
 /// Files larger than this are refused rather than read.
 pub const MAX_FILE_BYTES: u64 = 16 * 1024 * 1024;
@@ -140,12 +140,5 @@ impl SourceFile {
             value: Some(issue.value),
             message: issue.expected,
         }
-    }
-
-    /// The 1-based line and column of the value at `path` (or of the
-    /// deepest part of it present in the text).
-    pub fn position_of(&self, path: &FieldPath) -> (usize, usize) {
-        let offset = self.tree.as_ref().map_or(0, |t| t.offset_of(path));
-        span_tree::line_col(&self.text, offset)
     }
 }

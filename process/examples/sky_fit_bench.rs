@@ -14,7 +14,7 @@ use std::f64::consts::PI;
 use std::io::Write;
 use std::time::Instant;
 
-use campanile_process::sky::{SkyModel, SkySample, angle_between, fit_sky};
+use campanile_process::sky::{SkyModel, SkySample, angle_between, direction, fit_sky};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -41,7 +41,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 if occlude && (200f64.to_radians()..260f64.to_radians()).contains(&az) {
                     continue;
                 }
-                let d = [xi.sin() * az.sin(), xi.sin() * az.cos(), xi.cos()];
+                let d = direction(xi, az);
                 let g = angle_between(d, sun);
                 if g > 0.5f64.to_radians() {
                     v.push((xi, g));
@@ -136,7 +136,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let n = ((360.0 / 6.0) * xi.sin()).ceil().max(1.0) as usize;
             for k in 0..n {
                 let az = 2.0 * PI * k as f64 / n as f64;
-                let g = angle_between([xi.sin() * az.sin(), xi.sin() * az.cos(), xi.cos()], sun);
+                let g = angle_between(direction(xi, az), sun);
                 if g > 0.5f64.to_radians() {
                     let y = sky.radiance(xi, g) * (1.0 + 0.02 * 3f64.sqrt() * (2.0 * rng.random::<f64>() - 1.0));
                     samples.push(SkySample {

@@ -50,16 +50,22 @@ pub fn write_radiance_exr(map: &RadianceMap, path: &Path) -> std::result::Result
         })
 }
 
-/// Reads a file written by [`write_radiance_exr`].
-pub fn read_radiance_exr(path: &Path) -> std::result::Result<RadianceMap, HdrError> {
+/// The first layer of the OpenEXR file at `path`, all channels as flat
+/// samples; `expected` names what the caller wanted, for the error.
+fn first_layer(path: &Path, expected: &str) -> std::result::Result<Layer<AnyChannels<FlatSamples>>, HdrError> {
     let image = read_all_flat_layers_from_file(path).map_err(|cause| HdrError::Exr {
         path: path.to_path_buf(),
         cause,
     })?;
-    let layer = image.layer_data.first().ok_or_else(|| HdrError::BadImage {
+    image.layer_data.into_iter().next().ok_or_else(|| HdrError::BadImage {
         image: path.display().to_string(),
-        what: "no layer: expected one radiance layer".into(),
-    })?;
+        what: format!("no layer: expected {expected}"),
+    })
+}
+
+/// Reads a file written by [`write_radiance_exr`].
+pub fn read_radiance_exr(path: &Path) -> std::result::Result<RadianceMap, HdrError> {
+    let layer = first_layer(path, "one radiance layer")?;
     let (w, h) = (layer.size.width(), layer.size.height());
     let get = |name: &str| -> std::result::Result<Vec<f32>, HdrError> {
         layer
@@ -96,14 +102,7 @@ pub fn read_radiance_exr(path: &Path) -> std::result::Result<RadianceMap, HdrErr
 /// Reads the `R`, `G`, `B` channels of the first layer of any OpenEXR file
 /// (e.g. a flat-field radiance map for `hdr lens`).
 pub fn read_rgb_exr(path: &Path) -> std::result::Result<RadianceImage, HdrError> {
-    let image = read_all_flat_layers_from_file(path).map_err(|cause| HdrError::Exr {
-        path: path.to_path_buf(),
-        cause,
-    })?;
-    let layer = image.layer_data.first().ok_or_else(|| HdrError::BadImage {
-        image: path.display().to_string(),
-        what: "no layer: expected an RGB layer".into(),
-    })?;
+    let layer = first_layer(path, "an RGB layer")?;
     let (w, h) = (layer.size.width(), layer.size.height());
     let mut data = vec![0.0f32; w * h * 3];
     for (c, name) in ["R", "G", "B"].iter().enumerate() {

@@ -87,7 +87,7 @@ pub fn run(cmd: EnvCommand) -> Result<()> {
             let e_sky = rgb("sky-irradiance", &sky_irradiance)?;
             let e_sun = rgb("sun-irradiance", &sun_irradiance)?;
             let (z, a) = sun.resolve_any()?;
-            let l = [z.sin() * a.sin(), z.sin() * a.cos(), z.cos()];
+            let l = campanile_process::sky::direction(z, a);
             let text =
                 std::fs::read_to_string(&models).with_context(|| format!("{}: cannot read", models.display()))?;
             let env: EnvironmentFile = ron::from_str(&text)

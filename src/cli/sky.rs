@@ -8,8 +8,8 @@ use anyhow::{Context, Result, bail};
 use campanile_process::exr_io::write_radiance_exr;
 use campanile_process::hdr::merge::RadianceMap;
 use campanile_process::sky::{
-    ChannelSky, KnownSky, SkyFile, angle_between, fit_sky_robust, predict_sky, read_directions, read_samples,
-    render_latlong,
+    ChannelSky, KnownSky, SkyFile, angle_between, direction, fit_sky_robust, predict_sky, read_directions,
+    read_samples, render_latlong,
 };
 use campanile_process::sun::Ephemeris;
 use chrono::{DateTime, Utc};
@@ -140,10 +140,6 @@ impl SunArgs {
         }
         Ok((z, a))
     }
-}
-
-fn direction(zenith: f64, azimuth: f64) -> [f64; 3] {
-    [zenith.sin() * azimuth.sin(), zenith.sin() * azimuth.cos(), zenith.cos()]
 }
 
 fn read_sky(path: &PathBuf) -> Result<SkyFile> {

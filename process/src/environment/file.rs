@@ -16,6 +16,7 @@ use serde::{Deserialize, Serialize};
 
 use super::region_model::{EnvironmentObservation, RegionFit};
 use crate::csv_cell::{CellError, TableError, column, number};
+use crate::sky::direction;
 
 /// One region's fitted model, under its label.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -73,7 +74,7 @@ pub fn read_observations(input: impl Read) -> Result<BTreeMap<String, Vec<Enviro
         let sun_irradiance = rgb(6, 0.0, "a solar irradiance ≥ 0")?;
         let z = v(9, 0.0, 180.0, "a solar zenith angle in degrees in [0, 180]")?.to_radians();
         let a = v(10, -360.0, 360.0, "a solar azimuth in degrees")?.to_radians();
-        let sun = [z.sin() * a.sin(), z.sin() * a.cos(), z.cos()];
+        let sun = direction(z, a);
         let region = rec.get(idx[11]).unwrap_or("").to_owned();
         out.entry(region).or_default().push(EnvironmentObservation {
             radiance,

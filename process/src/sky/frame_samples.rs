@@ -15,7 +15,7 @@
 
 use super::file::SampleTable;
 use super::fit::SkySample;
-use super::geometry::angle_between;
+use super::geometry::{angle_between, direction};
 use crate::pose::{HeadPose, Mount, Pinhole};
 
 /// One HDR sky frame and where it was taken.
@@ -135,13 +135,10 @@ impl SampleTable {
         self.directions
             .iter()
             .zip(&self.values[channel])
-            .map(|(&(z, a), &v)| {
-                let d = [z.sin() * a.sin(), z.sin() * a.cos(), z.cos()];
-                SkySample {
-                    xi: z,
-                    gamma: angle_between(d, sun),
-                    radiance: v,
-                }
+            .map(|(&(z, a), &v)| SkySample {
+                xi: z,
+                gamma: angle_between(direction(z, a), sun),
+                radiance: v,
             })
             .filter(|s| s.gamma > 0.5f64.to_radians())
             .collect()
@@ -152,10 +149,6 @@ impl SampleTable {
 mod tests {
     use super::*;
     use crate::sky::{SkyModel, fit_sky_robust};
-
-    fn dir(zenith: f64, azimuth: f64) -> [f64; 3] {
-        [zenith.sin() * azimuth.sin(), zenith.sin() * azimuth.cos(), zenith.cos()]
-    }
 
     /// Renders what the camera sees: the sky per channel, a dark textured
     /// building over azimuths 200°–240° up to 25° elevation, the ground
@@ -227,7 +220,7 @@ mod tests {
                 h: 0.95,
             },
         ];
-        let sun = dir(40f64.to_radians(), 200f64.to_radians());
+        let sun = direction(40f64.to_radians(), 200f64.to_radians());
         let cam = Pinhole {
             focal_px: 60.0,
             principal_px: (64.0, 48.0),

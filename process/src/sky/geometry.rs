@@ -14,10 +14,12 @@ pub fn angle_between(u: [f64; 3], v: [f64; 3]) -> f64 {
     sin.atan2(cos)
 }
 
-/// `(ξ, γ)` of the unit direction `view` (world frame, z up) with the sun
-/// toward the unit direction `sun`.
-pub fn sky_angles(view: [f64; 3], sun: [f64; 3]) -> (f64, f64) {
-    (angle_between(view, [0.0, 0.0, 1.0]), angle_between(view, sun))
+/// The unit vector (world frame: x east, y north, z up) at zenith angle
+/// `zenith` and azimuth `azimuth` (from north through east), radians.
+pub fn direction(zenith: f64, azimuth: f64) -> [f64; 3] {
+    let (sz, cz) = zenith.sin_cos();
+    let (sa, ca) = azimuth.sin_cos();
+    [sz * sa, sz * ca, cz]
 }
 
 #[cfg(test)]

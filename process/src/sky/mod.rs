@@ -22,7 +22,7 @@ pub use fit::{
     WEIGHT_FLOOR, fit_sky, fit_sky_robust,
 };
 pub use frame_samples::{FrameSampleError, MIN_ELEVATION_RAD, SkyFrame, sky_samples};
-pub use geometry::{angle_between, sky_angles};
+pub use geometry::{angle_between, direction};
 pub use latlong::{latlong_direction, render_latlong};
 pub use predict::{KnownSky, OvercastSky, PredictError, predict_sky, redden};
 pub use seven_parameter::{COS_XI_FLOOR, SkyModel};

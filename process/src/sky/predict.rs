@@ -14,7 +14,7 @@
 
 use super::cie::{CieSky, CieSkyType};
 use super::fit::{SkyFit, SkyFitError, SkySample, fit_sky};
-use super::geometry::angle_between;
+use super::geometry::{angle_between, direction};
 use super::seven_parameter::SkyModel;
 
 /// A fitted sky and where its sun was.
@@ -49,7 +49,7 @@ fn hemisphere(step_deg: f64) -> Vec<[f64; 3]> {
         let n = ((360.0 / step_deg) * xi.sin()).ceil().max(1.0) as usize;
         for k in 0..n {
             let az = 2.0 * std::f64::consts::PI * k as f64 / n as f64;
-            out.push([xi.sin() * az.sin(), xi.sin() * az.cos(), xi.cos()]);
+            out.push(direction(xi, az));
         }
     }
     out
@@ -153,8 +153,7 @@ mod tests {
     use super::*;
 
     fn sun_at(zenith_deg: f64, azimuth_deg: f64) -> [f64; 3] {
-        let (z, a) = (zenith_deg.to_radians(), azimuth_deg.to_radians());
-        [z.sin() * a.sin(), z.sin() * a.cos(), z.cos()]
+        direction(zenith_deg.to_radians(), azimuth_deg.to_radians())
     }
 
     fn rms(a: impl Fn(f64, f64) -> f64, b: impl Fn(f64, f64) -> f64, sun: [f64; 3]) -> f64 {

@@ -94,9 +94,7 @@ impl SunPosition {
 
     /// Unit vector toward the sun in the world frame (x east, y north, z up).
     pub fn direction(&self) -> [f64; 3] {
-        let (sz, cz) = self.zenith_rad.sin_cos();
-        let (sa, ca) = self.azimuth_rad.sin_cos();
-        [sz * sa, sz * ca, cz]
+        crate::sky::direction(self.zenith_rad, self.azimuth_rad)
     }
 }
 
