@@ -7,6 +7,7 @@
 //!   assembly, lens falloff, and the checks on the input images.
 //! - [`exr_io`]: OpenEXR output and input of radiance maps.
 
+pub mod brdf;
 pub mod camera;
 pub mod csv_cell;
 pub mod environment;

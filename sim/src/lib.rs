@@ -1,1 +1,17 @@
 //! The simulated station. See the README table for what exists.
+//!
+//! - [`world`]: the scenes with their ground truth (geometry, materials, sun, sky) and the renderer's view of them.
+//! - [`camera`]: a camera that photographs a [`camera::FrameSource`] through the `Camera` device trait.
+//! - [`devices`]: device-side emulators of the head, filter wheel and lights over the firmware-link protocols.
+//! - [`clock`]: the simulated calendar, driven by tokio's (pausable) clock.
+//! - [`faults`]: seeded fault injection for links, camera and devices.
+//! - [`disk`]: a storage area that fills up.
+//! - [`station`]: a whole simulated station assembled from a station config.
+
+pub mod camera;
+pub mod clock;
+pub mod devices;
+pub mod disk;
+pub mod faults;
+pub mod station;
+pub mod world;
