@@ -15,5 +15,6 @@ pub mod exr_io;
 pub mod hdr;
 pub mod model_choice;
 pub mod pose;
+pub mod render;
 pub mod sky;
 pub mod sun;

@@ -7,6 +7,7 @@
 //! the sun, both in radians.
 
 mod cie;
+mod daylight;
 mod file;
 mod fit;
 mod frame_samples;
@@ -16,6 +17,7 @@ mod predict;
 mod seven_parameter;
 
 pub use cie::{CieSky, CieSkyType};
+pub use daylight::{Atmosphere, Daylight, REDDENING_ONSET_AIR_MASS, SUN_ANGULAR_RADIUS_RAD};
 pub use file::{ChannelSky, SampleTable, SampleTableError, SkyFile, read_directions, read_samples};
 pub use fit::{
     AUREOLE_SEEN_RAD, Candidate, OUTLIER_FLOOR, RobustSkyFit, SkyFit, SkyFitError, SkyModelKind, SkySample,

@@ -1,1 +1,238 @@
-//! (being written)
+//! The simulated world: a scene with its true materials, the site's sun
+//! and sky, and the station's lamps, rendered by `process::render`.
+//!
+//! The sun comes from the same ephemeris the station uses
+//! ([`campanile_process::sun`]), the sky from [`campanile_process::sky::Daylight`]
+//! (CIE clear sky per channel, extinction, reddening, optional clouds).
+//! Everything the solvers should recover is exposed here as ground truth.
+
+pub mod rig;
+pub mod scene_file;
+pub mod truth;
+
+use std::path::PathBuf;
+
+use campanile_process::camera::image::RadianceImage;
+use campanile_process::pose::{HeadPose, Mount};
+use campanile_process::render::{self, CameraRig, Lighting, RenderSettings, SphereLight};
+use campanile_process::sky::{Atmosphere, Daylight};
+use campanile_process::sun::{Observer, SunPosition, sun_position};
+use chrono::{DateTime, Utc};
+use nalgebra::Vector3;
+
+pub use scene_file::{LoadedScene, examples_dir, from_description, load_scene};
+pub use truth::{Appearance, Finish, Setting};
+
+/// Why a world could not be built or asked.
+#[derive(Debug, thiserror::Error)]
+pub enum WorldError {
+    /// A configuration file is invalid.
+    #[error("{path}: {message}")]
+    Config {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The geometry could not be read.
+    #[error("{path}: {message}")]
+    Geometry {
+        /// The OBJ file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The sun could not be computed for this time and site.
+    #[error("solar position at {time}: {message}")]
+    Sun {
+        /// The time asked.
+        time: DateTime<Utc>,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// One of the station's lamps as the world sees it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Lamp {
+    /// Name in the station config.
+    pub name: String,
+    /// The bulb at full level.
+    pub bulb: SphereLight,
+    /// Output fraction = level^gamma.
+    pub gamma: f64,
+}
+
+/// The smallest lamp radius rendered, metres: a "point" lamp in the config
+/// (radius 0) still needs a visible bulb.
+pub const MIN_BULB_RADIUS_M: f64 = 0.01;
+
+/// The world a simulated station photographs.
+#[derive(Debug, Clone)]
+pub struct World {
+    /// The scene and its true materials.
+    pub scene: LoadedScene,
+    /// Outdoors or indoors.
+    pub setting: Setting,
+    /// The site.
+    pub observer: Observer,
+    /// ΔT for the ephemeris, seconds.
+    pub delta_t_s: Option<f64>,
+    /// The clear atmosphere.
+    pub atmosphere: Atmosphere,
+    /// Cloud cover: fraction of sunlight blocked and the overcast zenith radiance per channel.
+    pub clouds: Option<(f64, [f64; 3])>,
+    /// The station's camera.
+    pub camera: campanile_config::Camera,
+    /// The head's mount.
+    pub mount: Mount,
+    /// The station's lamps.
+    pub lamps: Vec<Lamp>,
+    /// Samples per pixel and bounces for frames (the seed comes per frame).
+    pub quality: RenderSettings,
+}
+
+impl World {
+    /// The world of `scene` seen by `station`.
+    pub fn new(station: &campanile_config::Station, scene: LoadedScene) -> World {
+        let s = &station.site;
+        let lamps = station
+            .lights
+            .iter()
+            .flat_map(|l| l.channels.iter())
+            .map(|ch| {
+                let (x, y, z) = ch.position_m;
+                let (r, g, b) = ch.intensity.radiant_intensity_w_sr;
+                Lamp {
+                    name: ch.name.clone(),
+                    bulb: SphereLight::with_intensity(
+                        Vector3::new(x, y, z),
+                        ch.radius_m.max(MIN_BULB_RADIUS_M),
+                        [r, g, b],
+                    ),
+                    gamma: ch.intensity.gamma,
+                }
+            })
+            .collect();
+        World {
+            setting: truth::setting(&scene.description.name),
+            scene,
+            observer: Observer::from_degrees(
+                s.latitude_deg,
+                s.longitude_deg,
+                s.elevation_m,
+                s.pressure_mbar,
+                s.temperature_c,
+            ),
+            delta_t_s: s.delta_t_s,
+            atmosphere: Atmosphere::clear(),
+            clouds: None,
+            camera: station.camera.clone(),
+            mount: rig::mount(&station.head.mount),
+            lamps,
+            quality: RenderSettings {
+                samples_per_pixel: 16,
+                max_bounces: 2,
+                seed: 0,
+            },
+        }
+    }
+
+    /// The true solar position at `time`.
+    pub fn sun(&self, time: DateTime<Utc>) -> Result<SunPosition, WorldError> {
+        sun_position(time, &self.observer, self.delta_t_s).map_err(|e| WorldError::Sun {
+            time,
+            message: e.to_string(),
+        })
+    }
+
+    /// The true sun and sky at `time`; `None` indoors.
+    pub fn daylight(&self, time: DateTime<Utc>) -> Result<Option<Daylight>, WorldError> {
+        if self.setting == Setting::Indoor {
+            return Ok(None);
+        }
+        let sun = self.sun(time)?;
+        let day = Daylight::clear(sun.direction(), &self.atmosphere);
+        Ok(Some(match self.clouds {
+            Some((p, zenith)) => day.with_clouds(p, zenith),
+            None => day,
+        }))
+    }
+
+    /// The lamps' bulbs at `levels` (0–1 per lamp, in config order; missing
+    /// levels are off).
+    pub fn bulbs(&self, levels: &[f64]) -> Vec<SphereLight> {
+        self.lamps
+            .iter()
+            .enumerate()
+            .filter_map(|(i, lamp)| {
+                let level = levels.get(i).copied().unwrap_or(0.0).clamp(0.0, 1.0);
+                let k = level.powf(lamp.gamma);
+                (k > 0.0).then(|| SphereLight {
+                    radiance: lamp.bulb.radiance.map(|l| l * k),
+                    ..lamp.bulb
+                })
+            })
+            .collect()
+    }
+
+    /// The camera on its head at `position_m`, rendered at `width` × `height`.
+    pub fn rig(&self, head: HeadPose, position_m: [f64; 3], width: usize, height: usize) -> CameraRig {
+        CameraRig {
+            pinhole: rig::pinhole_at(&self.camera, width, height),
+            mount: self.mount,
+            head,
+            position: Vector3::from(position_m),
+            width,
+            height,
+        }
+    }
+
+    /// The true radiance the camera sees (before lens falloff, filter and sensor).
+    pub fn render(
+        &self,
+        time: DateTime<Utc>,
+        rig: &CameraRig,
+        light_levels: &[f64],
+        seed: u64,
+    ) -> Result<RadianceImage, WorldError> {
+        let daylight = self.daylight(time)?;
+        let bulbs = self.bulbs(light_levels);
+        let lighting = Lighting {
+            sky: daylight.as_ref().map(|d| d as &dyn render::Sky),
+            points: &[],
+            spheres: &bulbs,
+        };
+        let settings = RenderSettings { seed, ..self.quality };
+        Ok(render::render(&self.scene.scene, rig, &lighting, &settings))
+    }
+
+    /// The true irradiance (W·m⁻² per channel) at `point` on the side of
+    /// `normal`, by Monte Carlo with `samples` paths.
+    pub fn irradiance(
+        &self,
+        time: DateTime<Utc>,
+        point: [f64; 3],
+        normal: [f64; 3],
+        light_levels: &[f64],
+        samples: u32,
+        seed: u64,
+    ) -> Result<[f64; 3], WorldError> {
+        let daylight = self.daylight(time)?;
+        let bulbs = self.bulbs(light_levels);
+        let lighting = Lighting {
+            sky: daylight.as_ref().map(|d| d as &dyn render::Sky),
+            points: &[],
+            spheres: &bulbs,
+        };
+        Ok(render::irradiance(
+            &self.scene.scene,
+            &lighting,
+            &Vector3::from(point),
+            &Vector3::from(normal),
+            self.quality.max_bounces,
+            samples,
+            seed,
+        ))
+    }
+}

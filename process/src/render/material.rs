@@ -1,0 +1,26 @@
+//! Materials: an albedo texture, an optional Ward specular lobe, and
+//! optional emission (for the furnace test and glowing surfaces).
+
+use super::texture::Texture;
+
+/// How a surface reflects and emits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Material {
+    /// Name, as in the scene description.
+    pub name: String,
+    /// Diffuse albedo ρd per channel, varying over the surface.
+    pub albedo: Texture,
+    /// Emitted radiance per channel, W·m⁻²·sr⁻¹ (zero for ordinary surfaces).
+    pub emission: [f64; 3],
+}
+
+impl Material {
+    /// A Lambertian material of constant albedo.
+    pub fn diffuse(name: &str, albedo: [f64; 3]) -> Material {
+        Material {
+            name: name.to_string(),
+            albedo: Texture::Constant(albedo),
+            emission: [0.0; 3],
+        }
+    }
+}

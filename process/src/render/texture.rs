@@ -1,0 +1,196 @@
+//! Procedural albedo textures, evaluated at a face's planar texture
+//! coordinates in metres. They are the simulator's ground truth for
+//! per-texel albedo (thesis §5.4: "every surface of the building has its
+//! own surface texture"), so they are exact functions, not images.
+
+/// An albedo (per channel, 0–1) as a function of position on a face.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Texture {
+    /// The same albedo everywhere.
+    Constant([f64; 3]),
+    /// Running-bond brickwork: bricks of `size_m` (along, up) separated by
+    /// mortar joints `joint_m` wide; each brick's albedo is `brick` scaled by
+    /// `1 + variation · u` with `u` uniform in [−1, 1], drawn per brick from `seed`.
+    Bricks {
+        /// Mean brick albedo.
+        brick: [f64; 3],
+        /// Mortar albedo.
+        mortar: [f64; 3],
+        /// Brick length and height (with the joint), metres.
+        size_m: [f64; 2],
+        /// Joint width, metres.
+        joint_m: f64,
+        /// Relative per-brick variation.
+        variation: f64,
+        /// Seed of the per-brick variation.
+        seed: u64,
+    },
+    /// Alternating bands of two albedos, `period_m` apart, across the `t`
+    /// axis (horizontal bands) or, with `vertical`, across `s`.
+    Stripes {
+        /// The two albedos.
+        colours: [[f64; 3]; 2],
+        /// Width of one pair of bands, metres.
+        period_m: f64,
+        /// Bands run up the face instead of along it.
+        vertical: bool,
+    },
+    /// Square cells of `cell_m` whose albedo is `mean · (1 + amplitude · u)`,
+    /// `u` uniform in [−1, 1] per cell: the thesis's "zero mean white noise
+    /// added to the uniform diffuse albedo" (§4.7.1).
+    Noise {
+        /// Mean albedo.
+        mean: [f64; 3],
+        /// Relative amplitude (0.2 for ±20%).
+        amplitude: f64,
+        /// Cell size, metres.
+        cell_m: f64,
+        /// Seed of the cells.
+        seed: u64,
+    },
+}
+
+/// A uniform number in [−1, 1] for integer cell `(i, j)` and `seed`
+/// (SplitMix64 finalizer over the packed cell), so that textures need no state.
+fn cell_noise(i: i64, j: i64, seed: u64) -> f64 {
+    let mut z = seed
+        .wrapping_add((i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15))
+        .wrapping_add((j as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+}
+
+fn scale(c: [f64; 3], k: f64) -> [f64; 3] {
+    c.map(|v| (v * k).clamp(0.0, 1.0))
+}
+
+impl Texture {
+    /// The albedo at texture coordinates `st` (metres).
+    pub fn albedo(&self, st: [f64; 2]) -> [f64; 3] {
+        match self {
+            Texture::Constant(c) => *c,
+            Texture::Bricks {
+                brick,
+                mortar,
+                size_m,
+                joint_m,
+                variation,
+                seed,
+            } => {
+                let row = (st[1] / size_m[1]).floor();
+                // Running bond: odd rows shift by half a brick.
+                let shift = if (row as i64).rem_euclid(2) == 1 {
+                    0.5 * size_m[0]
+                } else {
+                    0.0
+                };
+                let col = ((st[0] + shift) / size_m[0]).floor();
+                let fs = st[0] + shift - col * size_m[0];
+                let ft = st[1] - row * size_m[1];
+                if fs < *joint_m || ft < *joint_m {
+                    *mortar
+                } else {
+                    scale(*brick, 1.0 + variation * cell_noise(col as i64, row as i64, *seed))
+                }
+            }
+            Texture::Stripes {
+                colours,
+                period_m,
+                vertical,
+            } => {
+                let x = if *vertical { st[0] } else { st[1] };
+                let phase = (x / period_m).rem_euclid(1.0);
+                if phase < 0.5 { colours[0] } else { colours[1] }
+            }
+            Texture::Noise {
+                mean,
+                amplitude,
+                cell_m,
+                seed,
+            } => {
+                let (i, j) = ((st[0] / cell_m).floor() as i64, (st[1] / cell_m).floor() as i64);
+                scale(*mean, 1.0 + amplitude * cell_noise(i, j, *seed))
+            }
+        }
+    }
+
+    /// The texture's mean albedo over a large area (for reports and for
+    /// the thesis's "compared to the true average values").
+    pub fn mean_albedo(&self) -> [f64; 3] {
+        match self {
+            Texture::Constant(c) => *c,
+            Texture::Bricks {
+                brick,
+                mortar,
+                size_m,
+                joint_m,
+                ..
+            } => {
+                let brick_fraction =
+                    (size_m[0] - joint_m).max(0.0) * (size_m[1] - joint_m).max(0.0) / (size_m[0] * size_m[1]);
+                [0, 1, 2].map(|c| brick_fraction * brick[c] + (1.0 - brick_fraction) * mortar[c])
+            }
+            Texture::Stripes { colours, .. } => [0, 1, 2].map(|c| 0.5 * (colours[0][c] + colours[1][c])),
+            Texture::Noise { mean, .. } => *mean,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cell_noise_is_uniform_on_minus_one_one() {
+        let n = 200_000;
+        let xs: Vec<f64> = (0..n).map(|i| cell_noise(i, -3 * i, 9)).collect();
+        let mean = xs.iter().sum::<f64>() / n as f64;
+        let var = xs.iter().map(|x| x * x).sum::<f64>() / n as f64 - mean * mean;
+        assert!(xs.iter().all(|x| (-1.0..=1.0).contains(x)));
+        assert!(mean.abs() < 0.01, "mean {mean}");
+        assert!((var - 1.0 / 3.0).abs() < 0.005, "variance {var} (uniform: 1/3)");
+    }
+
+    #[test]
+    fn brick_area_average_matches_mean_albedo() {
+        let t = Texture::Bricks {
+            brick: [0.6, 0.35, 0.25],
+            mortar: [0.8, 0.8, 0.75],
+            size_m: [0.25, 0.08],
+            joint_m: 0.01,
+            variation: 0.15,
+            seed: 3,
+        };
+        let n = 400;
+        let mut sum = [0.0; 3];
+        for i in 0..n {
+            for j in 0..n {
+                let a = t.albedo([i as f64 * 0.0173, j as f64 * 0.0071]);
+                (0..3).for_each(|c| sum[c] += a[c]);
+            }
+        }
+        let mean = t.mean_albedo();
+        for c in 0..3 {
+            let m = sum[c] / (n * n) as f64;
+            assert!(
+                (m / mean[c] - 1.0).abs() < 0.01,
+                "channel {c}: sampled {m} vs {}",
+                mean[c]
+            );
+        }
+    }
+
+    #[test]
+    fn stripes_alternate() {
+        let t = Texture::Stripes {
+            colours: [[0.1; 3], [0.9; 3]],
+            period_m: 2.0,
+            vertical: false,
+        };
+        assert_eq!(t.albedo([5.0, 0.5]), [0.1; 3]);
+        assert_eq!(t.albedo([5.0, 1.5]), [0.9; 3]);
+        assert_eq!(t.albedo([5.0, -0.5]), [0.9; 3]);
+    }
+}
