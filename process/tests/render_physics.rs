@@ -49,6 +49,7 @@ fn ground(half_size: f64, albedo: Texture) -> Scene {
     let material = Material {
         name: "ground".into(),
         albedo,
+        specular: None,
         emission: [0.0; 3],
     };
     Scene::new(tris, vec![material], vec!["ground".into()]).unwrap()
@@ -64,6 +65,7 @@ fn furnace_closed_box_and_sphere_give_e_over_one_minus_rho() {
         let material = Material {
             name: "furnace".into(),
             albedo: Texture::Constant([rho; 3]),
+            specular: None,
             emission,
         };
         let boxed = shapes::cuboid(Vector3::repeat(-1.0), Vector3::repeat(1.0), true, [0; 6], [0; 6]);

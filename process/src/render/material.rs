@@ -2,6 +2,7 @@
 //! optional emission (for the furnace test and glowing surfaces).
 
 use super::texture::Texture;
+use crate::brdf::WardLobe;
 
 /// How a surface reflects and emits.
 #[derive(Debug, Clone, PartialEq)]
@@ -10,6 +11,8 @@ pub struct Material {
     pub name: String,
     /// Diffuse albedo ρd per channel, varying over the surface.
     pub albedo: Texture,
+    /// Ward specular lobe ρs, α, γ (thesis eq. A.1/A.2, in its named variant), if any.
+    pub specular: Option<WardLobe>,
     /// Emitted radiance per channel, W·m⁻²·sr⁻¹ (zero for ordinary surfaces).
     pub emission: [f64; 3],
 }
@@ -20,6 +23,7 @@ impl Material {
         Material {
             name: name.to_string(),
             albedo: Texture::Constant(albedo),
+            specular: None,
             emission: [0.0; 3],
         }
     }

@@ -98,12 +98,18 @@ pub fn from_description(description: campanile_config::Scene, obj: &Path) -> Res
     let materials = material_names
         .iter()
         .zip(&appearances)
-        .map(|(name, a)| Material {
-            name: name.clone(),
-            albedo: a.albedo.clone(),
-            emission: [0.0; 3],
+        .map(|(name, a)| {
+            Ok(Material {
+                name: name.clone(),
+                albedo: a.albedo.clone(),
+                specular: a.lobe().map_err(|e| WorldError::Geometry {
+                    path: obj.to_path_buf(),
+                    message: format!("material {name:?}: {e}"),
+                })?,
+                emission: [0.0; 3],
+            })
         })
-        .collect();
+        .collect::<Result<Vec<_>, WorldError>>()?;
     let scene = Scene::new(triangles, materials, surface_names).map_err(|e| WorldError::Geometry {
         path: obj.to_path_buf(),
         message: e.to_string(),

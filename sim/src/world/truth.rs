@@ -9,6 +9,7 @@
 //!
 //! Materials of other scenes get a neutral grey Lambertian albedo of 0.5.
 
+use campanile_process::brdf::{BrdfError, WardLobe, WardVariant};
 use campanile_process::render::Texture;
 
 /// A Ward specular lobe (thesis eq. A.1/A.2, 1992 normalization).
@@ -33,7 +34,25 @@ pub struct Appearance {
     pub finish: Option<Finish>,
 }
 
+impl Finish {
+    /// The lobe in the thesis's 1992 normalization.
+    pub fn lobe(&self) -> Result<WardLobe, BrdfError> {
+        WardLobe::new(
+            self.rho_s,
+            self.alpha_x,
+            self.alpha_y,
+            self.gamma_deg.to_radians(),
+            WardVariant::Ward1992,
+        )
+    }
+}
+
 impl Appearance {
+    /// The specular lobe, if any.
+    pub fn lobe(&self) -> Result<Option<WardLobe>, BrdfError> {
+        self.finish.as_ref().map(Finish::lobe).transpose()
+    }
+
     fn diffuse(albedo: Texture) -> Appearance {
         Appearance { albedo, finish: None }
     }
