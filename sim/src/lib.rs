@@ -7,11 +7,15 @@
 //! - [`faults`]: seeded fault injection for links, camera and devices.
 //! - [`disk`]: a storage area that fills up.
 //! - [`station`]: a whole simulated station assembled from a station config.
+//! - [`seed`]: how per-frame and per-link seeds derive from the station's seed.
+//! - [`error`]: what assembling a simulated station can fail with.
 
 pub mod camera;
 pub mod clock;
 pub mod devices;
 pub mod disk;
+pub mod error;
 pub mod faults;
+pub mod seed;
 pub mod station;
 pub mod world;

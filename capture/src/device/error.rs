@@ -25,6 +25,10 @@ pub enum DeviceError {
     /// The device did not reach the requested state in time.
     #[error("timed out: {0}")]
     Timeout(String),
+    /// The camera reported a failure (a bad frame, a driver error); the
+    /// message is the camera's.
+    #[error("camera failure: {0}")]
+    Camera(String),
     /// The link to the device failed.
     #[error(transparent)]
     Link(#[from] DriverError),

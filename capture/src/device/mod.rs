@@ -1,5 +1,6 @@
-//! Device traits: the few methods the controller needs from a pan-tilt
-//! head, a filter wheel and a set of lights, with units in the types.
+//! Device traits: the few methods the controller needs from a camera, a
+//! pan-tilt head, a filter wheel and a set of lights, with units in the
+//! types.
 //!
 //! Like embedded-hal, drivers are generic over these small traits, so the
 //! same controller code runs against real hardware (drivers in
@@ -14,16 +15,20 @@
 //! whole session in moments. Methods are generic (`impl PanTilt`), not
 //! object-safe; wrap in an enum when a runtime choice is needed.
 //!
-//! A `Camera` trait is not defined here yet (the capture issue owns it).
+//! The [`Camera`] trait takes manual exposure and gain and returns raw
+//! frames with the exposure actually applied (cameras round it); the
+//! simulator's camera implements it, and real V4L2/nokhwa drivers are to.
 
+pub mod camera;
 pub mod error;
 pub mod filter_wheel;
 pub mod lights;
 pub mod pan_tilt;
 pub mod units;
 
+pub use camera::{Camera, CameraInfo, CaptureSettings, ExposureRange, Frame, GainRange};
 pub use error::DeviceError;
 pub use filter_wheel::FilterWheel;
 pub use lights::{LightChannel, Lights};
 pub use pan_tilt::{AxisRange, HeadStatus, PanTilt, PanTiltLimits};
-pub use units::{Angle, AngularSpeed, Level, Pose};
+pub use units::{Angle, AngularSpeed, ExposureTime, Gain, Level, Pose};

@@ -1,4 +1,5 @@
-//! Units carried in types: angles, angular speeds, light levels.
+//! Units carried in types: angles, angular speeds, light levels, exposure
+//! times and gains.
 
 /// A plane angle, stored in radians (the project's internal unit).
 #[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Default)]
@@ -101,6 +102,57 @@ impl Level {
     }
 }
 
+/// An exposure (integration) time, stored in seconds.
+#[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Default)]
+pub struct ExposureTime(f64);
+
+impl ExposureTime {
+    /// From seconds; `None` unless finite and > 0.
+    pub fn from_seconds(s: f64) -> Option<Self> {
+        (s.is_finite() && s > 0.0).then_some(Self(s))
+    }
+
+    /// From whole microseconds; `None` for 0.
+    pub fn from_micros(us: u64) -> Option<Self> {
+        Self::from_seconds(us as f64 * 1e-6)
+    }
+
+    /// In seconds.
+    pub const fn seconds(self) -> f64 {
+        self.0
+    }
+
+    /// As a [`std::time::Duration`] (rounded to the nanosecond).
+    pub fn duration(self) -> std::time::Duration {
+        std::time::Duration::from_secs_f64(self.0)
+    }
+}
+
+/// An analogue gain in decibels of signal amplitude (0 dB = unity):
+/// the linear factor is `10^(dB/20)`.
+#[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Default)]
+pub struct Gain(f64);
+
+impl Gain {
+    /// Unity gain.
+    pub const UNITY: Gain = Gain(0.0);
+
+    /// From decibels; `None` unless finite.
+    pub fn from_db(db: f64) -> Option<Self> {
+        db.is_finite().then_some(Self(db))
+    }
+
+    /// In decibels.
+    pub const fn db(self) -> f64 {
+        self.0
+    }
+
+    /// The linear amplitude factor, `10^(dB/20)`.
+    pub fn linear(self) -> f64 {
+        10f64.powf(self.0 / 20.0)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -112,5 +164,16 @@ mod tests {
         assert!(Level::new(1.5).is_none());
         assert!(Level::new(f64::NAN).is_none());
         assert_eq!(Level::new(0.25).unwrap().fraction(), 0.25);
+    }
+
+    #[test]
+    fn exposure_and_gain_units() {
+        assert_eq!(ExposureTime::from_micros(2500).unwrap().seconds(), 0.0025);
+        assert!(ExposureTime::from_seconds(0.0).is_none());
+        assert!(ExposureTime::from_seconds(f64::NAN).is_none());
+        // 20 dB is ten times the amplitude; 6.0206 dB is twice.
+        assert!((Gain::from_db(20.0).unwrap().linear() - 10.0).abs() < 1e-12);
+        assert!((Gain::from_db(6.020_599_913).unwrap().linear() - 2.0).abs() < 1e-9);
+        assert_eq!(Gain::UNITY.linear(), 1.0);
     }
 }

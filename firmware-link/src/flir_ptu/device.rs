@@ -90,6 +90,17 @@ impl PtuDevice {
         (self.head.pan.position, self.head.tilt.position)
     }
 
+    /// The head's motion model (ground truth: exact and mechanical
+    /// positions, dynamics).
+    pub fn head(&self) -> &Head {
+        &self.head
+    }
+
+    /// The head's motion model, to set dynamics, encoder noise and limits.
+    pub fn head_mut(&mut self) -> &mut Head {
+        &mut self.head
+    }
+
     /// Simulate a limit switch on `axis` (0 pan, 1 tilt): halt, send `!P`/`!T`.
     pub fn trip_limit<O: Output<PtuEffect>>(&mut self, axis: u8, out: &mut O) {
         self.head.stop();
@@ -219,8 +230,14 @@ impl PtuDevice {
                 out.effect(PtuEffect::Target { pan: 0, tilt: 0 });
                 Self::ack(out)
             }
-            (b"PP", None) => self.value(b"Current Pan position is", self.head.pan.position, out),
-            (b"TP", None) => self.value(b"Current Tilt position is", self.head.tilt.position, out),
+            (b"PP", None) => {
+                let p = self.head.read_pan();
+                self.value(b"Current Pan position is", p, out)
+            }
+            (b"TP", None) => {
+                let t = self.head.read_tilt();
+                self.value(b"Current Tilt position is", t, out)
+            }
             (b"PP", Some(v)) => self.set_position(false, v, out),
             (b"TP", Some(v)) => self.set_position(true, v, out),
             (b"PO", Some(v)) => {

@@ -182,6 +182,26 @@ impl LinkDevice {
         }
     }
 
+    /// The head's motion model (ground truth: exact and mechanical
+    /// positions, dynamics).
+    pub fn head(&self) -> &Head {
+        &self.head
+    }
+
+    /// The head's motion model, to set dynamics, encoder noise and limits.
+    pub fn head_mut(&mut self) -> &mut Head {
+        &mut self.head
+    }
+
+    /// The head's state as the encoders report it (with noise, if the head
+    /// has any); what the device sends to the host.
+    fn reported_head_state(&mut self) -> HeadState {
+        let mut s = self.head_state();
+        s.pan = self.head.read_pan();
+        s.tilt = self.head.read_tilt();
+        s
+    }
+
     /// The selected filter slot.
     pub fn filter_slot(&self) -> u8 {
         self.filter_slot
@@ -308,7 +328,7 @@ impl LinkDevice {
                     tilt: tt,
                     relative,
                 });
-                Reply::Head(self.head_state())
+                Reply::Head(self.reported_head_state())
             }
             Request::Home => {
                 self.fault = false;
@@ -316,12 +336,12 @@ impl LinkDevice {
                 self.head.pan.target = self.head.home.0;
                 self.head.tilt.target = self.head.home.1;
                 out.effect(Effect::HeadHome);
-                Reply::Head(self.head_state())
+                Reply::Head(self.reported_head_state())
             }
             Request::Stop => {
                 self.head.stop();
                 out.effect(Effect::HeadStop);
-                Reply::Head(self.head_state())
+                Reply::Head(self.reported_head_state())
             }
             Request::SetMotion { speed, accel } => {
                 if speed == 0 {
@@ -330,10 +350,16 @@ impl LinkDevice {
                 self.head.pan.speed = speed;
                 self.head.tilt.speed = speed;
                 self.accel = accel;
+                // Acceleration is simulated only on heads given dynamics.
+                for axis in [&mut self.head.pan, &mut self.head.tilt] {
+                    if axis.dynamics.accel != 0 && accel != 0 {
+                        axis.dynamics.accel = accel;
+                    }
+                }
                 out.effect(Effect::HeadMotion { speed, accel });
-                Reply::Head(self.head_state())
+                Reply::Head(self.reported_head_state())
             }
-            Request::QueryHead => Reply::Head(self.head_state()),
+            Request::QueryHead => Reply::Head(self.reported_head_state()),
             Request::SelectFilter(slot) => {
                 if self.config.filter_slots == 0 {
                     return Self::nack(k, NackCode::Unsupported);

@@ -78,6 +78,17 @@ impl PelcoDevice {
         (self.head.pan.position, self.head.tilt.position)
     }
 
+    /// The head's motion model (ground truth: exact and mechanical
+    /// positions, dynamics).
+    pub fn head(&self) -> &Head {
+        &self.head
+    }
+
+    /// The head's motion model, to set dynamics, encoder noise and limits.
+    pub fn head_mut(&mut self) -> &mut Head {
+        &mut self.head
+    }
+
     /// Whether the head is moving.
     pub fn moving(&self) -> bool {
         self.head.moving()
@@ -152,11 +163,11 @@ impl PelcoDevice {
                 self.set_targets(p, from_wire(v), speed, out);
             }
             Command::QueryPan => {
-                let r = Command::PanResponse(to_wire(self.head.pan.position));
+                let r = Command::PanResponse(to_wire(self.head.read_pan()));
                 out.send(&r.frame(self.config.address).encode());
             }
             Command::QueryTilt => {
-                let r = Command::TiltResponse(to_wire(self.head.tilt.position));
+                let r = Command::TiltResponse(to_wire(self.head.read_tilt()));
                 out.send(&r.frame(self.config.address).encode());
             }
             _ => {}

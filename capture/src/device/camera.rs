@@ -1,0 +1,204 @@
+//! The camera trait: manual exposure and gain in, raw frames with the
+//! settings the camera actually used out.
+//!
+//! Cameras round exposure times (a V4L2 driver takes them in 100 µs units,
+//! a sensor in line times), so a [`Frame`] records both the exposure asked
+//! for and the one the camera applied, as the session journal needs.
+
+use super::{DeviceError, ExposureTime, Gain};
+use campanile_process::camera::image::CodeImage;
+use chrono::{DateTime, Utc};
+use std::future::Future;
+
+/// A closed range of exposure times and the step the camera rounds to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExposureRange {
+    /// Shortest exposure.
+    pub min: ExposureTime,
+    /// Longest exposure.
+    pub max: ExposureTime,
+    /// The camera applies the nearest multiple of this step (within
+    /// `min..=max`).
+    pub step: ExposureTime,
+}
+
+impl ExposureRange {
+    /// The exposure the camera applies for `requested`: the nearest
+    /// multiple of the step, kept within `min..=max`; or
+    /// [`DeviceError::OutOfRange`] if `requested` is outside the range.
+    pub fn applied(&self, requested: ExposureTime) -> Result<ExposureTime, DeviceError> {
+        let (lo, hi, s) = (self.min.seconds(), self.max.seconds(), self.step.seconds());
+        let t = requested.seconds();
+        if t < lo || t > hi {
+            return Err(DeviceError::OutOfRange {
+                what: "exposure (s)",
+                requested: t,
+                min: lo,
+                max: hi,
+            });
+        }
+        let rounded = if s > 0.0 { (t / s).round() * s } else { t };
+        // Clamp back inside the range; a range whose ends are not multiples
+        // of the step keeps its ends.
+        Ok(ExposureTime::from_seconds(rounded.clamp(lo, hi)).unwrap_or(requested))
+    }
+}
+
+/// A closed range of gains and the step the camera rounds to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GainRange {
+    /// Lowest gain.
+    pub min: Gain,
+    /// Highest gain.
+    pub max: Gain,
+    /// The camera applies the nearest multiple of this step, in dB (0:
+    /// continuous).
+    pub step_db: f64,
+}
+
+impl GainRange {
+    /// The gain the camera applies for `requested`, or
+    /// [`DeviceError::OutOfRange`].
+    pub fn applied(&self, requested: Gain) -> Result<Gain, DeviceError> {
+        let (lo, hi, g) = (self.min.db(), self.max.db(), requested.db());
+        if g < lo || g > hi {
+            return Err(DeviceError::OutOfRange {
+                what: "gain (dB)",
+                requested: g,
+                min: lo,
+                max: hi,
+            });
+        }
+        let rounded = if self.step_db > 0.0 {
+            (g / self.step_db).round() * self.step_db
+        } else {
+            g
+        };
+        Ok(Gain::from_db(rounded.clamp(lo, hi)).unwrap_or(requested))
+    }
+}
+
+/// What a camera is and what it accepts (known after opening it).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CameraInfo {
+    /// Model or driver name, for the journal.
+    pub model: String,
+    /// Frame width, pixels.
+    pub width: usize,
+    /// Frame height, pixels.
+    pub height: usize,
+    /// Significant bits per sample of raw frames (8 to 16).
+    pub bits: u8,
+    /// Exposure times it accepts.
+    pub exposure: ExposureRange,
+    /// Gains it accepts.
+    pub gain: GainRange,
+}
+
+/// Settings for one frame (all manual: no auto-exposure).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CaptureSettings {
+    /// Exposure time asked for.
+    pub exposure: ExposureTime,
+    /// Analogue gain asked for.
+    pub gain: Gain,
+}
+
+/// One raw frame and the metadata the camera reported with it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame {
+    /// Width, pixels.
+    pub width: usize,
+    /// Height, pixels.
+    pub height: usize,
+    /// Significant bits per sample: codes lie in `0..=2^bits − 1`.
+    pub bits: u8,
+    /// Interleaved RGB codes (`[r, g, b, r, g, b, …]`, row-major),
+    /// `width · height · 3` of them.
+    pub data: Vec<u16>,
+    /// Exposure time asked for.
+    pub exposure_requested: ExposureTime,
+    /// Exposure time the camera applied (rounded to its step).
+    pub exposure_actual: ExposureTime,
+    /// Gain the camera applied.
+    pub gain: Gain,
+    /// The camera's frame counter (consecutive for consecutive captures,
+    /// counting failed ones).
+    pub sequence: u64,
+    /// When the exposure started, UTC.
+    pub timestamp: DateTime<Utc>,
+    /// Sensor temperature in °C, if the camera reports one.
+    pub temperature_c: Option<f64>,
+}
+
+impl Frame {
+    /// The codes as a [`CodeImage`] for the processing crate, labelled with
+    /// the sequence number and actual exposure.
+    pub fn to_code_image(&self) -> CodeImage {
+        CodeImage {
+            width: self.width,
+            height: self.height,
+            bits: self.bits,
+            data: self.data.clone(),
+            label: format!(
+                "frame {} ({} s, {} dB)",
+                self.sequence,
+                self.exposure_actual.seconds(),
+                self.gain.db()
+            ),
+        }
+    }
+}
+
+/// A camera with manual exposure and gain.
+///
+/// [`Camera::capture`] takes one frame and returns once it is read out:
+/// the call lasts at least the exposure time. Settings outside
+/// [`Camera::info`]'s ranges fail with [`DeviceError::OutOfRange`]; a frame
+/// that never arrives fails with [`DeviceError::Timeout`]; a camera that
+/// reports an error fails with [`DeviceError::Camera`].
+pub trait Camera: Send {
+    /// Resolution, bit depth, exposure and gain ranges (known after opening).
+    fn info(&self) -> CameraInfo;
+
+    /// Take one frame with `settings`.
+    fn capture(&mut self, settings: CaptureSettings) -> impl Future<Output = Result<Frame, DeviceError>> + Send;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn range() -> ExposureRange {
+        ExposureRange {
+            min: ExposureTime::from_micros(10).unwrap(),
+            max: ExposureTime::from_seconds(30.0).unwrap(),
+            step: ExposureTime::from_micros(10).unwrap(),
+        }
+    }
+
+    #[test]
+    fn exposure_is_rounded_to_the_step_and_range_checked() {
+        let r = range();
+        let e = |s| ExposureTime::from_seconds(s).unwrap();
+        // 1/3 s → 333 330 µs (nearest 10 µs).
+        assert!((r.applied(e(1.0 / 3.0)).unwrap().seconds() - 0.333_33).abs() < 1e-12);
+        assert!((r.applied(e(0.012_345)).unwrap().seconds() - 0.012_35).abs() < 1e-12);
+        assert!(matches!(r.applied(e(31.0)), Err(DeviceError::OutOfRange { .. })));
+        assert!(matches!(r.applied(e(1e-6)), Err(DeviceError::OutOfRange { .. })));
+    }
+
+    #[test]
+    fn gain_is_range_checked() {
+        let g = GainRange {
+            min: Gain::UNITY,
+            max: Gain::from_db(24.0).unwrap(),
+            step_db: 0.1,
+        };
+        assert!((g.applied(Gain::from_db(6.04).unwrap()).unwrap().db() - 6.0).abs() < 1e-12);
+        assert!(matches!(
+            g.applied(Gain::from_db(30.0).unwrap()),
+            Err(DeviceError::OutOfRange { .. })
+        ));
+    }
+}
