@@ -62,10 +62,11 @@ impl Focal {
 
 /// Pinhole intrinsics with radial distortion and vignetting falloff.
 ///
-/// With `r` the distance from the principal point divided by the focal
-/// length, a point at ideal normalized radius `r` is imaged at
-/// `r (1 + k1 r² + k2 r⁴)`, and its recorded intensity is scaled by
-/// `1 + a r² + b r⁴` (thesis §4.7.2).
+/// Distortion: with `r` the distance from the principal point divided by
+/// the focal length, a point at ideal normalized radius `r` is imaged at
+/// `r (1 + k1 r² + k2 r⁴)`. Falloff: with `ρ` the distance from the image
+/// centre normalized to 1 at the corners (as `campanile hdr lens` fits it),
+/// the recorded intensity is scaled by `1 + a ρ² + b ρ⁴` (thesis §4.7.2).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(test, derive(proptest_derive::Arbitrary))]
 #[serde(deny_unknown_fields)]
@@ -78,7 +79,7 @@ pub struct Intrinsics {
     /// Radial distortion coefficients `(k1, k2)`, each in [-2, 2].
     #[serde(default)]
     pub distortion: (f64, f64),
-    /// Falloff coefficients `(a, b)` of `1 + a r² + b r⁴`, each in [-2, 2].
+    /// Falloff coefficients `(a, b)` of `1 + a ρ² + b ρ⁴` (ρ = 1 at the corners), each in [-2, 2].
     #[serde(default)]
     pub falloff: (f64, f64),
 }

@@ -6,6 +6,7 @@
 //! (CIE clear sky per channel, extinction, reddening, optional clouds).
 //! Everything the solvers should recover is exposed here as ground truth.
 
+pub mod cube_room;
 pub mod rig;
 pub mod scene_file;
 pub mod truth;
@@ -19,6 +20,8 @@ use campanile_process::sky::{Atmosphere, Daylight};
 use campanile_process::sun::{Observer, SunPosition, sun_position};
 use chrono::{DateTime, Utc};
 use nalgebra::Vector3;
+
+use crate::camera::{FrameSource, View};
 
 pub use scene_file::{LoadedScene, examples_dir, from_description, load_scene};
 pub use truth::{Appearance, Finish, Setting};
@@ -234,5 +237,23 @@ impl World {
             samples,
             seed,
         ))
+    }
+}
+
+impl FrameSource for World {
+    /// The world's true radiance for the simulated camera's view. A time the
+    /// ephemeris cannot handle gives a black frame and an error in the log
+    /// (the camera trait has no error path for the scene itself).
+    fn radiance(&self, view: &View) -> RadianceImage {
+        let rig = self.rig(view.head, view.position_m, view.width, view.height);
+        self.render(view.time, &rig, &view.light_levels, view.seed)
+            .unwrap_or_else(|e| {
+                tracing::error!(error = %e, "the simulated world cannot render this view; the frame is black");
+                RadianceImage {
+                    width: view.width,
+                    height: view.height,
+                    data: vec![0.0; view.width * view.height * 3],
+                }
+            })
     }
 }
