@@ -1,0 +1,1 @@
+//! The crash-safe session store (being written).
