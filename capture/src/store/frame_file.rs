@@ -1,0 +1,102 @@
+//! Frame files: raw sensor codes stored losslessly as 16-bit RGB PNG.
+//!
+//! The codes are written unscaled (a 12-bit code of 4095 is stored as
+//! 4095, not 65535); the journal records the bit depth so readers know the
+//! range. PNG stores 16-bit samples big-endian and losslessly, and the
+//! encoder is deterministic, so the same codes always give the same bytes
+//! and the same checksum.
+
+use super::error::StoreError;
+use crate::device::Frame;
+use campanile_process::camera::image::CodeImage;
+use image::codecs::png::{CompressionType, FilterType, PngDecoder, PngEncoder};
+use image::{ColorType, DynamicImage, ImageBuffer, ImageDecoder, Rgb};
+use std::io::Cursor;
+use std::path::Path;
+
+/// Check that `frame` describes itself consistently: a nonzero size that
+/// fits a PNG, 1 to 16 bits, `width · height · 3` codes, none above
+/// `2^bits − 1`.
+pub fn check_frame(key: &str, frame: &Frame) -> Result<(), StoreError> {
+    let bad = |reason: String| {
+        Err(StoreError::BadFrame {
+            key: key.to_string(),
+            reason,
+        })
+    };
+    if frame.width == 0 || frame.height == 0 {
+        return bad(format!("size {}×{} is empty", frame.width, frame.height));
+    }
+    if u32::try_from(frame.width).is_err() || u32::try_from(frame.height).is_err() {
+        return bad(format!("size {}×{} is too large for PNG", frame.width, frame.height));
+    }
+    if !(1..=16).contains(&frame.bits) {
+        return bad(format!("bit depth {} is outside 1..=16", frame.bits));
+    }
+    let expected = frame.width.checked_mul(frame.height).and_then(|n| n.checked_mul(3));
+    if expected != Some(frame.data.len()) {
+        return bad(format!(
+            "{} codes for {}×{} RGB (expected {})",
+            frame.data.len(),
+            frame.width,
+            frame.height,
+            frame.width.saturating_mul(frame.height).saturating_mul(3)
+        ));
+    }
+    let max = u16::MAX >> (16 - frame.bits);
+    if let Some(i) = frame.data.iter().position(|&c| c > max) {
+        return bad(format!(
+            "code {} at sample {i} exceeds {max}, the largest {}-bit code",
+            frame.data[i], frame.bits
+        ));
+    }
+    Ok(())
+}
+
+/// Encode `frame`'s codes as a 16-bit RGB PNG (call [`check_frame`]
+/// first).
+pub fn encode_png(key: &str, frame: &Frame) -> Result<Vec<u8>, StoreError> {
+    let bad = |reason: String| StoreError::BadFrame {
+        key: key.to_string(),
+        reason,
+    };
+    let (w, h) = (
+        u32::try_from(frame.width).map_err(|_| bad("width too large".into()))?,
+        u32::try_from(frame.height).map_err(|_| bad("height too large".into()))?,
+    );
+    let buf: ImageBuffer<Rgb<u16>, &[u16]> =
+        ImageBuffer::from_raw(w, h, frame.data.as_slice()).ok_or_else(|| bad("codes do not fill the frame".into()))?;
+    let mut out = Vec::with_capacity(frame.data.len() * 2 + 1024);
+    let encoder = PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive);
+    buf.write_with_encoder(encoder)
+        .map_err(|e| bad(format!("PNG encoding failed: {e}")))?;
+    Ok(out)
+}
+
+/// Decode a frame file written by [`encode_png`]; `path` names it in
+/// errors and `bits` (from the journal) labels the codes.
+pub fn decode_png(path: &Path, bytes: &[u8], bits: u8) -> Result<CodeImage, StoreError> {
+    let bad = |reason: String| StoreError::BadFrameFile {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let decoder = PngDecoder::new(Cursor::new(bytes)).map_err(|e| bad(format!("not a readable PNG: {e}")))?;
+    if decoder.color_type() != ColorType::Rgb16 {
+        return Err(bad(format!(
+            "expected a 16-bit RGB PNG, found {:?}",
+            decoder.color_type()
+        )));
+    }
+    let (w, h) = decoder.dimensions();
+    let image = DynamicImage::from_decoder(decoder).map_err(|e| bad(format!("PNG data unreadable: {e}")))?;
+    let DynamicImage::ImageRgb16(buf) = image else {
+        return Err(bad("expected a 16-bit RGB PNG".into()));
+    };
+    Ok(CodeImage {
+        width: w as usize,
+        height: h as usize,
+        bits,
+        data: buf.into_raw(),
+        label: path.display().to_string(),
+    })
+}
