@@ -227,6 +227,18 @@ impl<S: FrameSource> SimCamera<S> {
         m
     }
 
+    /// Carry the camera (tripod, head and all) to `position_m`, world frame,
+    /// metres: what an operator does between the scene's named poses. Real
+    /// stations stand where they are put; only the simulation is told.
+    pub fn set_position(&mut self, position_m: [f64; 3]) {
+        self.position_m = position_m;
+    }
+
+    /// Where the camera stands, world frame, metres.
+    pub fn position(&self) -> [f64; 3] {
+        self.position_m
+    }
+
     /// Ground truth of the last frame taken, if any.
     pub fn last_truth(&self) -> Option<FrameTruth> {
         self.lock_log().frames.last().cloned()

@@ -314,3 +314,64 @@ fn rand_chacha_seed(k: u64) -> impl rand::Rng {
     use rand::SeedableRng;
     rand_chacha::ChaCha8Rng::seed_from_u64(k)
 }
+
+/// The environment panorama: its top rows are the daylight sky and its
+/// bottom row, every ray of which lands just below the station, is the
+/// ground's true albedo times its irradiance over π.
+#[test]
+fn environment_panorama_shows_the_sky_above_and_the_ground_below() {
+    let mut w = world("campanile-scene.ron");
+    w.quality.samples_per_pixel = 64;
+    // Over the centre of a 1 m ground-texture cell: the bottom row's rays
+    // land within 0.16 m of the point below.
+    let position = [30.5, -60.5, 1.5];
+    let map = w.environment_map(afternoon(), position, &[], 64, 4).unwrap();
+    assert_eq!((map.width, map.height), (64, 32));
+    let day = w.daylight(afternoon()).unwrap().unwrap();
+    // Row 2 (zenith angles 11.25°–16.9°), away from the sun: the sky model, averaged over each pixel.
+    for x in [8usize, 24, 56] {
+        let az = (x as f64 + 0.5) / 64.0 * std::f64::consts::TAU;
+        let zen = 2.5 / 32.0 * std::f64::consts::PI;
+        let d = campanile_process::sky::direction(zen, az);
+        let expected = day.sky_radiance(d);
+        let got = pixel(&map, x, 2);
+        for c in 0..3 {
+            assert!(
+                (got[c] / expected[c] - 1.0).abs() < 0.02,
+                "x {x}, channel {c}: {} vs {}",
+                got[c],
+                expected[c]
+            );
+        }
+    }
+    // The bottom row: the ground under the station.
+    let below = Vector3::new(position[0], position[1], 0.0);
+    let tri = w
+        .scene
+        .scene
+        .intersect(
+            &render::Ray {
+                origin: Vector3::from(position),
+                direction: -Vector3::z(),
+            },
+            f64::INFINITY,
+        )
+        .unwrap();
+    let albedo = w.scene.scene.albedo_at(tri.triangle, &below);
+    let e = w
+        .irradiance(afternoon(), [below.x, below.y, 0.0], [0.0, 0.0, 1.0], &[], 20_000, 8)
+        .unwrap();
+    let mut mean = [0.0; 3];
+    for x in 0..64 {
+        let p = pixel(&map, x, 31);
+        (0..3).for_each(|c| mean[c] += p[c] / 64.0);
+    }
+    for c in 0..3 {
+        let expected = albedo[c] * e[c] / std::f64::consts::PI;
+        assert!(
+            (mean[c] / expected - 1.0).abs() < 0.03,
+            "channel {c}: nadir {} vs ρE/π {expected}",
+            mean[c]
+        );
+    }
+}

@@ -199,6 +199,49 @@ pub fn render(scene: &Scene, camera: &CameraRig, lighting: &Lighting, settings: 
     }
 }
 
+/// A latitude-longitude panorama of everything seen from `position`:
+/// `width` × `width / 2` pixels covering the whole sphere, the top row at
+/// the zenith and the bottom row at the nadir, the left edge facing north
+/// and azimuth growing eastward to the right. The ground truth of the
+/// environment map (thesis §5.3.3): sky, sun disc, landscape and the scene itself.
+pub fn render_latlong(
+    scene: &Scene,
+    lighting: &Lighting,
+    position: &Vector3<f64>,
+    width: usize,
+    settings: &RenderSettings,
+) -> RadianceImage {
+    let (w, h) = (width.max(2), (width / 2).max(1));
+    let spp = settings.samples_per_pixel.max(1);
+    let mut data = vec![0f32; w * h * 3];
+    data.par_chunks_mut(w * 3).enumerate().for_each(|(y, row)| {
+        let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
+        rng.set_stream(y as u64);
+        for x in 0..w {
+            let mut sum = [0.0; 3];
+            for _ in 0..spp {
+                let zenith = (y as f64 + rng.random::<f64>()) / h as f64 * std::f64::consts::PI;
+                let azimuth = (x as f64 + rng.random::<f64>()) / w as f64 * std::f64::consts::TAU;
+                let d = crate::sky::direction(zenith, azimuth);
+                let ray = Ray {
+                    origin: *position,
+                    direction: Vector3::new(d[0], d[1], d[2]),
+                };
+                let l = trace(scene, lighting, ray, settings.max_bounces, &mut rng);
+                (0..3).for_each(|c| sum[c] += l[c]);
+            }
+            for c in 0..3 {
+                row[x * 3 + c] = (sum[c] / f64::from(spp)) as f32;
+            }
+        }
+    });
+    RadianceImage {
+        width: w,
+        height: h,
+        data,
+    }
+}
+
 /// Irradiance (W·m⁻² per channel) on the side `normal` of a point, by
 /// Monte Carlo: the sun, point lights and lamps sampled explicitly, and
 /// cosine-distributed rays for the sky and the light reflected by the scene

@@ -210,6 +210,34 @@ impl World {
         Ok(render::render(&self.scene.scene, rig, &lighting, &settings))
     }
 
+    /// The true environment seen from `position_m` at `time`: a
+    /// latitude-longitude panorama `width` pixels wide (see
+    /// [`render::render_latlong`]), with the world's quality settings.
+    pub fn environment_map(
+        &self,
+        time: DateTime<Utc>,
+        position_m: [f64; 3],
+        light_levels: &[f64],
+        width: usize,
+        seed: u64,
+    ) -> Result<RadianceImage, WorldError> {
+        let daylight = self.daylight(time)?;
+        let bulbs = self.bulbs(light_levels);
+        let lighting = Lighting {
+            sky: daylight.as_ref().map(|d| d as &dyn render::Sky),
+            points: &[],
+            spheres: &bulbs,
+        };
+        let settings = RenderSettings { seed, ..self.quality };
+        Ok(render::render_latlong(
+            &self.scene.scene,
+            &lighting,
+            &Vector3::from(position_m),
+            width,
+            &settings,
+        ))
+    }
+
     /// The true irradiance (W·m⁻² per channel) at `point` on the side of
     /// `normal`, by Monte Carlo with `samples` paths.
     pub fn irradiance(
