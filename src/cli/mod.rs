@@ -4,6 +4,7 @@ mod config_check;
 mod env;
 mod hdr;
 mod logging;
+mod plan;
 mod ron_output;
 mod site;
 mod sky;
@@ -66,6 +67,11 @@ pub enum Command {
         #[command(subcommand)]
         action: sky::SkyCommand,
     },
+    /// Plans: simulate one forward without devices (timeline, frames, durations, what it will not cover).
+    Plan {
+        #[command(subcommand)]
+        action: plan::PlanCommand,
+    },
 }
 
 /// Exit code for a failure while doing the work.
@@ -99,6 +105,7 @@ pub fn run() -> ExitCode {
         Command::Sun(args) => report(sun::run(args)),
         Command::Sky { action } => report(sky::run(action)),
         Command::Env { action } => report(env::run(action)),
+        Command::Plan { action } => plan::run(action),
     };
     ExitCode::from(code)
 }
