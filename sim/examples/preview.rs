@@ -44,10 +44,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let t0 = std::time::Instant::now();
         let image = world.render(time, &rig, levels, 1)?;
         let elapsed = t0.elapsed();
-        // Expose the median at 0.3, compress highlights (Reinhard), then the sRGB curve.
+        // Expose the median at 0.3 unless that would blow out the brightest
+        // 2%, compress highlights (Reinhard), then the sRGB curve.
         let mut lum: Vec<f32> = image.data.chunks(3).map(|p| p[1]).collect();
         lum.sort_by(f32::total_cmp);
-        let key = 0.3 / lum[lum.len() / 2].max(1e-6);
+        let p98 = lum[lum.len() * 98 / 100].max(1e-6);
+        let key = (0.3 / lum[lum.len() / 2].max(1e-6)).min(2.0 / p98);
         let srgb = |v: f32| {
             let v = v * key;
             let v = (v / (1.0 + v / 4.0)).clamp(0.0, 1.0);
