@@ -85,7 +85,13 @@ fn sunlit_wall_is_albedo_times_irradiance_over_pi() {
         .scene
         .intersect(&rig.ray(u as f64 + 0.5, v as f64 + 0.5).unwrap(), f64::INFINITY)
         .unwrap();
-    let albedo = w.scene.scene.albedo_at(triangle.triangle, &triangle.point);
+    let p = [triangle.point.x, triangle.point.y, triangle.point.z];
+    let truth = w.pseudo_albedos(triangle.triangle, p);
+    assert_eq!(
+        truth.sun, truth.sky_environment,
+        "Lambertian: one albedo for both spectra"
+    );
+    let albedo = truth.sun;
     let e = w
         .irradiance(
             afternoon(),

@@ -70,6 +70,19 @@ pub struct Lamp {
 /// (radius 0) still needs a visible bulb.
 pub const MIN_BULB_RADIUS_M: f64 = 0.01;
 
+/// The true outdoor pseudo-albedos at a surface point (thesis §5.2, §5.4):
+/// one for light with the sun's spectrum, one for the sky and environment.
+/// The simulator renders in the camera's three channels, so its
+/// pseudo-BRDFs are its BRDFs channel by channel; its outdoor surfaces are
+/// Lambertian, so both pseudo-albedos are the diffuse albedo texture there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PseudoAlbedos {
+    /// ρ^sun per channel.
+    pub sun: [f64; 3],
+    /// ρ^se (sky and environment) per channel.
+    pub sky_environment: [f64; 3],
+}
+
 /// The world a simulated station photographs.
 #[derive(Debug, Clone)]
 pub struct World {
@@ -208,6 +221,16 @@ impl World {
         };
         let settings = RenderSettings { seed, ..self.quality };
         Ok(render::render(&self.scene.scene, rig, &lighting, &settings))
+    }
+
+    /// The true pseudo-albedos at `point` on triangle `triangle` of the
+    /// scene (see [`PseudoAlbedos`]).
+    pub fn pseudo_albedos(&self, triangle: usize, point: [f64; 3]) -> PseudoAlbedos {
+        let albedo = self.scene.scene.albedo_at(triangle, &Vector3::from(point));
+        PseudoAlbedos {
+            sun: albedo,
+            sky_environment: albedo,
+        }
     }
 
     /// The true environment seen from `position_m` at `time`: a
