@@ -74,15 +74,20 @@ fn add_scaled(acc: &mut [f64; 3], beta: &[f64; 3], v: &[f64; 3], k: f64) {
     }
 }
 
+/// Two unit vectors completing unit `axis` to a right-handed orthonormal basis.
+fn perpendicular_axes(axis: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let helper = if axis.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+    let a = axis.cross(&helper).normalize();
+    (a, axis.cross(&a))
+}
+
 /// A direction uniformly distributed in the cone of half-angle `acos(cos_max)`
 /// about unit `axis`.
 fn sample_cone(axis: &Vector3<f64>, cos_max: f64, u1: f64, u2: f64) -> Vector3<f64> {
     let cos_t = 1.0 - u1 * (1.0 - cos_max);
     let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
     let phi = std::f64::consts::TAU * u2;
-    let helper = if axis.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
-    let a = axis.cross(&helper).normalize();
-    let b = axis.cross(&a);
+    let (a, b) = perpendicular_axes(axis);
     (a * (sin_t * phi.cos()) + b * (sin_t * phi.sin()) + axis * cos_t).normalize()
 }
 
@@ -290,13 +295,7 @@ pub fn irradiance(
 fn sample_cosine(normal: &Vector3<f64>, u1: f64, u2: f64) -> Vector3<f64> {
     let r = u1.sqrt();
     let phi = std::f64::consts::TAU * u2;
-    let helper = if normal.x.abs() < 0.9 {
-        Vector3::x()
-    } else {
-        Vector3::y()
-    };
-    let a = normal.cross(&helper).normalize();
-    let b = normal.cross(&a);
+    let (a, b) = perpendicular_axes(normal);
     (a * (r * phi.cos()) + b * (r * phi.sin()) + normal * (1.0 - u1).max(0.0).sqrt()).normalize()
 }
 

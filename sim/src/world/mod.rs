@@ -192,6 +192,24 @@ impl World {
             .collect()
     }
 
+    /// Runs `f` with everything that lights the world at `time`: the sun and
+    /// sky outdoors, the lamps at `light_levels`.
+    fn lit<R>(
+        &self,
+        time: DateTime<Utc>,
+        light_levels: &[f64],
+        f: impl FnOnce(&Lighting) -> R,
+    ) -> Result<R, WorldError> {
+        let daylight = self.daylight(time)?;
+        let bulbs = self.bulbs(light_levels);
+        let lighting = Lighting {
+            sky: daylight.as_ref().map(|d| d as &dyn render::Sky),
+            points: &[],
+            spheres: &bulbs,
+        };
+        Ok(f(&lighting))
+    }
+
     /// The camera on its head at `position_m`, rendered at `width` × `height`.
     pub fn rig(&self, head: HeadPose, position_m: [f64; 3], width: usize, height: usize) -> CameraRig {
         CameraRig {
@@ -212,15 +230,10 @@ impl World {
         light_levels: &[f64],
         seed: u64,
     ) -> Result<RadianceImage, WorldError> {
-        let daylight = self.daylight(time)?;
-        let bulbs = self.bulbs(light_levels);
-        let lighting = Lighting {
-            sky: daylight.as_ref().map(|d| d as &dyn render::Sky),
-            points: &[],
-            spheres: &bulbs,
-        };
         let settings = RenderSettings { seed, ..self.quality };
-        Ok(render::render(&self.scene.scene, rig, &lighting, &settings))
+        self.lit(time, light_levels, |lighting| {
+            render::render(&self.scene.scene, rig, lighting, &settings)
+        })
     }
 
     /// The true pseudo-albedos at `point` on triangle `triangle` of the
@@ -244,21 +257,44 @@ impl World {
         width: usize,
         seed: u64,
     ) -> Result<RadianceImage, WorldError> {
-        let daylight = self.daylight(time)?;
-        let bulbs = self.bulbs(light_levels);
-        let lighting = Lighting {
-            sky: daylight.as_ref().map(|d| d as &dyn render::Sky),
-            points: &[],
-            spheres: &bulbs,
-        };
         let settings = RenderSettings { seed, ..self.quality };
-        Ok(render::render_latlong(
-            &self.scene.scene,
-            &lighting,
-            &Vector3::from(position_m),
-            width,
-            &settings,
-        ))
+        self.lit(time, light_levels, |lighting| {
+            render::render_latlong(
+                &self.scene.scene,
+                lighting,
+                &Vector3::from(position_m),
+                width,
+                &settings,
+            )
+        })
+    }
+
+    /// The true radiance of one pixel `(u, v)` of `rig`'s image, averaged
+    /// over `samples` paths spread over the pixel: the ground truth of a
+    /// single pixel without rendering the frame.
+    pub fn pixel_radiance(
+        &self,
+        time: DateTime<Utc>,
+        rig: &CameraRig,
+        (u, v): (usize, usize),
+        light_levels: &[f64],
+        samples: u32,
+        seed: u64,
+    ) -> Result<[f64; 3], WorldError> {
+        use rand::{Rng, SeedableRng};
+        self.lit(time, light_levels, |lighting| {
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+            let mut sum = [0.0; 3];
+            let n = samples.max(1);
+            for _ in 0..n {
+                let (du, dv): (f64, f64) = (rng.random(), rng.random());
+                if let Some(ray) = rig.ray(u as f64 + du, v as f64 + dv) {
+                    let l = render::trace(&self.scene.scene, lighting, ray, self.quality.max_bounces, &mut rng);
+                    (0..3).for_each(|c| sum[c] += l[c]);
+                }
+            }
+            sum.map(|s| s / f64::from(n))
+        })
     }
 
     /// The true irradiance (W·m⁻² per channel) at `point` on the side of
@@ -272,22 +308,17 @@ impl World {
         samples: u32,
         seed: u64,
     ) -> Result<[f64; 3], WorldError> {
-        let daylight = self.daylight(time)?;
-        let bulbs = self.bulbs(light_levels);
-        let lighting = Lighting {
-            sky: daylight.as_ref().map(|d| d as &dyn render::Sky),
-            points: &[],
-            spheres: &bulbs,
-        };
-        Ok(render::irradiance(
-            &self.scene.scene,
-            &lighting,
-            &Vector3::from(point),
-            &Vector3::from(normal),
-            self.quality.max_bounces,
-            samples,
-            seed,
-        ))
+        self.lit(time, light_levels, |lighting| {
+            render::irradiance(
+                &self.scene.scene,
+                lighting,
+                &Vector3::from(point),
+                &Vector3::from(normal),
+                self.quality.max_bounces,
+                samples,
+                seed,
+            )
+        })
     }
 }
 
