@@ -95,7 +95,92 @@ pub fn predict_sky(known: &[KnownSky], sun: [f64; 3], step_deg: f64) -> Result<S
             })
         })
         .collect();
-    Ok(fit_sky(&samples, zs)?)
+    let mut fit = fit_sky(&samples, zs)?;
+    // The scale: the zenith radiance interpolated in the sun's zenith angle.
+    let zenith_now = fit.model.radiance(0.0, zs);
+    if let Some(z) = zenith_radiance(known, zs)
+        && zenith_now > 0.0
+        && zenith_now.is_finite()
+    {
+        fit.model.lz *= z / zenith_now;
+    }
+    Ok(fit)
+}
+
+/// The zenith radiance for a sun at zenith angle `zs`, interpolated from the
+/// known skies' own zenith radiances as a function of their suns' zenith
+/// angles: a monotone cubic through them (skies whose suns are within 0.5°
+/// of each other are averaged). `None` outside the range of the known suns'
+/// zenith angles, where there is nothing to interpolate and the thesis's
+/// scale stands.
+///
+/// This departs from the thesis's scale (§5.5.1 averages Lz over the known
+/// skies by angular distance between suns): on a clear day the zenith
+/// radiance follows the sun's elevation, not its azimuth, and the product
+/// of separately averaged factors does not keep it. Against the simulator's
+/// sky at the campanile held-out time the thesis's scale is 9% off and this
+/// one 0.5% (sim/tests/sky_from_world.rs).
+fn zenith_radiance(known: &[KnownSky], zs: f64) -> Option<f64> {
+    let mut points: Vec<(f64, f64)> = known
+        .iter()
+        .map(|k| {
+            let z = angle_between(k.sun, [0.0, 0.0, 1.0]);
+            (z, k.model.radiance(0.0, z))
+        })
+        .collect();
+    points.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut merged: Vec<(f64, f64, usize)> = Vec::new();
+    for (z, l) in points {
+        match merged.last_mut() {
+            Some(last) if (z - last.0 / last.2 as f64) < 0.5f64.to_radians() => {
+                last.0 += z;
+                last.1 += l;
+                last.2 += 1;
+            }
+            _ => merged.push((z, l, 1)),
+        }
+    }
+    let p: Vec<(f64, f64)> = merged
+        .into_iter()
+        .map(|(z, l, n)| (z / n as f64, l / n as f64))
+        .collect();
+    match p.iter().position(|&(z, _)| z >= zs) {
+        None => None,
+        Some(0) => (p[0].0 - zs < 1e-9).then_some(p[0].1),
+        Some(i) => Some(monotone_cubic(&p, i - 1, zs)),
+    }
+}
+
+/// The monotone cubic (Fritsch–Carlson) through the points `p` (sorted by
+/// x), evaluated at `x` in `[p[k].0, p[k + 1].0]`: exact for linear data,
+/// never overshooting the neighbouring values.
+fn monotone_cubic(p: &[(f64, f64)], k: usize, x: f64) -> f64 {
+    let secant = |i: usize| (p[i + 1].1 - p[i].1) / (p[i + 1].0 - p[i].0);
+    let slope = |i: usize| {
+        if i == 0 {
+            secant(0)
+        } else if i == p.len() - 1 {
+            secant(i - 1)
+        } else {
+            let (a, b) = (secant(i - 1), secant(i));
+            if a * b <= 0.0 {
+                0.0
+            } else {
+                // Weighted harmonic mean of the neighbouring secants.
+                let (h0, h1) = (p[i].0 - p[i - 1].0, p[i + 1].0 - p[i].0);
+                let (w1, w2) = (2.0 * h1 + h0, h1 + 2.0 * h0);
+                (w1 + w2) / (w1 / a + w2 / b)
+            }
+        }
+    };
+    let h = p[k + 1].0 - p[k].0;
+    let t = (x - p[k].0) / h;
+    let (m0, m1) = (slope(k) * h, slope(k + 1) * h);
+    let (t2, t3) = (t * t, t * t * t);
+    (2.0 * t3 - 3.0 * t2 + 1.0) * p[k].1
+        + (t3 - 2.0 * t2 + t) * m0
+        + (-2.0 * t3 + 3.0 * t2) * p[k + 1].1
+        + (t3 - t2) * m1
 }
 
 /// Reddens a sky predicted for a lower sun (§5.5.1): light crossing
@@ -172,7 +257,11 @@ mod tests {
 
     #[test]
     fn a_constant_shaped_sky_is_predicted_exactly_between_four_times() {
-        // The thesis's premise: Lz, Bg and Sa keep their shapes; only the sun moves.
+        // The thesis's premise: Lz, Bg and Sa keep their shapes; only the sun
+        // moves. The shape comes back exactly; the zenith radiance, here
+        // interpolated in the sun's zenith angle by a monotone cubic through
+        // the four known skies, is 0.14% off (the thesis's Lz average would
+        // be exact here, but is 9% off on the simulator's sky).
         let m = SkyModel {
             lz: 0.07,
             a: -1.0,
@@ -192,7 +281,7 @@ mod tests {
         let sun = sun_at(32.0, 185.0);
         let fit = predict_sky(&known, sun, 4.0).expect("predicts");
         let e = rms(|x, g| fit.model.radiance(x, g), |x, g| m.radiance(x, g), sun);
-        assert!(e < 1e-3, "{e}");
+        assert!(e < 2e-3, "{e}");
     }
 
     #[test]
@@ -208,11 +297,10 @@ mod tests {
         let truth = CieSky::new(kind, 0.05, 36f64.to_radians());
         let sun = sun_at(36.0, 160.0);
         let fit = predict_sky(&known, sun, 4.0).expect("predicts");
-        // The shape (the best-scaled error) is right to 5%; the scale is the
-        // inverse-distance average of the known skies' Lz, as in the thesis,
-        // which follows a zenith radiance that changes with the sun only
-        // roughly: it is reported, not hidden.
+        // The shape (the best-scaled error) is right to 5%, and the zenith
+        // radiance, interpolated in the sun's zenith angle, is exact.
         let scale = truth.radiance(0.0, 36f64.to_radians()) / fit.model.radiance(0.0, 36f64.to_radians());
+        assert!((scale - 1.0).abs() < 1e-9, "zenith radiance off by {}", scale - 1.0);
         let shape = rms(
             |x, g| scale * fit.model.radiance(x, g),
             |x, g| truth.radiance(x, g),
