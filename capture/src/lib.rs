@@ -1,12 +1,16 @@
 //! Device traits, drivers, the session controller and the session store. See the README table for what exists.
 //!
+//! - [`clock`]: UTC now and sleeping until an instant, on the wall clock or a simulated one.
+//! - [`controller`]: runs a timeline's shots through the devices into the store.
 //! - [`device`]: the traits the controller drives (camera, head, wheel, lights).
 //! - [`driver`]: real drivers over serial links and camera APIs.
 //! - [`conformance`]: suites any driver or emulator must pass.
 //! - [`schedule`]: when sessions run and what shots they take, as a pure function of plan, site and time.
 //! - [`store`]: the session directory: frames written atomically and an append-only journal.
 
+pub mod clock;
 pub mod conformance;
+pub mod controller;
 pub mod device;
 pub mod driver;
 pub mod schedule;

@@ -234,6 +234,15 @@ impl<S: FrameSource> SimCamera<S> {
         self.position_m = position_m;
     }
 
+    /// Number the next frame `sequence` (and those after it from there).
+    /// Render and sensor-noise seeds derive from the number, so the capture
+    /// controller numbers each planned shot's frames from a value fixed by
+    /// the timeline: a resumed session then takes the same frames as an
+    /// uninterrupted one.
+    pub fn set_sequence(&mut self, sequence: u64) {
+        self.sequence = sequence;
+    }
+
     /// Where the camera stands, world frame, metres.
     pub fn position(&self) -> [f64; 3] {
         self.position_m

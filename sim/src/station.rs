@@ -92,6 +92,7 @@ pub struct SimStation<S> {
     truth: DeviceTruth,
     clock: SimClock,
     retry: RetryPolicy,
+    home_m: [f64; 3],
 }
 
 impl<S: FrameSource> SimStation<S> {
@@ -171,12 +172,19 @@ impl<S: FrameSource> SimStation<S> {
             truth,
             clock,
             retry: options.retry,
+            home_m: options.position_m,
         })
     }
 
     /// The simulated calendar.
     pub fn clock(&self) -> SimClock {
         self.clock
+    }
+
+    /// Where the station stands when not at a named pose
+    /// ([`SimOptions::position_m`]).
+    pub fn home_position(&self) -> [f64; 3] {
+        self.home_m
     }
 
     /// The devices' ground truth (shareable).

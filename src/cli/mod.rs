@@ -1,5 +1,6 @@
 //! Argument parsing and dispatch. One module per subcommand.
 
+mod capture;
 mod config_check;
 mod env;
 mod hdr;
@@ -67,6 +68,8 @@ pub enum Command {
         #[command(subcommand)]
         action: sky::SkyCommand,
     },
+    /// Run a plan on a station into a session directory, or resume one (simulated stations for now).
+    Capture(capture::CaptureArgs),
     /// Plans: simulate one forward without devices (timeline, frames, durations, what it will not cover).
     Plan {
         #[command(subcommand)]
@@ -106,6 +109,7 @@ pub fn run() -> ExitCode {
         Command::Sky { action } => report(sky::run(action)),
         Command::Env { action } => report(env::run(action)),
         Command::Plan { action } => plan::run(action),
+        Command::Capture(args) => capture::run(args),
     };
     ExitCode::from(code)
 }

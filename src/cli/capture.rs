@@ -1,0 +1,372 @@
+//! `campanile capture`: run a plan on a station into a session directory,
+//! or resume one after a crash.
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail};
+use campanile_capture::controller::{self, Progress, RunOptions, ShotOutcome};
+use campanile_capture::schedule::{Occurrence, PlannedShot, SceneGeometry, Timeline, TimelineOptions, timeline};
+use campanile_capture::store::{JournalEntry, Provenance, SessionStore, Snapshot};
+use campanile_config::{Station, check_plan_on_station, load_plan, load_station};
+use campanile_sim::faults::{FaultPlan, LinkFaults};
+use campanile_sim::station::{SimOptions, SimStation};
+use campanile_sim::world::{World, load_scene};
+use chrono::TimeDelta;
+use clap::Args;
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
+
+/// Run a plan on a station and store every frame in a session directory.
+///
+/// Executes exactly the shots `campanile plan check` lists, occurrence by
+/// occurrence, and writes each frame (16-bit PNG, checksummed) and a journal
+/// line before the next shot. Shots that cannot be taken (a device down
+/// after its retries, the head unable to reach, a session that starts too
+/// late) are journaled as missed with the reason.
+///
+/// Simulated stations (a `Sim` camera or `sim:` ports) photograph the plan's
+/// scene under simulated time: the day passes as fast as the frames render.
+/// Real drivers are not yet wired for capture.
+///
+/// Exit status: 0 when every promised frame is stored; 1 when a shot was
+/// missed or the session stopped (e.g. the disk is full; resume it with
+/// --resume); 2 for bad input.
+///
+/// Examples:
+///   campanile capture examples/campanile-day.ron --station examples/sim-station.ron --out day
+///   campanile capture examples/campanile-day.ron --station examples/sim-station.ron --resume day
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub struct CaptureArgs {
+    /// The plan (RON); its scene is read from the plan's `scene` field.
+    #[arg(value_name = "PLAN")]
+    plan: PathBuf,
+    /// The station (RON) that runs it.
+    #[arg(long, value_name = "STATION")]
+    station: PathBuf,
+    /// A new session directory (must not exist or be empty).
+    #[arg(
+        long,
+        value_name = "DIR",
+        required_unless_present = "resume",
+        conflicts_with = "resume"
+    )]
+    out: Option<PathBuf>,
+    /// Resume the session in DIR after a crash or a stop: complete shots are
+    /// kept, the rest are taken. PLAN and STATION must be the ones it began with.
+    #[arg(long, value_name = "DIR")]
+    resume: Option<PathBuf>,
+    /// Run only the first N days of the plan.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    days: Option<u32>,
+    /// Simulation: render samples per pixel.
+    #[arg(long, value_name = "N", default_value_t = 2)]
+    sim_samples: u32,
+    /// Simulation: render bounces.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    sim_bounces: u32,
+    /// Simulation: chance that a byte is dropped on every serial link (0–0.5).
+    #[arg(long, value_name = "P")]
+    sim_drop_chance: Option<f64>,
+    /// Simulation: chance that a byte is corrupted on every serial link (0–0.5).
+    #[arg(long, value_name = "P")]
+    sim_corrupt_chance: Option<f64>,
+}
+
+pub fn run(args: CaptureArgs) -> u8 {
+    let inputs = match Inputs::load(&args) {
+        Ok(i) => i,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            return EXIT_USAGE;
+        }
+    };
+    if !inputs.station.uses_simulation() {
+        eprintln!(
+            "error: station {:?} ({}) uses real devices, and real drivers are not yet wired for `campanile capture`; \
+             use a simulated station (a `Sim` camera and `sim:` ports), e.g. examples/sim-station.ron",
+            inputs.station.name,
+            args.station.display()
+        );
+        return EXIT_USAGE;
+    }
+    match capture(&args, &inputs) {
+        Ok(true) => EXIT_OK,
+        Ok(false) => EXIT_FAILURE,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            EXIT_FAILURE
+        }
+    }
+}
+
+/// The plan, station and scene, as `plan check` reads them.
+struct Inputs {
+    plan: campanile_config::document::LoadedPlan,
+    station: Station,
+    timeline: Timeline,
+    snapshot: Snapshot,
+}
+
+impl Inputs {
+    fn load(args: &CaptureArgs) -> Result<Self> {
+        let plan = load_plan(&args.plan).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let loaded = load_station(&args.station).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let station = loaded.value.clone();
+        check_plan_on_station(&plan, &station).map_err(|e| {
+            anyhow::anyhow!(
+                "{e}\nthe plan does not run on station {:?} ({})",
+                station.name,
+                args.station.display()
+            )
+        })?;
+        let scene = match &plan.scene {
+            Some(s) => Some(SceneGeometry::load(&s.value, &s.source.base_dir()).context("reading the plan's scene")?),
+            None => None,
+        };
+        let t = timeline(
+            &plan.plan.value,
+            &station,
+            scene.as_ref(),
+            &TimelineOptions { days: args.days },
+        )
+        .with_context(|| format!("{}: cannot simulate the plan", args.plan.display()))?;
+        let snapshot = Snapshot {
+            plan_ron: plan.plan.source.text.clone(),
+            station_ron: loaded.source.text.clone(),
+            scene_ron: plan.scene.as_ref().map(|s| s.source.text.clone()),
+            provenance: Provenance {
+                campanile_version: env!("CARGO_PKG_VERSION").to_owned(),
+                created_utc: chrono::Utc::now(),
+                calibration: Vec::new(),
+            },
+        };
+        Ok(Self {
+            plan,
+            station,
+            timeline: t,
+            snapshot,
+        })
+    }
+}
+
+/// Progress bars: the session, and the current occurrence's step.
+struct Bars {
+    session: ProgressBar,
+    step: ProgressBar,
+    _multi: MultiProgress,
+}
+
+impl Bars {
+    fn new(promised: usize) -> Self {
+        let target = if std::io::stderr().is_terminal() {
+            ProgressDrawTarget::stderr()
+        } else {
+            ProgressDrawTarget::hidden()
+        };
+        let multi = MultiProgress::with_draw_target(target);
+        let style = ProgressStyle::with_template("{prefix:>24} [{bar:40}] {pos}/{len} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> ");
+        let session = multi.add(ProgressBar::new(promised as u64).with_style(style.clone()));
+        session.set_prefix("session");
+        let step = multi.add(ProgressBar::new(0).with_style(style));
+        Self {
+            session,
+            step,
+            _multi: multi,
+        }
+    }
+}
+
+impl Progress for Bars {
+    fn occurrence(&mut self, occurrence: &Occurrence) {
+        self.session.set_message(occurrence.key.clone());
+    }
+
+    fn step(&mut self, occurrence: &Occurrence, step: usize, kind: &str, shots: usize) {
+        self.step.reset();
+        self.step.set_length(shots as u64);
+        self.step.set_prefix(format!("{} s{step} {kind}", occurrence.name));
+    }
+
+    fn shot(&mut self, shot: &PlannedShot, outcome: ShotOutcome) {
+        self.step.inc(1);
+        if shot.promised && outcome != ShotOutcome::NotNeeded {
+            self.session.inc(1);
+        }
+    }
+}
+
+fn capture(args: &CaptureArgs, inputs: &Inputs) -> Result<bool> {
+    let (mut store, resumed) = match (&args.out, &args.resume) {
+        (Some(dir), _) => (
+            SessionStore::create(dir, inputs.snapshot.clone())
+                .with_context(|| format!("creating the session in {}", dir.display()))?,
+            false,
+        ),
+        (None, Some(dir)) => {
+            let (store, report) =
+                SessionStore::resume(dir).with_context(|| format!("resuming the session in {}", dir.display()))?;
+            if store.snapshot().plan_ron != inputs.snapshot.plan_ron
+                || store.snapshot().station_ron != inputs.snapshot.station_ron
+            {
+                bail!(
+                    "{} began with another plan or station than {} and {}; give the ones it began with (its plan.ron and station.ron)",
+                    dir.display(),
+                    args.plan.display(),
+                    args.station.display()
+                );
+            }
+            eprintln!(
+                "resuming {}: {} frames and {} missed shots journaled{}",
+                dir.display(),
+                report.frames,
+                report.missed,
+                if report.is_clean() {
+                    ""
+                } else {
+                    "; repairs: see the log"
+                }
+            );
+            tracing::info!(?report, "resumed");
+            (store, true)
+        }
+        (None, None) => bail!("give --out DIR or --resume DIR"),
+    };
+    let Some(first) = inputs.timeline.occurrences.first() else {
+        println!("the plan has no occurrences: nothing to capture");
+        return Ok(true);
+    };
+    // The simulated calendar begins a minute before the first occurrence,
+    // or, on resume, a second after the last journaled shot.
+    let last = store.entries().iter().map(|e| match e {
+        JournalEntry::Done(f) | JournalEntry::Late(f) => f.meta.time,
+        JournalEntry::Missed(m) => m.time,
+    });
+    let origin = match (resumed, last.max()) {
+        (true, Some(t)) => t + TimeDelta::seconds(1),
+        _ => first.start - TimeDelta::seconds(60),
+    };
+    let scene_path = inputs
+        .plan
+        .scene
+        .as_ref()
+        .map(|s| s.source.path.clone())
+        .context("a simulated capture needs the plan's scene to photograph (the plan has no `scene`)")?;
+    let mut world = World::new(
+        &inputs.station,
+        load_scene(&scene_path).with_context(|| format!("loading {}", scene_path.display()))?,
+    );
+    world.quality.samples_per_pixel = args.sim_samples.max(1);
+    world.quality.max_bounces = args.sim_bounces;
+    let home = inputs
+        .plan
+        .scene
+        .as_ref()
+        .and_then(|s| s.value.poses.first())
+        .map_or([0.0; 3], |p| [p.position_m.0, p.position_m.1, p.position_m.2]);
+    let faults = FaultPlan {
+        link: (args.sim_drop_chance.is_some() || args.sim_corrupt_chance.is_some()).then(|| LinkFaults {
+            drop_chance: args.sim_drop_chance.unwrap_or(0.0),
+            corrupt_chance: args.sim_corrupt_chance.unwrap_or(0.0),
+        }),
+        ..FaultPlan::default()
+    };
+    let options = SimOptions {
+        origin,
+        position_m: home,
+        faults,
+        ..SimOptions::default()
+    };
+    let promised = inputs.timeline.frames_promised();
+    let mut bars = Bars::new(promised);
+    let wall = Instant::now();
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_time()
+        .start_paused(true)
+        .build()
+        .context("starting the runtime")?;
+    let result = runtime.block_on(async {
+        let mut sim = SimStation::start(&inputs.station, Arc::new(world), options)
+            .await
+            .context("starting the simulated station")?;
+        let clock = sim.clock();
+        anyhow::Ok(
+            controller::run(
+                &inputs.timeline,
+                &inputs.plan.plan.value,
+                &inputs.station,
+                &mut store,
+                &mut sim,
+                &clock,
+                &RunOptions::default(),
+                &mut bars,
+            )
+            .await,
+        )
+    })?;
+    bars.session.finish_and_clear();
+    bars.step.finish_and_clear();
+    let elapsed = wall.elapsed();
+    let (report, stopped) = match result {
+        Ok(r) => (r, None),
+        Err(e) => (*e.report.clone(), Some(e)),
+    };
+    let promised_keys: std::collections::HashSet<&str> = inputs
+        .timeline
+        .occurrences
+        .iter()
+        .flat_map(|o| o.shots.iter())
+        .filter(|s| s.promised)
+        .map(|s| s.key.as_str())
+        .collect();
+    let (mut stored, mut late, mut missed, mut extra) = (0, 0, 0, 0);
+    for e in store.entries() {
+        let promised = promised_keys.contains(e.key());
+        match e {
+            JournalEntry::Done(_) if promised => stored += 1,
+            JournalEntry::Late(_) if promised => {
+                stored += 1;
+                late += 1;
+            }
+            JournalEntry::Missed(_) if !store.completed(e.key()) => missed += 1,
+            JournalEntry::Missed(_) => {}
+            _ => extra += 1,
+        }
+    }
+    println!("session {}", store.dir().display());
+    println!("  frames promised      {promised}");
+    println!("  frames stored        {stored} (of which late: {late})");
+    println!("  auto-bracket extras  {extra}");
+    println!("  shots missed         {missed}");
+    println!(
+        "  this run             {} frames, {} missed, {} retries, {} reconnects, {} metering captures, {} sun retakes",
+        report.frames,
+        report.missed,
+        report.retries,
+        report.reconnects,
+        report.metering_captures,
+        report.saturation_retakes
+    );
+    println!("  wall time            {}", seconds(elapsed));
+    if let Some(e) = stopped {
+        eprintln!("error: {e:#}");
+        eprintln!(
+            "resume with: campanile capture {} --station {} --resume {}",
+            args.plan.display(),
+            args.station.display(),
+            store.dir().display()
+        );
+        return Ok(false);
+    }
+    Ok(stored == promised && missed == 0)
+}
+
+fn seconds(d: Duration) -> String {
+    format!("{:.1} s", d.as_secs_f64())
+}
