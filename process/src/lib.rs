@@ -13,6 +13,7 @@ pub mod csv_cell;
 pub mod environment;
 pub mod exr_io;
 pub mod hdr;
+pub mod irradiance;
 pub mod model_choice;
 pub mod pose;
 pub mod render;
