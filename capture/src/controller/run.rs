@@ -627,7 +627,7 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
                 .find(|s| s.transmittance().iter().all(|&t| t >= 1.0))
                 .map(|s| s.name.clone()),
             FilterChoice::Slot(name) => Some(name.clone()),
-            FilterChoice::DensestUnsaturated(names) => {
+            FilterChoice::LightestUnsaturated(names) => {
                 let candidates = self.filter_candidates(names);
                 let i = state
                     .sun

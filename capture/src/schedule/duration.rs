@@ -82,7 +82,7 @@ fn slot(filter: &FilterChoice) -> Option<&str> {
     match filter {
         FilterChoice::None => None,
         FilterChoice::Slot(s) => Some(s),
-        FilterChoice::DensestUnsaturated(list) => list.last().map(String::as_str),
+        FilterChoice::LightestUnsaturated(list) => list.last().map(String::as_str),
     }
 }
 

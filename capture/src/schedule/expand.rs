@@ -7,7 +7,7 @@
 //! | --- | --- |
 //! | `Bracket` | one Data shot per listed exposure (`Fixed`), at the aim, through the step's filter |
 //! | `AutoBracket` | one Metering shot (`Auto`), then `max_frames` Data shots (`Auto`), of which only the first is promised: the controller takes the fewest that cover the metered dynamic range, 1..=`max_frames` |
-//! | `SunShot` (§5.3.1) | one Centering shot at the sun through the densest listed filter (`Fixed` 1 ms, within the camera's limits), then 3 Data shots if `triplet` else 1, at the sun, `Auto`, through `DensestUnsaturated(filters)`; retries on saturation are extra frames, not promised |
+//! | `SunShot` (§5.3.1) | one Centering shot at the sun through the densest listed filter (`Fixed` 1 ms, within the camera's limits), then 3 Data shots if `triplet` else 1, at the sun, `Auto`, through `LightestUnsaturated(filters)`; retries on saturation are extra frames, not promised |
 //! | `SkyScan` (§5.3.2) | the sky tiling ([`sky_rows`]: rows from `min_elevation_deg`, then the zenith), each tile a 3-frame bracket `Metered` −2, 0, +2 stops; then for each aureole radius, the ring of tiles around the sun's position at the occurrence's start ([`ring_tiles`]), each one Data frame at `Metered` −4 stops |
 //! | `EnvironmentTiles` (§5.3.3) | the band tiling from `min_elevation_deg` to `max_elevation_deg` ([`band_rows`]), each tile a 3-frame bracket −2, 0, +2 stops |
 //! | `Views` | per pose, a 5-frame bracket −4, −2, 0, +2, +4 stops |
@@ -165,7 +165,7 @@ impl Expansion<'_> {
                     None,
                     true,
                 );
-                let chosen = FilterChoice::DensestUnsaturated(filters.clone());
+                let chosen = FilterChoice::LightestUnsaturated(filters.clone());
                 for f in 0..if *triplet { 3 } else { 1 } {
                     b.push(
                         0,

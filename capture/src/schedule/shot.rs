@@ -118,9 +118,10 @@ pub enum FilterChoice {
     None,
     /// This slot.
     Slot(String),
-    /// The densest of these slots (listed lightest first) that leaves the
-    /// sun's disc unsaturated, chosen by the controller (thesis §5.3.1).
-    DensestUnsaturated(Vec<String>),
+    /// The least dense of these slots (listed lightest first) that leaves
+    /// the sun's disc unsaturated, chosen by the controller (thesis §5.3.1):
+    /// the most light that still measures the disc.
+    LightestUnsaturated(Vec<String>),
 }
 
 /// One frame the plan will take.
