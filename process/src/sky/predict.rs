@@ -98,7 +98,7 @@ pub fn predict_sky(known: &[KnownSky], sun: [f64; 3], step_deg: f64) -> Result<S
     let mut fit = fit_sky(&samples, zs)?;
     // The scale: the zenith radiance interpolated in the sun's zenith angle.
     let zenith_now = fit.model.radiance(0.0, zs);
-    if let Some(z) = zenith_radiance(known, zs)
+    if let Some(z) = zenith_radiance(known, &w, zs)
         && zenith_now > 0.0
         && zenith_now.is_finite()
     {
@@ -107,25 +107,31 @@ pub fn predict_sky(known: &[KnownSky], sun: [f64; 3], step_deg: f64) -> Result<S
     Ok(fit)
 }
 
-/// The zenith radiance for a sun at zenith angle `zs`, interpolated from the
-/// known skies' own zenith radiances as a function of their suns' zenith
-/// angles: a monotone cubic through them (skies whose suns are within 0.5°
-/// of each other are averaged). `None` outside the range of the known suns'
-/// zenith angles, where there is nothing to interpolate and the thesis's
-/// scale stands.
+/// The zenith radiance for a sun at zenith angle `zs`: each known sky's
+/// zenith radiance without its own aureole factor, `Lz Bg(0)`, interpolated
+/// as a function of its sun's zenith angle (a monotone cubic; skies whose
+/// suns are within 0.5° of each other are averaged), times the aureole
+/// factor at the zenith that the thesis's construction gives the new sun,
+/// `Σ wⱼ Saⱼ(Zs)` (weights `w` as in [`predict_sky`]). `None` outside the
+/// range of the known suns' zenith angles, where there is nothing to
+/// interpolate and the thesis's scale stands.
 ///
 /// This departs from the thesis's scale (§5.5.1 averages Lz over the known
 /// skies by angular distance between suns): on a clear day the zenith
 /// radiance follows the sun's elevation, not its azimuth, and the product
 /// of separately averaged factors does not keep it. Against the simulator's
 /// sky at the campanile held-out time the thesis's scale is 9% off and this
-/// one 0.5% (sim/tests/sky_from_world.rs).
-fn zenith_radiance(known: &[KnownSky], zs: f64) -> Option<f64> {
+/// one 0.2–0.6% RMS (sim/tests/sky_from_world.rs); when the known skies
+/// share one shape both are exact.
+fn zenith_radiance(known: &[KnownSky], w: &[f64], zs: f64) -> Option<f64> {
+    // Interpolate Lz·Bg(0), the zenith radiance without the sky's own
+    // aureole factor, then put back the aureole the thesis's construction
+    // gives the new sun: exact when the known skies share one shape.
     let mut points: Vec<(f64, f64)> = known
         .iter()
         .map(|k| {
             let z = angle_between(k.sun, [0.0, 0.0, 1.0]);
-            (z, k.model.radiance(0.0, z))
+            (z, k.model.lz * k.model.background(0.0))
         })
         .collect();
     points.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -144,11 +150,13 @@ fn zenith_radiance(known: &[KnownSky], zs: f64) -> Option<f64> {
         .into_iter()
         .map(|(z, l, n)| (z / n as f64, l / n as f64))
         .collect();
-    match p.iter().position(|&(z, _)| z >= zs) {
+    let without_aureole = match p.iter().position(|&(z, _)| z >= zs) {
         None => None,
         Some(0) => (p[0].0 - zs < 1e-9).then_some(p[0].1),
         Some(i) => Some(monotone_cubic(&p, i - 1, zs)),
-    }
+    }?;
+    let aureole: f64 = known.iter().zip(w).map(|(k, w)| w * k.model.aureole(zs)).sum();
+    Some(without_aureole * aureole)
 }
 
 /// The monotone cubic (Fritsch–Carlson) through the points `p` (sorted by
@@ -257,11 +265,7 @@ mod tests {
 
     #[test]
     fn a_constant_shaped_sky_is_predicted_exactly_between_four_times() {
-        // The thesis's premise: Lz, Bg and Sa keep their shapes; only the sun
-        // moves. The shape comes back exactly; the zenith radiance, here
-        // interpolated in the sun's zenith angle by a monotone cubic through
-        // the four known skies, is 0.14% off (the thesis's Lz average would
-        // be exact here, but is 9% off on the simulator's sky).
+        // The thesis's premise: Lz, Bg and Sa keep their shapes; only the sun moves.
         let m = SkyModel {
             lz: 0.07,
             a: -1.0,
@@ -281,7 +285,7 @@ mod tests {
         let sun = sun_at(32.0, 185.0);
         let fit = predict_sky(&known, sun, 4.0).expect("predicts");
         let e = rms(|x, g| fit.model.radiance(x, g), |x, g| m.radiance(x, g), sun);
-        assert!(e < 2e-3, "{e}");
+        assert!(e < 1e-3, "{e}");
     }
 
     #[test]
@@ -298,9 +302,10 @@ mod tests {
         let sun = sun_at(36.0, 160.0);
         let fit = predict_sky(&known, sun, 4.0).expect("predicts");
         // The shape (the best-scaled error) is right to 5%, and the zenith
-        // radiance, interpolated in the sun's zenith angle, is exact.
+        // radiance, interpolated in the sun's zenith angle, to 0.1%
+        // (measured 0.066%; the thesis's Lz average is 16.6% off here).
         let scale = truth.radiance(0.0, 36f64.to_radians()) / fit.model.radiance(0.0, 36f64.to_radians());
-        assert!((scale - 1.0).abs() < 1e-9, "zenith radiance off by {}", scale - 1.0);
+        assert!((scale - 1.0).abs() < 1e-3, "zenith radiance off by {}", scale - 1.0);
         let shape = rms(
             |x, g| scale * fit.model.radiance(x, g),
             |x, g| truth.radiance(x, g),
