@@ -134,7 +134,8 @@ fn lex_into(text: &str, out: &mut Vec<(Tok, usize, usize)>) -> Option<()> {
                     match b.get(i)? {
                         b'[' => depth += 1,
                         b']' => {
-                            depth -= 1;
+                            // A `]` before any `[` is not an attribute: no tree.
+                            depth = depth.checked_sub(1)?;
                             if depth == 0 {
                                 i += 1;
                                 break;
@@ -597,4 +598,22 @@ pub fn token_text_at(text: &str, offset: usize) -> Option<String> {
 pub fn next_token_start(text: &str, offset: usize) -> Option<usize> {
     let (toks, _) = lex(text);
     toks.into_iter().find(|t| t.2 > offset).map(|t| t.1.max(offset))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A stray `#` before a `]` (no attribute's `[`) is not a tree, and not
+    /// a panic: the case proptest found in `roundtrip::mangled_files_give_errors_not_panics`.
+    #[test]
+    fn a_hash_before_a_closing_bracket_gives_no_tree() {
+        for text in ["#]", "Station(#] name: \"x\")", "#![enable(x)]]", "# ]] ["] {
+            let _ = parse(text);
+            let _ = first_name(text);
+            let _ = next_token_start(text, 0);
+        }
+        assert!(parse("#]").is_none());
+        assert!(parse("#![enable(implicit_some)]\nStation(name: \"x\")").is_some());
+    }
 }
