@@ -1,0 +1,1 @@
+//! The processing report: a self-contained HTML page with plots and tables.
