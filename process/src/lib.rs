@@ -17,6 +17,7 @@ pub mod igi;
 pub mod irradiance;
 pub mod model_choice;
 pub mod outdoor;
+pub mod pipeline;
 pub mod pose;
 pub mod render;
 pub mod report;

@@ -168,7 +168,16 @@ pub struct SimCamera<S> {
     sequence: u64,
     options: CameraOptions,
     log: Arc<Mutex<TruthLog>>,
+    /// The last view rendered and its radiance: frames of the same view
+    /// within [`SAME_SCENE_S`] reuse it (see [`SimCamera::capture`]).
+    render_cache: Option<(View, Arc<RadianceImage>)>,
 }
+
+/// Frames of one view taken within this many seconds of its render see the
+/// same radiance (the sun moves 0.125° in 30 s). A real scene is static
+/// over a bracket; the renderer's Monte Carlo noise must not differ from
+/// one exposure to the next, or the bracket would not be of one scene.
+pub const SAME_SCENE_S: f64 = 30.0;
 
 impl<S: FrameSource> SimCamera<S> {
     /// A camera as `config` describes, looking at `source` from
@@ -216,6 +225,7 @@ impl<S: FrameSource> SimCamera<S> {
             sequence: 0,
             options,
             log: Arc::default(),
+            render_cache: None,
         }
     }
 
@@ -327,7 +337,7 @@ impl<S: FrameSource> Camera for SimCamera<S> {
             None => {}
         }
         let (width, height) = (self.info.width, self.info.height);
-        let view = View {
+        let mut view = View {
             time: timestamp,
             head: self.devices.head_pose(),
             position_m: self.position_m,
@@ -339,7 +349,24 @@ impl<S: FrameSource> Camera for SimCamera<S> {
         let filter_slot = self.devices.wheel_slot();
         let transmittance = self.transmittance(filter_slot);
         tokio::time::sleep(busy).await;
-        let scene = self.source.radiance(&view);
+        let cached = self.render_cache.as_ref().filter(|(v, _)| {
+            v.head == view.head
+                && v.position_m == view.position_m
+                && v.light_levels == view.light_levels
+                && (v.width, v.height) == (width, height)
+                && ((view.time - v.time).num_milliseconds() as f64).abs() <= SAME_SCENE_S * 1e3
+        });
+        let scene = match cached {
+            Some((v, image)) => {
+                view.seed = v.seed;
+                Arc::clone(image)
+            }
+            None => {
+                let image = Arc::new(self.source.radiance(&view));
+                self.render_cache = Some((view.clone(), Arc::clone(&image)));
+                image
+            }
+        };
         if scene.width != width || scene.height != height || scene.data.len() != width * height * 3 {
             return Err(DeviceError::Camera(format!(
                 "the frame source rendered {}×{} ({} samples) for a {width}×{height} camera",

@@ -6,6 +6,7 @@ mod env;
 mod hdr;
 mod logging;
 mod plan;
+mod process;
 mod ron_output;
 mod site;
 mod sky;
@@ -70,6 +71,8 @@ pub enum Command {
     },
     /// Run a plan on a station into a session directory, or resume one (simulated stations for now).
     Capture(capture::CaptureArgs),
+    /// Process a captured session: response, HDR, sun, sky and environment, with a summary.
+    Process(process::ProcessArgs),
     /// Plans: simulate one forward without devices (timeline, frames, durations, what it will not cover).
     Plan {
         #[command(subcommand)]
@@ -110,6 +113,7 @@ pub fn run() -> ExitCode {
         Command::Env { action } => report(env::run(action)),
         Command::Plan { action } => plan::run(action),
         Command::Capture(args) => capture::run(args),
+        Command::Process(args) => report(process::run(args)),
     };
     ExitCode::from(code)
 }

@@ -57,6 +57,7 @@ pub mod fault;
 mod frame_file;
 mod journal;
 mod key;
+mod reader;
 mod report;
 mod session;
 mod snapshot;
@@ -69,6 +70,7 @@ pub use journal::{
     FrameEntry, FrameMeta, JournalEntry, LightLevel, MissedEntry, ParsedJournal, PoseDeg, ShotKind, parse_journal,
 };
 pub use key::{MAX_KEY_BYTES, check_key, frame_file_name};
+pub use reader::SessionReader;
 pub use report::{ResumeReport, TornLine, VerifyReport};
 pub use session::{FRAMES_DIR, JOURNAL_FILE, SessionStore};
 pub use snapshot::{CalibrationRef, PLAN_FILE, PROVENANCE_FILE, Provenance, SCENE_FILE, STATION_FILE, Snapshot};

@@ -37,6 +37,16 @@ fn rotate_y(v: [f64; 3], a: f64) -> [f64; 3] {
 }
 
 impl Mount {
+    /// A configured mount calibration, in radians.
+    pub fn of_calibration(m: &campanile_config::head::MountCalibration) -> Mount {
+        Mount {
+            pan_zero_azimuth_rad: m.pan_zero_azimuth_deg.to_radians(),
+            tilt_zero_rad: m.tilt_zero_deg.to_radians(),
+            roll_rad: m.level_roll_deg.to_radians(),
+            pitch_rad: m.level_pitch_deg.to_radians(),
+        }
+    }
+
     /// The camera's axes in the level frame for `pose`: right, down and
     /// forward (the optical axis), as unit vectors.
     fn axes(&self, pose: HeadPose) -> [[f64; 3]; 3] {

@@ -16,6 +16,30 @@ pub struct Pinhole {
 }
 
 impl Pinhole {
+    /// The pinhole of a configured camera at its configured resolution.
+    pub fn of_camera(camera: &campanile_config::Camera) -> Pinhole {
+        let (w, h) = (camera.resolution.width, camera.resolution.height);
+        let i = &camera.intrinsics;
+        Pinhole {
+            focal_px: i.focal.pixels(w),
+            principal_px: i.principal_point_px.unwrap_or((f64::from(w) / 2.0, f64::from(h) / 2.0)),
+            k1: i.distortion.0,
+            k2: i.distortion.1,
+        }
+    }
+
+    /// This pinhole, given for `from` = (width, height), rescaled to a frame
+    /// of `width` × `height`: focal length and principal point scale.
+    pub fn rescaled(&self, from: (usize, usize), width: usize, height: usize) -> Pinhole {
+        let sx = width as f64 / from.0 as f64;
+        let sy = height as f64 / from.1 as f64;
+        Pinhole {
+            focal_px: self.focal_px * sx,
+            principal_px: (self.principal_px.0 * sx, self.principal_px.1 * sy),
+            ..*self
+        }
+    }
+
     /// The pixel `(u, v)` a camera-frame direction projects to, or `None`
     /// behind the camera.
     pub fn project(&self, d: [f64; 3]) -> Option<(f64, f64)> {

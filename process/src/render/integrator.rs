@@ -171,18 +171,40 @@ fn path(scene: &Scene, lighting: &Lighting, ray: Ray, bounce: u32, max_bounces: 
     radiance
 }
 
+/// Samples per pixel for pixels within a few pixels of the solar disc.
+pub const SUN_PIXEL_SAMPLES: u32 = 1024;
+
 /// Renders the radiance image a camera sees: `samples_per_pixel` stratified
-/// paths per pixel, rows in parallel, each row from its own random stream.
+/// paths per pixel, rows in parallel, each row from its own random stream;
+/// pixels near the solar disc take [`SUN_PIXEL_SAMPLES`].
 pub fn render(scene: &Scene, camera: &CameraRig, lighting: &Lighting, settings: &RenderSettings) -> RadianceImage {
     let (w, h) = (camera.width, camera.height);
     let spp = settings.samples_per_pixel.max(1);
     let side = (f64::from(spp)).sqrt().ceil() as u32;
     let mut data = vec![0f32; w * h * 3];
+    // Pixels that may see part of the solar disc are sampled densely: the
+    // disc spans a few pixels, and its coverage of each one (what a sun
+    // photograph integrates, §5.3.1) would otherwise carry sampling noise
+    // of tens of percent.
+    let sun = lighting.sky.and_then(|s| s.sun());
+    let pixel_rad = camera.pinhole.focal_px.recip();
+    let near_sun = |u: f64, v: f64| {
+        sun.as_ref().is_some_and(|disc| {
+            camera.ray(u, v).is_some_and(|r| {
+                r.direction.dot(&disc.direction).clamp(-1.0, 1.0).acos() < disc.angular_radius_rad + 3.0 * pixel_rad
+            })
+        })
+    };
     data.par_chunks_mut(w * 3).enumerate().for_each(|(y, row)| {
         let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
         rng.set_stream(y as u64);
         for x in 0..w {
             let mut sum = [0.0; 3];
+            let (spp, side) = if near_sun(x as f64 + 0.5, y as f64 + 0.5) {
+                (spp.max(SUN_PIXEL_SAMPLES), side.max(SUN_PIXEL_SAMPLES.isqrt()))
+            } else {
+                (spp, side)
+            };
             for s in 0..spp {
                 let (sx, sy) = (s % side, s / side % side);
                 let u = x as f64 + (f64::from(sx) + rng.random::<f64>()) / f64::from(side);

@@ -1,0 +1,139 @@
+//! Read-only access to a session, for processing: the snapshot, the
+//! journal and the frames, changing nothing on disk.
+//!
+//! Unlike [`SessionStore::resume`](super::SessionStore::resume), a reader
+//! repairs nothing. A torn last journal line (a capture that crashed, or is
+//! still running) is left alone and counted in [`SessionReader::torn_bytes`];
+//! its frame is simply not in the session yet.
+
+use std::path::{Path, PathBuf};
+
+use super::error::StoreError;
+use super::frame_file::decode_png;
+use super::journal::{FrameEntry, JournalEntry, parse_journal};
+use super::session::{FRAMES_DIR, JOURNAL_FILE};
+use super::snapshot::Snapshot;
+use super::storage::{FsStorage, Storage};
+use crate::store::crc32c;
+use campanile_process::camera::image::CodeImage;
+
+/// A session directory opened for reading.
+#[derive(Debug)]
+pub struct SessionReader {
+    dir: PathBuf,
+    snapshot: Snapshot,
+    entries: Vec<JournalEntry>,
+    torn_bytes: u64,
+}
+
+impl SessionReader {
+    /// Opens the session in `dir`: reads its snapshot and journal. A journal
+    /// line that is not an entry is [`StoreError::JournalCorrupt`] naming it.
+    pub fn open(dir: &Path) -> Result<SessionReader, StoreError> {
+        let storage = FsStorage;
+        let journal = dir.join(JOURNAL_FILE);
+        let bytes = match storage.read(&journal) {
+            Ok(b) => b,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                return Err(StoreError::NotASession {
+                    dir: dir.to_path_buf(),
+                    missing: journal,
+                });
+            }
+            Err(source) => {
+                return Err(StoreError::Io {
+                    action: "reading",
+                    path: journal,
+                    source,
+                });
+            }
+        };
+        let snapshot = Snapshot::read(&storage, dir)?;
+        let parsed = parse_journal(&journal, &bytes)?;
+        Ok(SessionReader {
+            dir: dir.to_path_buf(),
+            snapshot,
+            entries: parsed.entries,
+            torn_bytes: parsed.torn_len,
+        })
+    }
+
+    /// The session directory.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// The plan, station and scene the session was captured under.
+    pub fn snapshot(&self) -> &Snapshot {
+        &self.snapshot
+    }
+
+    /// Every journal line, in order.
+    pub fn entries(&self) -> &[JournalEntry] {
+        &self.entries
+    }
+
+    /// The journaled frames, in order (done and late).
+    pub fn frames(&self) -> impl Iterator<Item = &FrameEntry> {
+        self.entries.iter().filter_map(JournalEntry::frame)
+    }
+
+    /// Bytes of a torn last journal line (0 if none).
+    pub fn torn_bytes(&self) -> u64 {
+        self.torn_bytes
+    }
+
+    /// The codes of a journaled frame, after checking its size and CRC-32C.
+    pub fn read_frame(&self, entry: &FrameEntry) -> Result<CodeImage, StoreError> {
+        let path = self.dir.join(&entry.file);
+        if !entry.file.starts_with(&format!("{FRAMES_DIR}/")) || entry.file.contains("..") {
+            return Err(StoreError::BadFrameFile {
+                path,
+                reason: format!(
+                    "the journal names {:?}, expected a file under {FRAMES_DIR}/",
+                    entry.file
+                ),
+            });
+        }
+        let bytes = match FsStorage.read(&path) {
+            Ok(b) => b,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                return Err(StoreError::MissingFrame {
+                    key: entry.key.clone(),
+                    path,
+                });
+            }
+            Err(source) => {
+                return Err(StoreError::Io {
+                    action: "reading",
+                    path,
+                    source,
+                });
+            }
+        };
+        let crc = crc32c(&bytes);
+        if bytes.len() as u64 != entry.bytes || crc != entry.crc32c {
+            return Err(StoreError::BadFrameFile {
+                path,
+                reason: format!(
+                    "{} bytes with CRC-32C {crc:08x}; the journal says {} bytes with {:08x}",
+                    bytes.len(),
+                    entry.bytes,
+                    entry.crc32c
+                ),
+            });
+        }
+        let mut image = decode_png(&path, &bytes, entry.bits)?;
+        if (image.width, image.height) != (entry.width as usize, entry.height as usize) {
+            return Err(StoreError::BadFrameFile {
+                path,
+                reason: format!(
+                    "image is {}×{}, the journal says {}×{}",
+                    image.width, image.height, entry.width, entry.height
+                ),
+            });
+        }
+        image.label = entry.key.clone();
+        Ok(image)
+    }
+}

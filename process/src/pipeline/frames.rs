@@ -1,0 +1,115 @@
+//! Captured frames and their grouping into shots: the frames of one target
+//! (a tile, a pose) of one step form a bracket.
+
+use chrono::{DateTime, Utc};
+
+use crate::camera::image::CodeImage;
+use crate::pose::HeadPose;
+
+/// What a frame was taken for (from the plan step that took it).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Purpose {
+    /// A short exposure to centre the head on the sun (not measured).
+    SunCentering,
+    /// A filtered frame of the sun (§5.3.1); each one is measured alone.
+    Sun,
+    /// A tile of a sky scan (§5.3.2).
+    Sky,
+    /// A tile of the environment below and around the horizon (§5.3.3).
+    Environment,
+    /// A view of the scene from a named pose.
+    View {
+        /// The pose's name.
+        pose: String,
+    },
+    /// Frames with the lights at given levels (indoors, §4.7.2).
+    Lights {
+        /// Level per light channel.
+        levels: Vec<f64>,
+    },
+}
+
+/// One stored frame with what processing needs of its journal line.
+#[derive(Debug, Clone)]
+pub struct CapturedFrame {
+    /// The journal key, `"{occurrence}/s{step}/t{target}/f{frame}"`.
+    pub key: String,
+    /// The occurrence (session name and date) it belongs to.
+    pub occurrence: String,
+    /// Whether the plan holds this occurrence out of fitting.
+    pub held_out: bool,
+    /// When it was taken.
+    pub time: DateTime<Utc>,
+    /// What for.
+    pub purpose: Purpose,
+    /// The head's reading.
+    pub head: HeadPose,
+    /// Where the head stood, scene frame, metres.
+    pub position_m: [f64; 3],
+    /// The exposure the camera reports it applied, seconds.
+    pub exposure_s: f64,
+    /// Transmittance of the filter in the light path, per channel.
+    pub filter_transmittance: [f64; 3],
+    /// The raw codes.
+    pub codes: CodeImage,
+}
+
+/// The frames of one target of one step: a bracket, or the sun's frames.
+#[derive(Debug, Clone)]
+pub struct FrameGroup {
+    /// The key without its frame number, `"{occurrence}/s{step}/t{target}"`.
+    pub key: String,
+    /// Its frames, in journal order.
+    pub frames: Vec<CapturedFrame>,
+}
+
+impl FrameGroup {
+    /// The group's purpose (its first frame's).
+    pub fn purpose(&self) -> &Purpose {
+        &self.frames[0].purpose
+    }
+
+    /// The occurrence.
+    pub fn occurrence(&self) -> &str {
+        &self.frames[0].occurrence
+    }
+
+    /// Mean capture time.
+    pub fn time(&self) -> DateTime<Utc> {
+        let t0 = self.frames[0].time;
+        let mean_ms = self
+            .frames
+            .iter()
+            .map(|f| (f.time - t0).num_milliseconds() as f64)
+            .sum::<f64>()
+            / self.frames.len() as f64;
+        t0 + chrono::Duration::milliseconds(mean_ms.round() as i64)
+    }
+}
+
+/// Groups frames by key prefix (everything before the last `/`), keeping
+/// first-seen order; centring frames are dropped.
+pub fn group_frames(frames: Vec<CapturedFrame>) -> Vec<FrameGroup> {
+    let mut groups: Vec<FrameGroup> = Vec::new();
+    let mut index = std::collections::HashMap::new();
+    for f in frames {
+        if f.purpose == Purpose::SunCentering {
+            continue;
+        }
+        let prefix = f.key.rsplit_once('/').map_or(f.key.as_str(), |(p, _)| p).to_string();
+        match index.get(&prefix) {
+            Some(&i) => {
+                let g: &mut FrameGroup = &mut groups[i];
+                g.frames.push(f);
+            }
+            None => {
+                index.insert(prefix.clone(), groups.len());
+                groups.push(FrameGroup {
+                    key: prefix,
+                    frames: vec![f],
+                });
+            }
+        }
+    }
+    groups
+}

@@ -1,0 +1,287 @@
+//! `campanile process`: a captured session to radiance, light and
+//! reflectance, with a machine-readable summary of every figure.
+
+mod session_frames;
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use campanile_process::hdr::curve_plot::curve_plot_svg;
+use campanile_process::hdr::debevec::DebevecOptions;
+use campanile_process::pipeline::{
+    MergedGroup, OccurrenceLight, Purpose, StationOptics, calibrate_response, group_frames, illumination, merge_groups,
+};
+use campanile_process::sky::{ChannelSky, SkyFile};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde::Serialize;
+
+pub use session_frames::SessionInputs;
+
+/// Process a captured session: response and HDR, then sun, sky and environment.
+///
+/// Reads the session directory that `campanile capture` wrote (its journal,
+/// frames and the plan, station and scene snapshots) and runs:
+///   1. the camera response (Debevec–Malik) from the session's own brackets,
+///      and the HDR merge of every bracket (filters and lens falloff undone);
+///   2. per occurrence: the sun's irradiance from its filtered frames
+///      (triplet agreement checked), the sky model per channel fitted to the
+///      sky scan (model choice by BIC, reason given), the environment map.
+///
+/// Outputs, in OUT (default SESSION/processed):
+///   response.csv, response.svg     the curve with its uncertainty
+///   radiance/<group>.exr           HDR views (RGB, variance, mask)
+///   light/<occurrence>.ron         sun irradiance and sky per channel
+///   summary.json                   every figure and diagnostic, with stage times
+///
+/// Example:
+///   campanile process campanile-day-session --scene examples/campanile-scene.ron
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub struct ProcessArgs {
+    /// The session directory.
+    #[arg(value_name = "SESSION")]
+    session: PathBuf,
+    /// Output directory (created; existing files in it are replaced).
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+    /// The scene file, when the session's scene snapshot cannot find its OBJ geometry.
+    #[arg(long, value_name = "FILE")]
+    scene: Option<PathBuf>,
+    /// Response recovery: smoothness weight λ (Debevec–Malik; unit-free, see `hdr calibrate --help`).
+    #[arg(long, value_name = "λ", default_value_t = campanile_process::hdr::debevec::DEFAULT_LAMBDA)]
+    lambda: f64,
+    /// Response recovery: pixels sampled per channel.
+    #[arg(long, value_name = "N", default_value_t = 4000)]
+    samples: usize,
+    /// Environment map elevation bands (−90° to 90°).
+    #[arg(long, value_name = "N", default_value_t = 18)]
+    env_rows: usize,
+    /// Environment map azimuth sectors.
+    #[arg(long, value_name = "N", default_value_t = 36)]
+    env_cols: usize,
+}
+
+/// What `process` measured, for `summary.json` and the report.
+#[derive(Debug, Serialize)]
+pub struct Summary {
+    pub session: String,
+    pub frames: usize,
+    pub groups: usize,
+    pub response: ResponseSummary,
+    pub occurrences: Vec<OccurrenceSummary>,
+    pub stage_seconds: Vec<(String, f64)>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct ResponseSummary {
+    pub bracket: String,
+    pub reason: String,
+    pub residual_rms: [f64; 3],
+    pub condition_estimate: [f64; 3],
+}
+
+#[derive(Debug, Serialize)]
+pub struct OccurrenceSummary {
+    pub occurrence: String,
+    pub held_out: bool,
+    pub time: String,
+    pub sun_zenith_deg: f64,
+    pub sun_azimuth_deg: f64,
+    pub sun_irradiance: Option<[f64; 3]>,
+    pub sun_triplet_spread: Option<[f64; 3]>,
+    pub sky: Option<SkyFile>,
+    pub environment_regions_seen: Option<usize>,
+    pub notes: Vec<String>,
+}
+
+/// The products of stages 1 and 2, in memory, for the demo and the report.
+#[allow(dead_code)] // The outdoor and report stages read the rest.
+pub struct Processed {
+    pub inputs: SessionInputs,
+    pub optics: StationOptics,
+    pub calibration: campanile_process::hdr::debevec::Calibration,
+    pub merged: Vec<MergedGroup>,
+    pub light: Vec<OccurrenceLight>,
+    pub summary: Summary,
+}
+
+pub fn run(args: ProcessArgs) -> Result<()> {
+    let out = args.out.clone().unwrap_or_else(|| args.session.join("processed"));
+    let mut debevec = DebevecOptions {
+        lambda: args.lambda,
+        ..DebevecOptions::default()
+    };
+    debevec.sampling.samples = args.samples;
+    let processed = process_session(
+        &args.session,
+        args.scene.as_deref(),
+        &debevec,
+        (args.env_rows, args.env_cols),
+    )?;
+    write_outputs(&processed, &out)?;
+    println!("processed {} → {}", args.session.display(), out.display());
+    for (stage, s) in &processed.summary.stage_seconds {
+        println!("  {stage:<28} {s:>7.2} s");
+    }
+    for o in &processed.summary.occurrences {
+        let sky = o.sky.as_ref().map_or("no sky".to_owned(), |s| {
+            format!(
+                "sky {} (rms {:.1}%)",
+                s.channels[1].chosen,
+                100.0 * s.channels.iter().map(|c| c.rms_relative).fold(0.0, f64::max)
+            )
+        });
+        let sun = o.sun_irradiance.map_or("no sun".to_owned(), |e| {
+            format!("sun {:.0}/{:.0}/{:.0} W·m⁻²", e[0], e[1], e[2])
+        });
+        println!("  {:<28} {sun}; {sky}", o.occurrence);
+        for n in &o.notes {
+            println!("    note: {n}");
+        }
+    }
+    Ok(())
+}
+
+pub fn bar(len: u64, what: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len);
+    if std::io::stderr().is_terminal() {
+        bar.set_style(
+            ProgressStyle::with_template("{msg:>24} [{bar:40}] {pos}/{len} {elapsed}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
+        );
+    } else {
+        bar.set_draw_target(ProgressDrawTarget::hidden());
+    }
+    bar.set_message(what.to_owned());
+    bar
+}
+
+/// Stages 1 and 2 on the session in `dir`.
+pub fn process_session(
+    dir: &Path,
+    scene: Option<&Path>,
+    debevec: &DebevecOptions,
+    env: (usize, usize),
+) -> Result<Processed> {
+    let mut stages = Vec::new();
+    let t = Instant::now();
+    let inputs = SessionInputs::open(dir, scene)?;
+    let optics = StationOptics::of_station(&inputs.station);
+    let b = bar(0, "reading frames");
+    let frames = inputs.frames(&b)?;
+    b.finish_and_clear();
+    let frame_count = frames.len();
+    stages.push(("read and check frames".to_owned(), t.elapsed().as_secs_f64()));
+
+    let t = Instant::now();
+    let groups = group_frames(frames);
+    let (calibration, choice) = calibrate_response(&groups, debevec)?;
+    stages.push(("response (Debevec–Malik)".to_owned(), t.elapsed().as_secs_f64()));
+
+    let t = Instant::now();
+    let b = bar(1, "merging HDR");
+    let merged = merge_groups(&groups, &calibration.curve, &optics)?;
+    b.finish_and_clear();
+    stages.push((format!("HDR merge ({} maps)", merged.len()), t.elapsed().as_secs_f64()));
+
+    let t = Instant::now();
+    let light = illumination(&merged, &optics, env.0, env.1)?;
+    stages.push(("sun, sky, environment".to_owned(), t.elapsed().as_secs_f64()));
+
+    let occurrences = light
+        .iter()
+        .map(|l| OccurrenceSummary {
+            occurrence: l.occurrence.clone(),
+            held_out: l.held_out,
+            time: l.time.to_rfc3339(),
+            sun_zenith_deg: l.sun.zenith_rad.to_degrees(),
+            sun_azimuth_deg: l.sun.azimuth_rad.to_degrees(),
+            sun_irradiance: l.sun_irradiance.as_ref().map(|s| s.irradiance),
+            sun_triplet_spread: l.sun_irradiance.as_ref().map(|s| s.spread),
+            sky: sky_file(l),
+            environment_regions_seen: l
+                .environment
+                .as_ref()
+                .map(|m| m.regions.iter().filter(|r| r.count > 0).count()),
+            notes: l.notes.clone(),
+        })
+        .collect();
+    let summary = Summary {
+        session: dir.display().to_string(),
+        frames: frame_count,
+        groups: groups.len(),
+        response: ResponseSummary {
+            bracket: choice.group.clone(),
+            reason: choice.reason.clone(),
+            residual_rms: [0, 1, 2].map(|c| calibration.channels[c].residual_rms),
+            condition_estimate: [0, 1, 2].map(|c| calibration.channels[c].condition_estimate),
+        },
+        occurrences,
+        stage_seconds: stages,
+    };
+    Ok(Processed {
+        inputs,
+        optics,
+        calibration,
+        merged,
+        light,
+        summary,
+    })
+}
+
+/// The sky fits of an occurrence as a sky file.
+pub fn sky_file(l: &OccurrenceLight) -> Option<SkyFile> {
+    let fits = l.sky.as_ref()?;
+    Some(SkyFile {
+        sun_zenith_deg: l.sun.zenith_rad.to_degrees(),
+        sun_azimuth_deg: l.sun.azimuth_rad.to_degrees(),
+        channels: fits
+            .iter()
+            .zip(["r", "g", "b"])
+            .map(|(f, name)| ChannelSky::new(name, &f.fit, f.kept.len(), f.masked_fraction))
+            .collect(),
+    })
+}
+
+fn file_name(key: &str) -> String {
+    key.chars()
+        .map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' })
+        .collect()
+}
+
+/// Writes the curve, the views' radiance, the light per occurrence and the summary.
+pub fn write_outputs(p: &Processed, out: &Path) -> Result<()> {
+    let mkdir = |d: &Path| std::fs::create_dir_all(d).with_context(|| format!("{}: cannot create", d.display()));
+    mkdir(out)?;
+    mkdir(&out.join("radiance"))?;
+    mkdir(&out.join("light"))?;
+    let write = |path: PathBuf, bytes: &[u8]| -> Result<()> {
+        let tmp = path.with_extension("partial");
+        std::fs::write(&tmp, bytes).with_context(|| format!("{}: cannot write", tmp.display()))?;
+        std::fs::rename(&tmp, &path).with_context(|| format!("{}: cannot write", path.display()))
+    };
+    write(
+        out.join("response.csv"),
+        p.calibration.curve.to_csv(&p.calibration.method).as_bytes(),
+    )?;
+    let svg = curve_plot_svg(&p.calibration.curve, "recovered camera response (full-well gauge)")?;
+    write(out.join("response.svg"), svg.as_bytes())?;
+    for g in p.merged.iter().filter(|g| matches!(g.purpose, Purpose::View { .. })) {
+        let path = out.join("radiance").join(format!("{}.exr", file_name(&g.key)));
+        campanile_process::exr_io::write_radiance_exr(&g.map, &path)
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    for o in &p.summary.occurrences {
+        if let Some(sky) = &o.sky {
+            let path = out.join("light").join(format!("{}.ron", file_name(&o.occurrence)));
+            super::ron_output::write_ron(sky, Some(&path))?;
+        }
+    }
+    let json = serde_json::to_vec_pretty(&p.summary)?;
+    write(out.join("summary.json"), &json)?;
+    Ok(())
+}

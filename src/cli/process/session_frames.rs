@@ -1,0 +1,202 @@
+//! A session directory as processing input: its journal's frames, each with
+//! what its plan step took it for, its head reading, filter and position.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, anyhow, bail};
+use campanile_capture::store::{FrameEntry, SessionReader, ShotKind};
+use campanile_config::plan::Step;
+use campanile_config::source::SourceFile;
+use campanile_config::{Plan, Scene, Station};
+use campanile_process::pipeline::{CapturedFrame, Purpose};
+use campanile_process::pose::HeadPose;
+use indicatif::ProgressBar;
+use rayon::prelude::*;
+
+/// A session's descriptions, parsed from its snapshot.
+pub struct SessionInputs {
+    pub reader: SessionReader,
+    pub plan: Plan,
+    pub station: Station,
+    /// The scene and the directory its geometry path is relative to.
+    pub scene: Option<(Scene, PathBuf)>,
+}
+
+impl SessionInputs {
+    /// Opens `dir`; `scene_override` replaces the session's scene snapshot
+    /// (whose OBJ geometry may not have been copied into the session).
+    pub fn open(dir: &Path, scene_override: Option<&Path>) -> Result<SessionInputs> {
+        let reader = SessionReader::open(dir).with_context(|| format!("{}: cannot read the session", dir.display()))?;
+        let snap = reader.snapshot();
+        let parse = |name: &str, text: &str| SourceFile::from_text(&dir.join(name), text.to_owned());
+        let plan: Plan = parse("plan.ron", &snap.plan_ron).parse().map_err(|e| anyhow!("{e}"))?;
+        let station: Station = parse("station.ron", &snap.station_ron)
+            .parse()
+            .map_err(|e| anyhow!("{e}"))?;
+        let scene = match (scene_override, &snap.scene_ron) {
+            (Some(path), _) => {
+                let loaded = campanile_config::load_scene(path).map_err(|e| anyhow!("{e}"))?;
+                let base = loaded.source.base_dir();
+                Some((loaded.value, base))
+            }
+            (None, Some(text)) => {
+                let scene: Scene = parse("scene.ron", text).parse().map_err(|e| anyhow!("{e}"))?;
+                Some((scene, dir.to_path_buf()))
+            }
+            (None, None) => None,
+        };
+        Ok(SessionInputs {
+            reader,
+            plan,
+            station,
+            scene,
+        })
+    }
+
+    /// The OBJ geometry of the scene, checked to exist.
+    #[allow(dead_code)] // The outdoor stage reads it.
+    pub fn geometry(&self) -> Result<Option<PathBuf>> {
+        let Some((scene, base)) = &self.scene else {
+            return Ok(None);
+        };
+        let path = base.join(&scene.geometry);
+        if !path.is_file() {
+            bail!(
+                "the scene's geometry {} is not in the session directory: pass the scene file with --scene (e.g. --scene examples/campanile-scene.ron)",
+                path.display()
+            );
+        }
+        Ok(Some(path))
+    }
+
+    /// Every data frame of the session with its purpose, read and checked
+    /// (in parallel), in journal order.
+    pub fn frames(&self, bar: &ProgressBar) -> Result<Vec<CapturedFrame>> {
+        let entries: Vec<&FrameEntry> = self
+            .reader
+            .frames()
+            .filter(|f| f.meta.kind != ShotKind::Metering)
+            .collect();
+        bar.set_length(entries.len() as u64);
+        // Where the head stood: the last pose a view aimed from, starting at
+        // the scene's first pose (where a station is set up).
+        let mut position = self
+            .scene
+            .as_ref()
+            .and_then(|(s, _)| s.poses.first())
+            .map_or([0.0; 3], |p| [p.position_m.0, p.position_m.1, p.position_m.2]);
+        let mut described = Vec::with_capacity(entries.len());
+        for e in &entries {
+            let (purpose, pos) = self.purpose(e)?;
+            if let Some(p) = pos {
+                position = p;
+            }
+            described.push((purpose, position));
+        }
+        let frames: Result<Vec<CapturedFrame>> = entries
+            .par_iter()
+            .zip(described)
+            .map(|(e, (purpose, position_m))| {
+                let codes = self.reader.read_frame(e).map_err(|err| anyhow!("{err}"))?;
+                bar.inc(1);
+                let pose = e.meta.pose_reached.or(e.meta.pose_requested).ok_or_else(|| {
+                    anyhow!(
+                        "{}: journal line of {:?} has no head pose",
+                        self.reader.dir().display(),
+                        e.key
+                    )
+                })?;
+                let filter_transmittance = match &e.meta.filter {
+                    None => [1.0; 3],
+                    Some(name) => self
+                        .station
+                        .filter_wheel
+                        .as_ref()
+                        .and_then(|w| w.slots.iter().find(|s| &s.name == name))
+                        .map(|s| s.transmittance())
+                        .ok_or_else(|| {
+                            anyhow!(
+                                "frame {:?} was taken through filter {name:?}, which the station's wheel does not have",
+                                e.key
+                            )
+                        })?,
+                };
+                let occurrence = e.key.split('/').next().unwrap_or_default().to_owned();
+                let held_out = self.session_of(&occurrence).is_some_and(|s| s.held_out);
+                Ok(CapturedFrame {
+                    key: e.key.clone(),
+                    occurrence,
+                    held_out,
+                    time: e.meta.time,
+                    purpose,
+                    head: HeadPose {
+                        pan_rad: pose.pan_deg.to_radians(),
+                        tilt_rad: pose.tilt_deg.to_radians(),
+                    },
+                    position_m,
+                    exposure_s: e.meta.exposure_actual_s,
+                    filter_transmittance,
+                    codes,
+                })
+            })
+            .collect();
+        frames
+    }
+
+    fn session_of(&self, occurrence: &str) -> Option<&campanile_config::plan::Session> {
+        let name = occurrence.split('@').next()?;
+        self.plan.sessions.iter().find(|s| s.name == name)
+    }
+
+    /// What a frame was for, from its key `"{session}@{date}/s{step}/t{target}/f{frame}"`,
+    /// and for a view the position it was taken from.
+    fn purpose(&self, e: &FrameEntry) -> Result<(Purpose, Option<[f64; 3]>)> {
+        let bad = |why: &str| anyhow!("frame key {:?}: {why}", e.key);
+        let parts: Vec<&str> = e.key.split('/').collect();
+        let [occurrence, step, target, _frame] = parts[..] else {
+            return Err(bad("expected SESSION@DATE/sSTEP/tTARGET/fFRAME"));
+        };
+        let number = |s: &str, prefix: char| -> Result<usize> {
+            s.strip_prefix(prefix)
+                .and_then(|n| n.parse().ok())
+                .ok_or_else(|| bad(&format!("expected {prefix}N, found {s:?}")))
+        };
+        let (step, target) = (number(step, 's')?, number(target, 't')?);
+        let session = self
+            .session_of(occurrence)
+            .ok_or_else(|| bad("no session of that name in the plan"))?;
+        let step = session
+            .steps
+            .get(step)
+            .ok_or_else(|| bad(&format!("the session has {} steps", session.steps.len())))?;
+        if e.meta.kind == ShotKind::Centering {
+            return Ok((Purpose::SunCentering, None));
+        }
+        let pose = |name: &str| -> Result<(Purpose, Option<[f64; 3]>)> {
+            let position = self
+                .scene
+                .as_ref()
+                .and_then(|(s, _)| s.pose(name))
+                .map(|p| [p.position_m.0, p.position_m.1, p.position_m.2]);
+            Ok((Purpose::View { pose: name.to_owned() }, position))
+        };
+        let levels = || e.meta.lights.iter().flatten().map(|l| l.level).collect::<Vec<f64>>();
+        match step {
+            Step::SunShot { .. } => Ok((Purpose::Sun, None)),
+            Step::SkyScan { .. } => Ok((Purpose::Sky, None)),
+            Step::EnvironmentTiles { .. } => Ok((Purpose::Environment, None)),
+            Step::Views { poses, .. } => pose(poses.get(target).ok_or_else(|| bad("no such pose in the step"))?),
+            Step::Bracket { aim, .. } | Step::AutoBracket { aim, .. } => match aim {
+                campanile_config::plan::Aim::Pose(name) => pose(name),
+                campanile_config::plan::Aim::Sun => Ok((Purpose::Sun, None)),
+                campanile_config::plan::Aim::PanTilt { pan_deg, tilt_deg } => Ok((
+                    Purpose::View {
+                        pose: format!("pan {pan_deg}° tilt {tilt_deg}°"),
+                    },
+                    None,
+                )),
+            },
+            Step::LightSequence { .. } => Ok((Purpose::Lights { levels: levels() }, None)),
+        }
+    }
+}

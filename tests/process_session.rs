@@ -1,0 +1,126 @@
+//! `campanile process` on a captured simulated session (the quick day:
+//! two training times and a held-out one): the response, the sun and the
+//! sky it recovers from the session's own frames, against the simulator's
+//! truth.
+
+mod common;
+
+use campanile_process::camera::sensor::CameraModel;
+use campanile_process::sky::{SkyFile, angle_between, direction};
+use campanile_sim::world::{World, examples_dir, load_scene};
+use common::campanile;
+
+#[test]
+fn a_processed_session_recovers_the_simulated_response_sun_and_sky() {
+    let tmp = tempfile::tempdir().unwrap();
+    let session = tmp.path().join("quick");
+    let out = campanile(&[
+        "-q",
+        "capture",
+        "examples/campanile-quick.ron",
+        "--station",
+        "examples/sim-station.ron",
+        "--out",
+        session.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let processed = tmp.path().join("processed");
+    let out = campanile(&[
+        "-q",
+        "process",
+        session.to_str().unwrap(),
+        "--scene",
+        "examples/campanile-scene.ron",
+        "--out",
+        processed.to_str().unwrap(),
+    ]);
+    println!("{}", String::from_utf8_lossy(&out.stdout));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+
+    // The response, from the plan's dense calibration bracket: shape within
+    // 0.025 log-RMS of the simulated camera's over codes 400–3800, and the
+    // full-well gauge within 0.05.
+    let csv = std::fs::read_to_string(processed.join("response.csv")).unwrap();
+    let curve = campanile_process::hdr::curve::ResponseCurve::from_csv(&csv, &processed.join("response.csv")).unwrap();
+    let truth = CameraModel::typical(12);
+    let mut failures: Vec<(String, f64, f64)> = Vec::new();
+    for c in 0..3 {
+        let d: Vec<f64> = (400..=3800)
+            .step_by(100)
+            .map(|code| curve.ln_exposure(c, f64::from(code)) - truth.true_ln_exposure(f64::from(code), c))
+            .collect();
+        let mean = d.iter().sum::<f64>() / d.len() as f64;
+        let shape = (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / d.len() as f64).sqrt();
+        println!(
+            "  Δ at codes 400, 800, …: {:?}",
+            d.iter()
+                .step_by(4)
+                .map(|x| (x * 1000.0).round() / 1000.0)
+                .collect::<Vec<_>>()
+        );
+        println!("response channel {c}: gauge offset {mean:+.4}, shape log-RMS {shape:.4} over codes 400–3800");
+        failures.push((format!("response {c} shape"), shape, 0.025));
+        failures.push((format!("response {c} gauge"), mean.abs(), 0.05));
+    }
+
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(processed.join("summary.json")).unwrap()).unwrap();
+    let station = campanile_config::document::load_station(&examples_dir().join("sim-station.ron"))
+        .unwrap()
+        .value;
+    let world = World::new(
+        &station,
+        load_scene(&examples_dir().join("campanile-scene.ron")).unwrap(),
+    );
+    let occurrences = summary["occurrences"].as_array().unwrap();
+    assert_eq!(occurrences.len(), 3);
+    for o in occurrences {
+        let name = o["occurrence"].as_str().unwrap();
+        let time: chrono::DateTime<chrono::Utc> = o["time"].as_str().unwrap().parse().unwrap();
+        let daylight = world.daylight(time).unwrap().unwrap();
+        // The sun: irradiance normal to it within 6% per channel, gauge
+        // error included. (The measurement is at the sun shot, a minute
+        // before the sky scan's reference time; the truth is taken at the
+        // sky's time.)
+        let e = o["sun_irradiance"].as_array().expect("a sun measurement");
+        let truth_e = daylight.sun_irradiance();
+        for c in 0..3 {
+            let got = e[c].as_f64().unwrap();
+            let rel = got / truth_e[c] - 1.0;
+            println!(
+                "{name} sun channel {c}: {got:.1} vs {:.1} W·m⁻² ({:+.2}%)",
+                truth_e[c],
+                100.0 * rel
+            );
+            failures.push((format!("{name} sun {c}"), rel.abs(), 0.06));
+        }
+        // The sky: within 6% RMS of the true sky over the sky above 10°
+        // and more than 10° from the sun, per channel, absolute (gauge included).
+        let sky: SkyFile = serde_json::from_value(o["sky"].clone()).unwrap();
+        let sun = daylight.sun_direction;
+        let dirs: Vec<[f64; 3]> = (0..27)
+            .flat_map(|i| {
+                (0..72).map(move |j| direction((3.0 * f64::from(i)).to_radians(), (5.0 * f64::from(j)).to_radians()))
+            })
+            .filter(|d| d[2] > 10f64.to_radians().sin() && angle_between(*d, sun) > 10f64.to_radians())
+            .collect();
+        for (c, ch) in sky.channels.iter().enumerate() {
+            let ms: f64 = dirs
+                .iter()
+                .map(|&d| {
+                    let t = daylight.sky_radiance(d)[c];
+                    (ch.model.radiance(d[2].acos(), angle_between(d, sun)) / t - 1.0).powi(2)
+                })
+                .sum::<f64>()
+                / dirs.len() as f64;
+            println!(
+                "{name} sky channel {c}: {:.2}% RMS against the truth ({})",
+                100.0 * ms.sqrt(),
+                ch.chosen
+            );
+            failures.push((format!("{name} sky {c}"), ms.sqrt(), 0.06));
+        }
+    }
+    let failed: Vec<_> = failures.iter().filter(|(_, v, bound)| v.is_nan() || v >= bound).collect();
+    assert!(failed.is_empty(), "beyond bounds: {failed:?}");
+}
