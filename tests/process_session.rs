@@ -121,6 +121,9 @@ fn a_processed_session_recovers_the_simulated_response_sun_and_sky() {
             failures.push((format!("{name} sky {c}"), ms.sqrt(), 0.06));
         }
     }
-    let failed: Vec<_> = failures.iter().filter(|(_, v, bound)| v.is_nan() || v >= bound).collect();
+    let failed: Vec<_> = failures
+        .iter()
+        .filter(|(_, v, bound)| v.is_nan() || v >= bound)
+        .collect();
     assert!(failed.is_empty(), "beyond bounds: {failed:?}");
 }

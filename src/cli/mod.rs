@@ -2,6 +2,7 @@
 
 mod capture;
 mod config_check;
+mod demo;
 mod env;
 mod hdr;
 mod logging;
@@ -47,6 +48,8 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// The whole station on simulated hardware: capture a day, process it, write a report.
+    Demo(demo::DemoArgs),
     /// Read and validate configuration files (station, plan, scene).
     Config {
         #[command(subcommand)]
@@ -113,6 +116,7 @@ pub fn run() -> ExitCode {
         Command::Env { action } => report(env::run(action)),
         Command::Plan { action } => plan::run(action),
         Command::Capture(args) => capture::run(args),
+        Command::Demo(args) => report(demo::run(args)),
         Command::Process(args) => report(process::run(args)),
     };
     ExitCode::from(code)

@@ -242,3 +242,57 @@ pub fn illumination(
     }
     Ok(out)
 }
+
+/// A fisheye map of the sky, `size` × `size` pixels, zenith at the centre
+/// and the horizon on the inscribed circle (equidistant in zenith angle),
+/// north up and east to the right (as seen from above), of `value(d,
+/// measured)` averaged over the sky pixels of an occurrence's sky scan
+/// looking toward unit direction `d`. Pixels nothing fell in are NaN.
+pub fn sky_fisheye(
+    merged: &[MergedGroup],
+    optics: &StationOptics,
+    occurrence: &str,
+    channel: usize,
+    size: usize,
+    value: impl Fn([f64; 3], f64) -> f64,
+) -> Vec<f64> {
+    let mut sum = vec![0.0; size * size];
+    let mut count = vec![0u32; size * size];
+    let half = size as f64 / 2.0;
+    for g in merged
+        .iter()
+        .filter(|g| g.occurrence == occurrence && g.purpose == Purpose::Sky)
+    {
+        for y in 0..g.map.height {
+            for x in 0..g.map.width {
+                let p = y * g.map.width + x;
+                if g.map.mask[p] != 0 {
+                    continue;
+                }
+                let Some(d) = g.pinhole.unproject(x as f64 + 0.5, y as f64 + 0.5) else {
+                    continue;
+                };
+                let d = optics.mount.to_world(g.head, d);
+                if d[2] <= 0.0 {
+                    continue;
+                }
+                let v = value(d, f64::from(g.map.rgb[3 * p + channel]));
+                if !v.is_finite() {
+                    continue;
+                }
+                let r = d[2].clamp(-1.0, 1.0).acos() / std::f64::consts::FRAC_PI_2 * half;
+                let h = (d[0] * d[0] + d[1] * d[1]).sqrt().max(1e-12);
+                let (u, w) = (half + r * d[0] / h, half - r * d[1] / h);
+                let (u, w) = (u as usize, w as usize);
+                if u < size && w < size {
+                    sum[w * size + u] += v;
+                    count[w * size + u] += 1;
+                }
+            }
+        }
+    }
+    sum.iter()
+        .zip(&count)
+        .map(|(s, &n)| if n > 0 { s / f64::from(n) } else { f64::NAN })
+        .collect()
+}

@@ -26,7 +26,7 @@ mod radiance;
 mod response;
 
 pub use frames::{CapturedFrame, FrameGroup, Purpose, group_frames};
-pub use illumination::{OccurrenceLight, SunMeasurement, illumination};
+pub use illumination::{OccurrenceLight, SunMeasurement, illumination, sky_fisheye};
 pub use radiance::{MergedGroup, merge_groups};
 pub use response::{ResponseChoice, calibrate_response};
 

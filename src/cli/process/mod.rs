@@ -1,6 +1,7 @@
 //! `campanile process`: a captured session to radiance, light and
 //! reflectance, with a machine-readable summary of every figure.
 
+pub mod report_sections;
 mod session_frames;
 
 use std::io::IsTerminal;
@@ -13,6 +14,7 @@ use campanile_process::hdr::debevec::DebevecOptions;
 use campanile_process::pipeline::{
     MergedGroup, OccurrenceLight, Purpose, StationOptics, calibrate_response, group_frames, illumination, merge_groups,
 };
+use campanile_process::report::{Report, Section};
 use campanile_process::sky::{ChannelSky, SkyFile};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -35,6 +37,7 @@ pub use session_frames::SessionInputs;
 ///   radiance/<group>.exr           HDR views (RGB, variance, mask)
 ///   light/<occurrence>.ron         sun irradiance and sky per channel
 ///   summary.json                   every figure and diagnostic, with stage times
+///   report.html                    the same as a page with plots (self-contained)
 ///
 /// Example:
 ///   campanile process campanile-day-session --scene examples/campanile-scene.ron
@@ -122,6 +125,16 @@ pub fn run(args: ProcessArgs) -> Result<()> {
         (args.env_rows, args.env_cols),
     )?;
     write_outputs(&processed, &out)?;
+    let report = Report {
+        title: format!("Campanile: {}", args.session.display()),
+        intro: vec![format!(
+            "Session {}, processed by campanile {}.",
+            args.session.display(),
+            env!("CARGO_PKG_VERSION")
+        )],
+        sections: stage_sections(&processed, None)?,
+    };
+    write_report(&report, &out.join("report.html"))?;
     println!("processed {} → {}", args.session.display(), out.display());
     for (stage, s) in &processed.summary.stage_seconds {
         println!("  {stage:<28} {s:>7.2} s");
@@ -231,6 +244,24 @@ pub fn process_session(
         light,
         summary,
     })
+}
+
+/// The report sections of stages 1 and 2 (with the simulator's truth beside the figures, if given).
+pub fn stage_sections(p: &Processed, truth: Option<&report_sections::Truth>) -> Result<Vec<Section>> {
+    Ok(vec![
+        report_sections::response(p, truth)?,
+        report_sections::sun(p, truth)?,
+        report_sections::sky(p, truth)?,
+        report_sections::environment(p)?,
+        report_sections::speed(p),
+    ])
+}
+
+/// Writes a report page (through a temporary file).
+pub fn write_report(report: &Report, path: &Path) -> Result<()> {
+    let tmp = path.with_extension("html.partial");
+    std::fs::write(&tmp, report.to_html()).with_context(|| format!("{}: cannot write", tmp.display()))?;
+    std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot write", path.display()))
 }
 
 /// The sky fits of an occurrence as a sky file.

@@ -1,0 +1,136 @@
+//! `campanile demo`: the whole station on the simulated hardware, in one
+//! command: capture a day at the campanile, process it, write a report.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use campanile_process::report::Report;
+use campanile_sim::world::{World, examples_dir, load_scene};
+use clap::{Args, Parser};
+
+use super::capture::CaptureArgs;
+use super::process::{self, report_sections::Truth};
+
+/// Run the whole station on simulated hardware and write a report.
+///
+/// With no hardware and no arguments, it:
+///   1. builds the simulated station (examples/sim-station.ron);
+///   2. captures a simulated day at the campanile (examples/campanile-day.ron:
+///      four training times and one held-out time; --quick: two and one);
+///   3. processes it (response, HDR, sun, sky, environment);
+///   4. writes OUT/report.html, with every figure beside the simulator's truth.
+///
+/// The session directories and every product stay in OUT.
+///
+/// Example:
+///   cargo run --release -- demo --out campanile-demo
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub struct DemoArgs {
+    /// Where to write the sessions, the products and report.html.
+    #[arg(long, value_name = "DIR", default_value = "campanile-demo")]
+    out: PathBuf,
+    /// A smaller, faster run (two training times, fewer views): what the tests use.
+    #[arg(long)]
+    quick: bool,
+}
+
+/// Parses a `capture` command line, as the user would type it.
+#[derive(Debug, Parser)]
+struct CaptureLine {
+    #[command(flatten)]
+    args: CaptureArgs,
+}
+
+pub fn run(args: DemoArgs) -> Result<()> {
+    let wall = Instant::now();
+    let examples = examples_dir();
+    if !examples.join("sim-station.ron").is_file() {
+        bail!(
+            "the example files are not at {}: run the demo from a clone of the repository",
+            examples.display()
+        );
+    }
+    std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create", args.out.display()))?;
+    let station = examples.join("sim-station.ron");
+    let plan = examples.join(if args.quick {
+        "campanile-quick.ron"
+    } else {
+        "campanile-day.ron"
+    });
+    let scene = examples.join("campanile-scene.ron");
+
+    // 1–2. Capture.
+    let session = args.out.join("campanile-session");
+    if session.exists() {
+        std::fs::remove_dir_all(&session).with_context(|| format!("{}: cannot clear", session.display()))?;
+    }
+    eprintln!("capturing {} on the simulated station …", plan.display());
+    let line = CaptureLine::try_parse_from([
+        "capture".as_ref(),
+        plan.as_os_str(),
+        "--station".as_ref(),
+        station.as_os_str(),
+        "--out".as_ref(),
+        session.as_os_str(),
+    ])?;
+    let t = Instant::now();
+    if super::capture::run(line.args) != super::EXIT_OK {
+        bail!("the simulated capture did not complete (see above)");
+    }
+    let capture_s = t.elapsed().as_secs_f64();
+
+    // 3. Process.
+    eprintln!("processing {} …", session.display());
+    let processed = process::process_session(
+        &session,
+        Some(&scene),
+        &campanile_process::hdr::debevec::DebevecOptions::default(),
+        (18, 36),
+    )?;
+    let products = args.out.join("campanile-processed");
+    process::write_outputs(&processed, &products)?;
+
+    // 4. Report.
+    let station_cfg = campanile_config::load_station(&station)
+        .map_err(|e| anyhow::anyhow!("{e}"))?
+        .value;
+    let world = World::new(&station_cfg, load_scene(&scene).context("loading the campanile scene")?);
+    let truth = Truth {
+        camera: campanile_sim::camera::CameraOptions::default().model,
+        world: &world,
+    };
+    let mut sections = process::stage_sections(&processed, Some(&truth))?;
+    if let Some(speed) = sections.last_mut() {
+        speed.tables[0].rows.insert(
+            0,
+            vec!["simulated capture (the whole plan)".into(), format!("{capture_s:.2}")],
+        );
+    }
+    let report = Report {
+        title: "Campanile demo: a simulated day at the bell tower".into(),
+        intro: vec![
+            format!(
+                "The plan {} was captured on the simulated station {} and processed; every figure stands beside the simulator's truth.",
+                plan.file_name().and_then(|n| n.to_str()).unwrap_or_default(),
+                station.file_name().and_then(|n| n.to_str()).unwrap_or_default()
+            ),
+            format!("Sessions and products are in {}.", display(&args.out)),
+        ],
+        sections,
+    };
+    let path = args.out.join("report.html");
+    process::write_report(&report, &path)?;
+    println!(
+        "demo finished in {:.1} s: {} ({} figures)",
+        wall.elapsed().as_secs_f64(),
+        path.display(),
+        report.figure_count()
+    );
+    Ok(())
+}
+
+fn display(p: &Path) -> String {
+    p.display().to_string()
+}
