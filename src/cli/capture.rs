@@ -2,14 +2,17 @@
 //! or resume one after a crash.
 
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
 use campanile_capture::controller::{self, Progress, RunOptions, ShotOutcome};
 use campanile_capture::schedule::{Occurrence, PlannedShot, SceneGeometry, Timeline, TimelineOptions, timeline};
-use campanile_capture::store::{JournalEntry, Provenance, SessionStore, Snapshot};
+use campanile_capture::store::{
+    JournalEntry, PLAN_FILE, Provenance, SCENE_FILE, STATION_FILE, SessionStore, Snapshot, SourcePaths,
+};
+use campanile_config::document::{Document, load_text};
 use campanile_config::{Station, check_plan_on_station, load_plan, load_station};
 use campanile_sim::faults::{FaultPlan, LinkFaults};
 use campanile_sim::station::{SimOptions, SimStation};
@@ -38,16 +41,18 @@ use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
 ///
 /// Examples:
 ///   campanile capture examples/campanile-day.ron --station examples/sim-station.ron --out day
-///   campanile capture examples/campanile-day.ron --station examples/sim-station.ron --resume day
+///   campanile capture --resume day
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct CaptureArgs {
     /// The plan (RON); its scene is read from the plan's `scene` field.
-    #[arg(value_name = "PLAN")]
-    plan: PathBuf,
-    /// The station (RON) that runs it.
-    #[arg(long, value_name = "STATION")]
-    station: PathBuf,
+    /// Optional with --resume: the session's own plan.ron is used.
+    #[arg(value_name = "PLAN", required_unless_present = "resume")]
+    plan: Option<PathBuf>,
+    /// The station (RON) that runs it. Optional with --resume: the
+    /// session's own station.ron is used.
+    #[arg(long, value_name = "STATION", required_unless_present = "resume")]
+    station: Option<PathBuf>,
     /// A new session directory (must not exist or be empty).
     #[arg(
         long,
@@ -57,7 +62,9 @@ pub struct CaptureArgs {
     )]
     out: Option<PathBuf>,
     /// Resume the session in DIR after a crash or a stop: complete shots are
-    /// kept, the rest are taken. PLAN and STATION must be the ones it began with.
+    /// kept, the rest are taken. Without PLAN and STATION the session's
+    /// snapshots (DIR/plan.ron, station.ron, scene.ron) are used; given
+    /// ones must be the ones it began with.
     #[arg(long, value_name = "DIR")]
     resume: Option<PathBuf>,
     /// Run only the first N days of the plan.
@@ -89,8 +96,7 @@ pub fn run(args: CaptureArgs) -> u8 {
         eprintln!(
             "error: station {:?} ({}) uses real devices, and real drivers are not yet wired for `campanile capture`; \
              use a simulated station (a `Sim` camera and `sim:` ports), e.g. examples/sim-station.ron",
-            inputs.station.name,
-            args.station.display()
+            inputs.station.name, inputs.station_label
         );
         return EXIT_USAGE;
     }
@@ -110,31 +116,30 @@ struct Inputs {
     station: Station,
     timeline: Timeline,
     snapshot: Snapshot,
+    /// How to name the plan and station in messages.
+    plan_label: String,
+    station_label: String,
+    /// Whether they were read from a session's snapshot.
+    from_session: bool,
 }
 
 impl Inputs {
     fn load(args: &CaptureArgs) -> Result<Self> {
-        let plan = load_plan(&args.plan).map_err(|e| anyhow::anyhow!("{e}"))?;
-        let loaded = load_station(&args.station).map_err(|e| anyhow::anyhow!("{e}"))?;
-        let station = loaded.value.clone();
-        check_plan_on_station(&plan, &station).map_err(|e| {
-            anyhow::anyhow!(
-                "{e}\nthe plan does not run on station {:?} ({})",
-                station.name,
-                args.station.display()
-            )
-        })?;
-        let scene = match &plan.scene {
-            Some(s) => Some(SceneGeometry::load(&s.value, &s.source.base_dir()).context("reading the plan's scene")?),
-            None => None,
-        };
-        let t = timeline(
-            &plan.plan.value,
-            &station,
-            scene.as_ref(),
-            &TimelineOptions { days: args.days },
-        )
-        .with_context(|| format!("{}: cannot simulate the plan", args.plan.display()))?;
+        match (&args.resume, &args.plan, &args.station) {
+            (Some(dir), None, None) => Self::from_session(dir, args.days),
+            (_, Some(plan), Some(station)) => Self::from_files(plan, station, args.days),
+            (Some(_), _, _) => bail!(
+                "give both PLAN and --station STATION, or neither (to resume with the session's own plan.ron and station.ron)"
+            ),
+            (None, _, _) => bail!("give PLAN and --station STATION"),
+        }
+    }
+
+    /// Read PLAN and STATION (and the plan's scene) from their files.
+    fn from_files(plan_path: &Path, station_path: &Path, days: Option<u32>) -> Result<Self> {
+        let plan = load_plan(plan_path).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let loaded = load_station(station_path).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
         let snapshot = Snapshot {
             plan_ron: plan.plan.source.text.clone(),
             station_ron: loaded.source.text.clone(),
@@ -143,13 +148,109 @@ impl Inputs {
                 campanile_version: env!("CARGO_PKG_VERSION").to_owned(),
                 created_utc: chrono::Utc::now(),
                 calibration: Vec::new(),
+                sources: Some(SourcePaths {
+                    plan: absolute(plan_path),
+                    station: absolute(station_path),
+                    scene: plan.scene.as_ref().map(|s| absolute(&s.source.path)),
+                }),
             },
         };
+        Self::new(
+            plan,
+            loaded.value,
+            snapshot,
+            plan_path.display().to_string(),
+            station_path.display().to_string(),
+            false,
+            days,
+        )
+    }
+
+    /// Read the plan, station and scene from the snapshot of the session
+    /// in `dir`. Their relative paths (the scene's OBJ geometry) resolve
+    /// against the files the session was created from; the scene file
+    /// there must still be the one snapshotted.
+    fn from_session(dir: &Path, days: Option<u32>) -> Result<Self> {
+        let snapshot = Snapshot::read_dir(dir)
+            .with_context(|| format!("reading the snapshot of the session in {}", dir.display()))?;
+        let sources = snapshot.provenance.sources.clone();
+        let plan_path = sources.as_ref().map_or_else(|| dir.join(PLAN_FILE), |s| s.plan.clone());
+        let station_path = sources
+            .as_ref()
+            .map_or_else(|| dir.join(STATION_FILE), |s| s.station.clone());
+        let plan = match load_text(&plan_path, snapshot.plan_ron.clone()) {
+            Ok(Document::Plan(p)) => *p,
+            Ok(_) => bail!(
+                "{}: the session's plan snapshot is not a `Plan(...)`",
+                dir.join(PLAN_FILE).display()
+            ),
+            Err(e) => bail!(
+                "{e}\nthe session's plan snapshot ({}) does not load as if at {}; give PLAN and --station again",
+                dir.join(PLAN_FILE).display(),
+                plan_path.display()
+            ),
+        };
+        if let (Some(scene), Some(snap)) = (&plan.scene, &snapshot.scene_ron)
+            && &scene.source.text != snap
+        {
+            bail!(
+                "the scene file {} has changed since the session in {} began (its snapshot is {}); restore it to resume",
+                scene.source.path.display(),
+                dir.display(),
+                dir.join(SCENE_FILE).display()
+            );
+        }
+        let station = match load_text(&station_path, snapshot.station_ron.clone()) {
+            Ok(Document::Station(s)) => s.value,
+            Ok(_) => bail!(
+                "{}: the session's station snapshot is not a `Station(...)`",
+                dir.join(STATION_FILE).display()
+            ),
+            Err(e) => bail!(
+                "{e}\nthe session's station snapshot ({}) does not load",
+                dir.join(STATION_FILE).display()
+            ),
+        };
+        Self::new(
+            plan,
+            station,
+            snapshot,
+            dir.join(PLAN_FILE).display().to_string(),
+            dir.join(STATION_FILE).display().to_string(),
+            true,
+            days,
+        )
+    }
+
+    fn new(
+        plan: campanile_config::document::LoadedPlan,
+        station: Station,
+        snapshot: Snapshot,
+        plan_label: String,
+        station_label: String,
+        from_session: bool,
+        days: Option<u32>,
+    ) -> Result<Self> {
+        check_plan_on_station(&plan, &station).map_err(|e| {
+            anyhow::anyhow!(
+                "{e}\nthe plan does not run on station {:?} ({station_label})",
+                station.name
+            )
+        })?;
+        let scene = match &plan.scene {
+            Some(s) => Some(SceneGeometry::load(&s.value, &s.source.base_dir()).context("reading the plan's scene")?),
+            None => None,
+        };
+        let t = timeline(&plan.plan.value, &station, scene.as_ref(), &TimelineOptions { days })
+            .with_context(|| format!("{plan_label}: cannot simulate the plan"))?;
         Ok(Self {
             plan,
             station,
             timeline: t,
             snapshot,
+            plan_label,
+            station_label,
+            from_session,
         })
     }
 }
@@ -216,15 +317,21 @@ fn capture(args: &CaptureArgs, inputs: &Inputs) -> Result<bool> {
                 || store.snapshot().station_ron != inputs.snapshot.station_ron
             {
                 bail!(
-                    "{} began with another plan or station than {} and {}; give the ones it began with (its plan.ron and station.ron)",
+                    "{} began with another plan or station than {} and {}; resume with `campanile capture --resume {}` alone to use its own plan.ron and station.ron",
                     dir.display(),
-                    args.plan.display(),
-                    args.station.display()
+                    inputs.plan_label,
+                    inputs.station_label,
+                    dir.display()
                 );
             }
             eprintln!(
-                "resuming {}: {} frames and {} missed shots journaled{}",
+                "resuming {}{}: {} frames and {} missed shots journaled{}",
                 dir.display(),
+                if inputs.from_session {
+                    " with its own plan.ron and station.ron"
+                } else {
+                    ""
+                },
                 report.frames,
                 report.missed,
                 if report.is_clean() {
@@ -356,12 +463,7 @@ fn capture(args: &CaptureArgs, inputs: &Inputs) -> Result<bool> {
     println!("  wall time            {}", seconds(elapsed));
     if let Some(e) = stopped {
         eprintln!("error: {e:#}");
-        eprintln!(
-            "resume with: campanile capture {} --station {} --resume {}",
-            args.plan.display(),
-            args.station.display(),
-            store.dir().display()
-        );
+        eprintln!("resume with: campanile capture --resume {}", store.dir().display());
         return Ok(false);
     }
     Ok(stored == promised && missed == 0)

@@ -10,7 +10,12 @@
 //! | [`flir_ptu::FlirHead`] | FLIR PTU ASCII | `PanTilt` |
 //! | [`fw102c::Fw102cWheel`] | Thorlabs FW102C | `FilterWheel` |
 //! | [`enttec::DmxLights`] | Enttec DMX USB Pro | `Lights` |
+//!
+//! A link that drops is reopened by [`backoff::reopen`] (exponential
+//! backoff, capped, logged); [`crate::station`] does so for every serial
+//! device of a real station.
 
+pub mod backoff;
 pub mod enttec;
 pub mod flir_ptu;
 pub mod fw102c;
