@@ -47,7 +47,7 @@ use thiserror::Error;
 pub enum StationError {
     /// A device's port is a simulator port.
     #[error(
-        "the {device} is on port {port:?}, a simulated port; a real station needs device paths such as /dev/ttyUSB0 (`campanile devices` lists them)"
+        "port {port:?} of the {device} is a simulated port; a real station needs device paths such as /dev/ttyUSB0 (`campanile devices` lists them)"
     )]
     SimulatedPort {
         /// Which device.
@@ -288,6 +288,11 @@ impl<O: PortOpener, C: Camera> StationRig<O, C> {
         self.options
             .link_seq
             .wrapping_add(self.connections.wrapping_sub(1).wrapping_mul(4096))
+    }
+
+    /// The port opener (a test bench's ground truth).
+    pub fn opener(&self) -> &O {
+        &self.opener
     }
 
     /// How many connections were made, reconnections included.
