@@ -16,11 +16,14 @@
 //! device of a real station.
 
 pub mod backoff;
+pub mod camera_thread;
 pub mod enttec;
+pub mod exposure_control;
 pub mod flir_ptu;
 pub mod fw102c;
 pub mod link;
 pub mod pelco_d;
+pub mod pixel_format;
 
 use std::time::Duration;
 
