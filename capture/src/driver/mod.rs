@@ -22,8 +22,12 @@ pub mod exposure_control;
 pub mod flir_ptu;
 pub mod fw102c;
 pub mod link;
+#[cfg(feature = "nokhwa")]
+pub mod nokhwa_camera;
 pub mod pelco_d;
 pub mod pixel_format;
+#[cfg(feature = "v4l")]
+pub mod v4l2;
 
 use std::time::Duration;
 

@@ -78,6 +78,15 @@ impl PixelFormat {
     }
 }
 
+/// The preferred format among those a camera offers (by fourcc), if any
+/// is supported: raw before YUV, deeper first.
+pub fn choose(offered: &[[u8; 4]]) -> Option<PixelFormat> {
+    offered
+        .iter()
+        .filter_map(|f| PixelFormat::from_fourcc(*f))
+        .min_by_key(|f| f.preference())
+}
+
 /// How Y′CbCr codes span their range.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum YuvRange {
@@ -366,5 +375,10 @@ mod tests {
         assert_eq!(PixelFormat::from_fourcc(*b"YUYV"), Some(PixelFormat::Yuyv));
         assert_eq!(PixelFormat::from_fourcc(*b"MJPG"), None);
         assert_eq!(PixelFormat::Y16.fourcc(), *b"Y16 ");
+        // A webcam offering MJPEG and YUYV gets YUYV; a machine-vision
+        // camera offering GREY and Y16 gets Y16; MJPEG alone, nothing.
+        assert_eq!(choose(&[*b"MJPG", *b"YUYV"]), Some(PixelFormat::Yuyv));
+        assert_eq!(choose(&[*b"GREY", *b"Y16 ", *b"YUYV"]), Some(PixelFormat::Y16));
+        assert_eq!(choose(&[*b"MJPG"]), None);
     }
 }
