@@ -7,14 +7,19 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
-use campanile_capture::controller::{self, Progress, RunOptions, ShotOutcome};
+use campanile_capture::clock::SystemClock;
+use campanile_capture::controller::{self, Progress, RunError, RunOptions, RunReport, ShotOutcome};
 use campanile_capture::schedule::{Occurrence, PlannedShot, SceneGeometry, Timeline, TimelineOptions, timeline};
+use campanile_capture::station::{SerialOpener, StationOptions, StationRig, check_ports, open_camera};
+use campanile_capture::store::fault::QuotaStorage;
+use campanile_capture::store::{FsStorage, Storage};
 use campanile_capture::store::{
     JournalEntry, PLAN_FILE, Provenance, SCENE_FILE, STATION_FILE, SessionStore, Snapshot, SourcePaths,
 };
 use campanile_config::document::{Document, load_text};
 use campanile_config::{Station, check_plan_on_station, load_plan, load_station};
-use campanile_sim::faults::{FaultPlan, LinkFaults};
+use campanile_sim::camera::CameraOptions;
+use campanile_sim::faults::{CameraFaultPlan, Device, FaultPlan, LinkFaults, Outage};
 use campanile_sim::station::{SimOptions, SimStation};
 use campanile_sim::world::{World, load_scene};
 use chrono::TimeDelta;
@@ -32,8 +37,11 @@ use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
 /// late) are journaled as missed with the reason.
 ///
 /// Simulated stations (a `Sim` camera or `sim:` ports) photograph the plan's
-/// scene under simulated time: the day passes as fast as the frames render.
-/// Real drivers are not yet wired for capture.
+/// scene under simulated time: the day passes as fast as the frames render;
+/// the --sim-* flags inject faults. Real stations run on the wall clock:
+/// the camera through its driver (V4L2 or nokhwa, cargo features `v4l` and
+/// `nokhwa`), the head, filter wheel and lights on their serial ports, each
+/// reopened with exponential backoff when its link drops.
 ///
 /// Exit status: 0 when every promised frame is stored; 1 when a shot was
 /// missed or the session stopped (e.g. the disk is full; resume it with
@@ -82,6 +90,66 @@ pub struct CaptureArgs {
     /// Simulation: chance that a byte is corrupted on every serial link (0–0.5).
     #[arg(long, value_name = "P")]
     sim_corrupt_chance: Option<f64>,
+    /// Simulation: chance that any one frame never arrives (the camera times out), 0–1.
+    #[arg(long, value_name = "P", value_parser = chance)]
+    sim_camera_timeout_chance: Option<f64>,
+    /// Simulation: chance that any one frame fails with a camera error, 0–1.
+    #[arg(long, value_name = "P", value_parser = chance)]
+    sim_camera_error_chance: Option<f64>,
+    /// Simulation: DEVICE (head, wheel or lights) disconnects AFTER seconds
+    /// into the run for DURATION seconds, e.g. head:600:20. Repeatable.
+    #[arg(long, value_name = "DEVICE:AFTER:DURATION")]
+    sim_outage: Vec<OutageArg>,
+    /// Simulation: the session directory may hold at most BYTES (what it
+    /// already holds counts), as if the disk filled up there.
+    #[arg(long, value_name = "BYTES")]
+    sim_disk_quota: Option<u64>,
+}
+
+/// A chance in [0, 1].
+fn chance(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(p) if (0.0..=1.0).contains(&p) => Ok(p),
+        _ => Err(format!("found {s:?}; expected a chance between 0 and 1")),
+    }
+}
+
+/// `--sim-outage DEVICE:AFTER:DURATION`.
+#[derive(Debug, Clone, Copy)]
+struct OutageArg(Outage);
+
+impl std::str::FromStr for OutageArg {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad = || {
+            format!(
+                "found {s:?}; expected DEVICE:AFTER_S:DURATION_S with DEVICE head, wheel or lights, e.g. head:600:20"
+            )
+        };
+        let mut parts = s.split(':');
+        let (Some(d), Some(a), Some(l), None) = (parts.next(), parts.next(), parts.next(), parts.next()) else {
+            return Err(bad());
+        };
+        let device = match d {
+            "head" => Device::Head,
+            "wheel" => Device::Wheel,
+            "lights" => Device::Lights,
+            _ => return Err(bad()),
+        };
+        let secs = |v: &str| {
+            v.parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite() && *x >= 0.0 && *x < 1e9)
+                .map(Duration::from_secs_f64)
+                .ok_or_else(bad)
+        };
+        Ok(Self(Outage {
+            device,
+            after: secs(a)?,
+            duration: secs(l)?,
+        }))
+    }
 }
 
 pub fn run(args: CaptureArgs) -> u8 {
@@ -92,10 +160,15 @@ pub fn run(args: CaptureArgs) -> u8 {
             return EXIT_USAGE;
         }
     };
-    if !inputs.station.uses_simulation() {
+    let sim_flags = args.sim_drop_chance.is_some()
+        || args.sim_corrupt_chance.is_some()
+        || args.sim_camera_timeout_chance.is_some()
+        || args.sim_camera_error_chance.is_some()
+        || !args.sim_outage.is_empty()
+        || args.sim_disk_quota.is_some();
+    if !inputs.station.uses_simulation() && sim_flags {
         eprintln!(
-            "error: station {:?} ({}) uses real devices, and real drivers are not yet wired for `campanile capture`; \
-             use a simulated station (a `Sim` camera and `sim:` ports), e.g. examples/sim-station.ron",
+            "error: the --sim-* fault flags are for simulated stations; station {:?} ({}) has real devices",
             inputs.station.name, inputs.station_label
         );
         return EXIT_USAGE;
@@ -304,15 +377,41 @@ impl Progress for Bars {
 }
 
 fn capture(args: &CaptureArgs, inputs: &Inputs) -> Result<bool> {
+    let dir = args
+        .out
+        .as_ref()
+        .or(args.resume.as_ref())
+        .context("give --out DIR or --resume DIR")?;
+    match args.sim_disk_quota {
+        Some(quota) => {
+            if inputs.station.uses_simulation() {
+                // The quota counts what is already in the directory.
+                if args.out.is_some() {
+                    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+                }
+                let storage = QuotaStorage::open(FsStorage, dir, quota)
+                    .with_context(|| format!("measuring {} for the disk quota", dir.display()))?;
+                capture_into(args, inputs, storage)
+            } else {
+                bail!("--sim-disk-quota is for simulated stations")
+            }
+        }
+        None => capture_into(args, inputs, FsStorage),
+    }
+}
+
+/// Open the session (new or resumed) on `storage`, run the timeline on
+/// the station's devices, and report.
+fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> Result<bool> {
     let (mut store, resumed) = match (&args.out, &args.resume) {
         (Some(dir), _) => (
-            SessionStore::create(dir, inputs.snapshot.clone())
+            SessionStore::create_with(storage, dir, inputs.snapshot.clone())
                 .with_context(|| format!("creating the session in {}", dir.display()))?,
             false,
         ),
         (None, Some(dir)) => {
-            let (store, report) =
-                SessionStore::resume(dir).with_context(|| format!("resuming the session in {}", dir.display()))?;
+            let (store, report) = SessionStore::resume_with(storage, dir)
+                .with_context(|| format!("resuming the session in {}", dir.display()))?;
             if store.snapshot().plan_ron != inputs.snapshot.plan_ron
                 || store.snapshot().station_ron != inputs.snapshot.station_ron
             {
@@ -345,78 +444,18 @@ fn capture(args: &CaptureArgs, inputs: &Inputs) -> Result<bool> {
         }
         (None, None) => bail!("give --out DIR or --resume DIR"),
     };
-    let Some(first) = inputs.timeline.occurrences.first() else {
+    if inputs.timeline.occurrences.is_empty() {
         println!("the plan has no occurrences: nothing to capture");
         return Ok(true);
-    };
-    // The simulated calendar begins a minute before the first occurrence,
-    // or, on resume, a second after the last journaled shot.
-    let last = store.entries().iter().map(|e| match e {
-        JournalEntry::Done(f) | JournalEntry::Late(f) => f.meta.time,
-        JournalEntry::Missed(m) => m.time,
-    });
-    let origin = match (resumed, last.max()) {
-        (true, Some(t)) => t + TimeDelta::seconds(1),
-        _ => first.start - TimeDelta::seconds(60),
-    };
-    let scene_path = inputs
-        .plan
-        .scene
-        .as_ref()
-        .map(|s| s.source.path.clone())
-        .context("a simulated capture needs the plan's scene to photograph (the plan has no `scene`)")?;
-    let mut world = World::new(
-        &inputs.station,
-        load_scene(&scene_path).with_context(|| format!("loading {}", scene_path.display()))?,
-    );
-    world.quality.samples_per_pixel = args.sim_samples.max(1);
-    world.quality.max_bounces = args.sim_bounces;
-    let home = inputs
-        .plan
-        .scene
-        .as_ref()
-        .and_then(|s| s.value.poses.first())
-        .map_or([0.0; 3], |p| [p.position_m.0, p.position_m.1, p.position_m.2]);
-    let faults = FaultPlan {
-        link: (args.sim_drop_chance.is_some() || args.sim_corrupt_chance.is_some()).then(|| LinkFaults {
-            drop_chance: args.sim_drop_chance.unwrap_or(0.0),
-            corrupt_chance: args.sim_corrupt_chance.unwrap_or(0.0),
-        }),
-        ..FaultPlan::default()
-    };
-    let options = SimOptions {
-        origin,
-        position_m: home,
-        faults,
-        ..SimOptions::default()
-    };
+    }
     let promised = inputs.timeline.frames_promised();
     let mut bars = Bars::new(promised);
     let wall = Instant::now();
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_time()
-        .start_paused(true)
-        .build()
-        .context("starting the runtime")?;
-    let result = runtime.block_on(async {
-        let mut sim = SimStation::start(&inputs.station, Arc::new(world), options)
-            .await
-            .context("starting the simulated station")?;
-        let clock = sim.clock();
-        anyhow::Ok(
-            controller::run(
-                &inputs.timeline,
-                &inputs.plan.plan.value,
-                &inputs.station,
-                &mut store,
-                &mut sim,
-                &clock,
-                &RunOptions::default(),
-                &mut bars,
-            )
-            .await,
-        )
-    })?;
+    let result = if inputs.station.uses_simulation() {
+        run_simulated(args, inputs, &mut store, resumed, &mut bars)?
+    } else {
+        run_real(inputs, &mut store, &mut bars)?
+    };
     bars.session.finish_and_clear();
     bars.step.finish_and_clear();
     let elapsed = wall.elapsed();
@@ -467,6 +506,131 @@ fn capture(args: &CaptureArgs, inputs: &Inputs) -> Result<bool> {
         return Ok(false);
     }
     Ok(stored == promised && missed == 0)
+}
+
+type RunResult = std::result::Result<RunReport, RunError>;
+
+/// The simulated station under paused time: the day passes as fast as the
+/// frames render.
+fn run_simulated<S: Storage>(
+    args: &CaptureArgs,
+    inputs: &Inputs,
+    store: &mut SessionStore<S>,
+    resumed: bool,
+    bars: &mut Bars,
+) -> Result<RunResult> {
+    let first = &inputs.timeline.occurrences[0];
+    // The simulated calendar begins a minute before the first occurrence,
+    // or, on resume, a second after the last journaled shot.
+    let last = store.entries().iter().map(|e| match e {
+        JournalEntry::Done(f) | JournalEntry::Late(f) => f.meta.time,
+        JournalEntry::Missed(m) => m.time,
+    });
+    let origin = match (resumed, last.max()) {
+        (true, Some(t)) => t + TimeDelta::seconds(1),
+        _ => first.start - TimeDelta::seconds(60),
+    };
+    let scene_path = inputs
+        .plan
+        .scene
+        .as_ref()
+        .map(|s| s.source.path.clone())
+        .context("a simulated capture needs the plan's scene to photograph (the plan has no `scene`)")?;
+    let mut world = World::new(
+        &inputs.station,
+        load_scene(&scene_path).with_context(|| format!("loading {}", scene_path.display()))?,
+    );
+    world.quality.samples_per_pixel = args.sim_samples.max(1);
+    world.quality.max_bounces = args.sim_bounces;
+    let home = inputs
+        .plan
+        .scene
+        .as_ref()
+        .and_then(|s| s.value.poses.first())
+        .map_or([0.0; 3], |p| [p.position_m.0, p.position_m.1, p.position_m.2]);
+    let seed = inputs.station.simulation.as_ref().map_or(0, |s| s.seed);
+    let faults = FaultPlan {
+        link: (args.sim_drop_chance.is_some() || args.sim_corrupt_chance.is_some()).then(|| LinkFaults {
+            drop_chance: args.sim_drop_chance.unwrap_or(0.0),
+            corrupt_chance: args.sim_corrupt_chance.unwrap_or(0.0),
+        }),
+        outages: args.sim_outage.iter().map(|o| o.0).collect(),
+        ..FaultPlan::default()
+    };
+    let camera = CameraOptions {
+        faults: CameraFaultPlan {
+            seed,
+            timeout_chance: args.sim_camera_timeout_chance.unwrap_or(0.0),
+            error_chance: args.sim_camera_error_chance.unwrap_or(0.0),
+            ..CameraFaultPlan::none()
+        },
+        ..CameraOptions::default()
+    };
+    let options = SimOptions {
+        origin,
+        position_m: home,
+        faults,
+        camera,
+        ..SimOptions::default()
+    };
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_time()
+        .start_paused(true)
+        .build()
+        .context("starting the runtime")?;
+    runtime.block_on(async {
+        let mut sim = SimStation::start(&inputs.station, Arc::new(world), options)
+            .await
+            .context("starting the simulated station")?;
+        let clock = sim.clock();
+        Ok(controller::run(
+            &inputs.timeline,
+            &inputs.plan.plan.value,
+            &inputs.station,
+            store,
+            &mut sim,
+            &clock,
+            &RunOptions::default(),
+            bars,
+        )
+        .await)
+    })
+}
+
+/// The station's real devices on the wall clock: the camera its driver
+/// names, the serial devices on their ports, reopened with backoff when a
+/// link drops.
+fn run_real<S: Storage>(inputs: &Inputs, store: &mut SessionStore<S>, bars: &mut Bars) -> Result<RunResult> {
+    check_ports(&inputs.station).with_context(|| format!("station {}", inputs.station_label))?;
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .context("starting the runtime")?;
+    runtime.block_on(async {
+        let camera = open_camera(&inputs.station.camera)
+            .with_context(|| format!("opening the camera of station {}", inputs.station_label))?;
+        // Sequence numbers from the clock, so that a restarted program does
+        // not reuse numbers a campanile-link device still remembers.
+        let link_seq = (chrono::Utc::now().timestamp_subsec_micros() % 4096) as u16 + 1;
+        let options = StationOptions {
+            link_seq,
+            ..StationOptions::default()
+        };
+        let mut rig = StationRig::connect(&inputs.station, SerialOpener, camera, options)
+            .await
+            .with_context(|| format!("connecting the devices of station {}", inputs.station_label))?;
+        Ok(controller::run(
+            &inputs.timeline,
+            &inputs.plan.plan.value,
+            &inputs.station,
+            store,
+            &mut rig,
+            &SystemClock,
+            &RunOptions::default(),
+            bars,
+        )
+        .await)
+    })
 }
 
 fn seconds(d: Duration) -> String {

@@ -19,9 +19,11 @@
 //! Each device needs its own port: a campanile-link controller serving
 //! head, wheel and lights on one line is refused ([`StationError::SharedPort`]).
 
+pub mod camera;
 pub mod devices;
 pub mod port;
 
+pub use camera::open_camera;
 pub use devices::{AnyHead, AnyLights, AnyWheel};
 pub use port::{PortOpener, SerialOpener};
 
