@@ -2,6 +2,7 @@
 
 mod capture;
 mod config_check;
+mod devices;
 mod env;
 mod hdr;
 mod logging;
@@ -68,8 +69,10 @@ pub enum Command {
         #[command(subcommand)]
         action: sky::SkyCommand,
     },
-    /// Run a plan on a station into a session directory, or resume one (simulated stations for now).
+    /// Run a plan on a station into a session directory, or resume one.
     Capture(capture::CaptureArgs),
+    /// List serial ports and cameras, or test a station's devices (`devices test --station FILE`).
+    Devices(devices::DevicesArgs),
     /// Plans: simulate one forward without devices (timeline, frames, durations, what it will not cover).
     Plan {
         #[command(subcommand)]
@@ -110,6 +113,7 @@ pub fn run() -> ExitCode {
         Command::Env { action } => report(env::run(action)),
         Command::Plan { action } => plan::run(action),
         Command::Capture(args) => capture::run(args),
+        Command::Devices(args) => devices::run(args),
     };
     ExitCode::from(code)
 }
