@@ -81,11 +81,6 @@ fn devices_test_runs_the_suites_over_pseudo_terminals() {
     ]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     println!("{stdout}");
-    assert!(
-        out.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     assert!(stdout.contains(&format!("head (PelcoD on {head_path}):")), "{stdout}");
     assert!(
         stdout.contains(&format!("filter wheel (Fw102c on {wheel_path}):")),
@@ -95,13 +90,22 @@ fn devices_test_runs_the_suites_over_pseudo_terminals() {
         stdout.contains(&format!("lights (DmxEnttec on {lights_path}):")),
         "{stdout}"
     );
-    // 6 head, 2 wheel, 2 lights checks, all passing; the camera is tested
-    // only when its driver is built.
-    let passes = stdout.lines().filter(|l| l.trim_start().starts_with("pass")).count();
-    if cfg!(feature = "v4l") {
-        assert!(passes >= 10, "{stdout}");
-    } else {
-        assert_eq!(passes, 10, "{stdout}");
+    // 6 head, 2 wheel and 2 lights checks, all passing.
+    let serial_part = stdout.split("camera (").next().unwrap_or_default();
+    assert!(!serial_part.contains("FAIL"), "{stdout}");
+    let passes = serial_part
+        .lines()
+        .filter(|l| l.trim_start().starts_with("pass"))
+        .count();
+    assert_eq!(passes, 10, "{stdout}");
+    // The camera is tested only when its driver is built (and then needs
+    // a camera, which a build machine may not have).
+    if !cfg!(feature = "v4l") {
+        assert!(
+            out.status.success(),
+            "{stdout}\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         assert!(stdout.contains("10 checks, 0 failed"), "{stdout}");
         assert!(stdout.contains("skipped: camera failure: this campanile was built without the V4L2 camera driver"));
     }
@@ -120,10 +124,12 @@ fn devices_test_runs_the_suites_over_pseudo_terminals() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert_eq!(out.status.code(), Some(1), "{stdout}");
     assert!(
-        stdout.contains("FAIL  connect: I/O error on the device link: opening serial port /dev/campanile-no-such-port"),
+        stdout.contains("filter wheel (Fw102c on /dev/campanile-no-such-port):\n  FAIL  connect: I/O error on the device link: opening serial port /dev/campanile-no-such-port"),
         "{stdout}"
     );
-    assert!(stdout.contains("9 checks, 1 failed"), "{stdout}");
+    if !cfg!(feature = "v4l") {
+        assert!(stdout.contains("9 checks, 1 failed"), "{stdout}");
+    }
     drop((head_slave, wheel_slave, lights_slave));
 }
 

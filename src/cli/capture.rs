@@ -16,6 +16,7 @@ use campanile_capture::store::{FsStorage, Storage};
 use campanile_capture::store::{
     JournalEntry, PLAN_FILE, Provenance, SCENE_FILE, STATION_FILE, SessionStore, Snapshot, SourcePaths,
 };
+use campanile_config::camera::CameraDriver;
 use campanile_config::document::{Document, load_text};
 use campanile_config::{Station, check_plan_on_station, load_plan, load_station};
 use campanile_sim::camera::CameraOptions;
@@ -382,6 +383,24 @@ fn capture(args: &CaptureArgs, inputs: &Inputs) -> Result<bool> {
         .as_ref()
         .or(args.resume.as_ref())
         .context("give --out DIR or --resume DIR")?;
+    if !inputs.station.uses_simulation() {
+        // Before any session directory is made: the ports are real and
+        // distinct, and this build has the camera's driver.
+        check_ports(&inputs.station).with_context(|| format!("station {}", inputs.station_label))?;
+        let driver = inputs.station.camera.driver;
+        let built = match driver {
+            CameraDriver::V4l => cfg!(feature = "v4l"),
+            CameraDriver::Nokhwa => cfg!(feature = "nokhwa"),
+            CameraDriver::Sim => true,
+        };
+        if !built {
+            let why = open_camera(&inputs.station.camera)
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default();
+            bail!("opening the camera of station {}: {why}", inputs.station_label);
+        }
+    }
     match args.sim_disk_quota {
         Some(quota) => {
             if inputs.station.uses_simulation() {
@@ -601,7 +620,6 @@ fn run_simulated<S: Storage>(
 /// names, the serial devices on their ports, reopened with backoff when a
 /// link drops.
 fn run_real<S: Storage>(inputs: &Inputs, store: &mut SessionStore<S>, bars: &mut Bars) -> Result<RunResult> {
-    check_ports(&inputs.station).with_context(|| format!("station {}", inputs.station_label))?;
     let runtime = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()

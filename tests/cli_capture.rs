@@ -1,4 +1,4 @@
-//! Disk full, end to end through `campanile capture`: a simulated session
+//! `campanile capture` end to end. Disk full: a simulated session
 //! on a directory with a byte quota stops cleanly with a clear message and
 //! a valid journal; `campanile capture --resume DIR` alone (the plan and
 //! station from the session's snapshots), with the space freed, completes
@@ -234,4 +234,30 @@ fn camera_timeouts_and_a_head_outage_from_the_command_line() {
     assert!(count("retries") >= 2, "{line}");
     assert!(count("reconnects") >= 1, "{line}");
     assert_eq!(frames(&dir).len(), 8);
+}
+
+/// A real station in a build without its camera driver: nothing is
+/// opened or created, and the message says how to get the driver.
+#[test]
+fn a_real_station_without_its_camera_driver_is_refused_clearly() {
+    if cfg!(feature = "v4l") {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("real");
+    let out = campanile(&[
+        "capture",
+        "examples/campanile-day.ron",
+        "--station",
+        "examples/real-station.ron",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("opening the camera of station examples/real-station.ron: camera failure: this campanile was built without the V4L2 camera driver; rebuild with `--features v4l`"),
+        "{stderr}"
+    );
+    assert!(!dir.exists(), "no session directory is made");
 }
