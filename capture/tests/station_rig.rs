@@ -20,12 +20,15 @@ use campanile_capture::driver::backoff::Backoff;
 use campanile_capture::schedule::{TimelineOptions, timeline};
 use campanile_capture::station::{PortOpener, StationError, StationOptions, StationRig};
 use campanile_capture::store::{JournalEntry, Provenance, SessionStore, Snapshot};
+use campanile_config::head::HeadProtocol;
 use campanile_config::link::SerialLink;
 use campanile_config::plan::Plan;
 use campanile_config::{Station, load_station};
 use campanile_firmware_link::emulator::Emulator;
 use campanile_firmware_link::enttec::device::DmxDevice;
+use campanile_firmware_link::flir_ptu::device::{PtuConfig, PtuDevice};
 use campanile_firmware_link::fw102c::device::WheelDevice;
+use campanile_firmware_link::link::device::{DeviceConfig, LinkDevice};
 use campanile_firmware_link::pelco_d::device::{PelcoConfig, PelcoDevice};
 use campanile_firmware_link::transport::fault::{FaultConfig, FaultyStream};
 use campanile_firmware_link::transport::memory::duplex;
@@ -51,11 +54,15 @@ struct PortPlan {
 /// connection (a fresh emulator per open, like a power-cycled device).
 #[derive(Default)]
 struct Bench {
+    /// The head's protocol (Pelco-D unless set).
+    head_protocol: Option<HeadProtocol>,
     plans: HashMap<String, PortPlan>,
     opens: Mutex<HashMap<String, u32>>,
     heads: Mutex<Vec<Emulator<PelcoDevice>>>,
     wheels: Mutex<Vec<Emulator<WheelDevice>>>,
     lights: Mutex<Vec<Emulator<DmxDevice>>>,
+    /// FLIR and campanile-link heads, kept running.
+    other_heads: Mutex<Vec<Box<dyn std::any::Any + Send>>>,
 }
 
 impl Bench {
@@ -95,6 +102,18 @@ impl PortOpener for Bench {
         }
         let (host, dev) = duplex(4096);
         match link.port.as_str() {
+            "/dev/ttyUSB0" if self.head_protocol == Some(HeadProtocol::FlirPtu) => {
+                let cfg = PtuConfig {
+                    speed: 16_000,
+                    ..PtuConfig::default()
+                };
+                let emu = Emulator::spawn(PtuDevice::new(cfg), dev, TICK);
+                self.other_heads.lock().unwrap().push(Box::new(emu));
+            }
+            "/dev/ttyUSB0" if self.head_protocol == Some(HeadProtocol::CampanileLink) => {
+                let emu = Emulator::spawn(LinkDevice::new(DeviceConfig::default()), dev, TICK);
+                self.other_heads.lock().unwrap().push(Box::new(emu));
+            }
             "/dev/ttyUSB0" => {
                 let cfg = PelcoConfig {
                     speed: 9_000,
@@ -490,4 +509,48 @@ async fn shared_and_simulated_ports_are_refused_by_name() {
             .starts_with("port \"sim:lights\" of the lights is a simulated port"),
         "{err}"
     );
+}
+
+/// The FLIR PTU and campanile-link heads too: the link drops mid-move, the
+/// port is absent for two opens, and the reopened head (limits read anew
+/// from the unit) reaches the next pose.
+#[tokio::test(start_paused = true)]
+async fn flir_and_campanile_link_heads_are_reopened_with_backoff() {
+    for protocol in [HeadProtocol::FlirPtu, HeadProtocol::CampanileLink] {
+        let mut station = real_station();
+        station.head.protocol = protocol;
+        let mut bench = Bench::new(&[(
+            "/dev/ttyUSB0",
+            PortPlan {
+                drop_after: Some(1500),
+                absent_opens: 2,
+            },
+        )]);
+        bench.head_protocol = Some(protocol);
+        let camera = FlatCamera {
+            clock: clock(),
+            sequence: 0,
+        };
+        let mut rig = StationRig::connect(&station, bench, camera, options()).await.unwrap();
+        move_until_the_link_drops(&mut rig).await;
+        let t0 = Instant::now();
+        rig.reconnect(DeviceKind::Head).await.unwrap();
+        let waited = t0.elapsed();
+        assert!(
+            waited >= Duration::from_millis(1500) && waited < Duration::from_millis(1700),
+            "{protocol:?}: {waited:?}"
+        );
+        let target = Pose::from_degrees(20.0, 10.0);
+        rig.head().move_to(target).await.unwrap();
+        let at = rig.head().wait_idle(Duration::from_secs(30)).await.unwrap();
+        let tol = rig.head().limits().resolution;
+        assert!(
+            at.within(
+                &target,
+                campanile_capture::device::Angle::from_radians(tol.radians() * 1.01)
+            ),
+            "{protocol:?}: {at:?}"
+        );
+        assert_eq!(rig.opener().opens("/dev/ttyUSB0"), 4, "{protocol:?}");
+    }
 }
