@@ -178,6 +178,7 @@ pub fn render(scene: &Scene, camera: &CameraRig, lighting: &Lighting, settings: 
     let spp = settings.samples_per_pixel.max(1);
     let side = (f64::from(spp)).sqrt().ceil() as u32;
     let mut data = vec![0f32; w * h * 3];
+    let caster = camera.rays();
     data.par_chunks_mut(w * 3).enumerate().for_each(|(y, row)| {
         let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
         rng.set_stream(y as u64);
@@ -187,7 +188,7 @@ pub fn render(scene: &Scene, camera: &CameraRig, lighting: &Lighting, settings: 
                 let (sx, sy) = (s % side, s / side % side);
                 let u = x as f64 + (f64::from(sx) + rng.random::<f64>()) / f64::from(side);
                 let v = y as f64 + (f64::from(sy) + rng.random::<f64>()) / f64::from(side);
-                if let Some(ray) = camera.ray(u, v) {
+                if let Some(ray) = caster.ray(u, v) {
                     let l = trace(scene, lighting, ray, settings.max_bounces, &mut rng);
                     (0..3).for_each(|c| sum[c] += l[c]);
                 }
