@@ -89,6 +89,7 @@ fn a_session_completes_through_link_faults_a_disconnect_and_camera_timeouts() {
             campanile_version: "test".into(),
             created_utc: chrono::DateTime::default(),
             calibration: Vec::new(),
+            sources: None,
         },
     };
     let mut store = SessionStore::create(tmp.path(), snapshot).unwrap();

@@ -102,6 +102,7 @@ fn snapshot() -> Snapshot {
             campanile_version: "test".into(),
             created_utc: chrono::DateTime::default(),
             calibration: Vec::new(),
+            sources: None,
         },
     }
 }

@@ -70,6 +70,7 @@ fn sun_shots_are_centred_and_unsaturated_and_auto_brackets_are_short() {
             campanile_version: "test".into(),
             created_utc: chrono::DateTime::default(),
             calibration: Vec::new(),
+            sources: None,
         },
     };
     let dir = tmp.path().join("session");

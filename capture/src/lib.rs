@@ -6,6 +6,7 @@
 //! - [`driver`]: real drivers over serial links and camera APIs.
 //! - [`conformance`]: suites any driver or emulator must pass.
 //! - [`schedule`]: when sessions run and what shots they take, as a pure function of plan, site and time.
+//! - [`station`]: a real station's devices, built from its configuration, reconnecting with backoff.
 //! - [`store`]: the session directory: frames written atomically and an append-only journal.
 
 pub mod clock;
@@ -14,4 +15,5 @@ pub mod controller;
 pub mod device;
 pub mod driver;
 pub mod schedule;
+pub mod station;
 pub mod store;

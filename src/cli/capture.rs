@@ -2,16 +2,25 @@
 //! or resume one after a crash.
 
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
-use campanile_capture::controller::{self, Progress, RunOptions, ShotOutcome};
+use campanile_capture::clock::SystemClock;
+use campanile_capture::controller::{self, Progress, RunError, RunOptions, RunReport, ShotOutcome};
 use campanile_capture::schedule::{Occurrence, PlannedShot, SceneGeometry, Timeline, TimelineOptions, timeline};
-use campanile_capture::store::{JournalEntry, Provenance, SessionStore, Snapshot};
+use campanile_capture::station::{SerialOpener, StationOptions, StationRig, check_ports, open_camera};
+use campanile_capture::store::fault::QuotaStorage;
+use campanile_capture::store::{FsStorage, Storage};
+use campanile_capture::store::{
+    JournalEntry, PLAN_FILE, Provenance, SCENE_FILE, STATION_FILE, SessionStore, Snapshot, SourcePaths,
+};
+use campanile_config::camera::CameraDriver;
+use campanile_config::document::{Document, load_text};
 use campanile_config::{Station, check_plan_on_station, load_plan, load_station};
-use campanile_sim::faults::{FaultPlan, LinkFaults};
+use campanile_sim::camera::CameraOptions;
+use campanile_sim::faults::{CameraFaultPlan, Device, FaultPlan, LinkFaults, Outage};
 use campanile_sim::station::{SimOptions, SimStation};
 use campanile_sim::world::{World, load_scene};
 use chrono::TimeDelta;
@@ -29,8 +38,11 @@ use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
 /// late) are journaled as missed with the reason.
 ///
 /// Simulated stations (a `Sim` camera or `sim:` ports) photograph the plan's
-/// scene under simulated time: the day passes as fast as the frames render.
-/// Real drivers are not yet wired for capture.
+/// scene under simulated time: the day passes as fast as the frames render;
+/// the --sim-* flags inject faults. Real stations run on the wall clock:
+/// the camera through its driver (V4L2 or nokhwa, cargo features `v4l` and
+/// `nokhwa`), the head, filter wheel and lights on their serial ports, each
+/// reopened with exponential backoff when its link drops.
 ///
 /// Exit status: 0 when every promised frame is stored; 1 when a shot was
 /// missed or the session stopped (e.g. the disk is full; resume it with
@@ -38,16 +50,18 @@ use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
 ///
 /// Examples:
 ///   campanile capture examples/campanile-day.ron --station examples/sim-station.ron --out day
-///   campanile capture examples/campanile-day.ron --station examples/sim-station.ron --resume day
+///   campanile capture --resume day
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct CaptureArgs {
     /// The plan (RON); its scene is read from the plan's `scene` field.
-    #[arg(value_name = "PLAN")]
-    plan: PathBuf,
-    /// The station (RON) that runs it.
-    #[arg(long, value_name = "STATION")]
-    station: PathBuf,
+    /// Optional with --resume: the session's own plan.ron is used.
+    #[arg(value_name = "PLAN", required_unless_present = "resume")]
+    plan: Option<PathBuf>,
+    /// The station (RON) that runs it. Optional with --resume: the
+    /// session's own station.ron is used.
+    #[arg(long, value_name = "STATION", required_unless_present = "resume")]
+    station: Option<PathBuf>,
     /// A new session directory (must not exist or be empty).
     #[arg(
         long,
@@ -57,7 +71,9 @@ pub struct CaptureArgs {
     )]
     out: Option<PathBuf>,
     /// Resume the session in DIR after a crash or a stop: complete shots are
-    /// kept, the rest are taken. PLAN and STATION must be the ones it began with.
+    /// kept, the rest are taken. Without PLAN and STATION the session's
+    /// snapshots (DIR/plan.ron, station.ron, scene.ron) are used; given
+    /// ones must be the ones it began with.
     #[arg(long, value_name = "DIR")]
     resume: Option<PathBuf>,
     /// Run only the first N days of the plan.
@@ -75,6 +91,66 @@ pub struct CaptureArgs {
     /// Simulation: chance that a byte is corrupted on every serial link (0–0.5).
     #[arg(long, value_name = "P")]
     sim_corrupt_chance: Option<f64>,
+    /// Simulation: chance that any one frame never arrives (the camera times out), 0–1.
+    #[arg(long, value_name = "P", value_parser = chance)]
+    sim_camera_timeout_chance: Option<f64>,
+    /// Simulation: chance that any one frame fails with a camera error, 0–1.
+    #[arg(long, value_name = "P", value_parser = chance)]
+    sim_camera_error_chance: Option<f64>,
+    /// Simulation: DEVICE (head, wheel or lights) disconnects AFTER seconds
+    /// into the run for DURATION seconds, e.g. head:600:20. Repeatable.
+    #[arg(long, value_name = "DEVICE:AFTER:DURATION")]
+    sim_outage: Vec<OutageArg>,
+    /// Simulation: the session directory may hold at most BYTES (what it
+    /// already holds counts), as if the disk filled up there.
+    #[arg(long, value_name = "BYTES")]
+    sim_disk_quota: Option<u64>,
+}
+
+/// A chance in [0, 1].
+fn chance(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(p) if (0.0..=1.0).contains(&p) => Ok(p),
+        _ => Err(format!("found {s:?}; expected a chance between 0 and 1")),
+    }
+}
+
+/// `--sim-outage DEVICE:AFTER:DURATION`.
+#[derive(Debug, Clone, Copy)]
+struct OutageArg(Outage);
+
+impl std::str::FromStr for OutageArg {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad = || {
+            format!(
+                "found {s:?}; expected DEVICE:AFTER_S:DURATION_S with DEVICE head, wheel or lights, e.g. head:600:20"
+            )
+        };
+        let mut parts = s.split(':');
+        let (Some(d), Some(a), Some(l), None) = (parts.next(), parts.next(), parts.next(), parts.next()) else {
+            return Err(bad());
+        };
+        let device = match d {
+            "head" => Device::Head,
+            "wheel" => Device::Wheel,
+            "lights" => Device::Lights,
+            _ => return Err(bad()),
+        };
+        let secs = |v: &str| {
+            v.parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite() && *x >= 0.0 && *x < 1e9)
+                .map(Duration::from_secs_f64)
+                .ok_or_else(bad)
+        };
+        Ok(Self(Outage {
+            device,
+            after: secs(a)?,
+            duration: secs(l)?,
+        }))
+    }
 }
 
 pub fn run(args: CaptureArgs) -> u8 {
@@ -85,12 +161,16 @@ pub fn run(args: CaptureArgs) -> u8 {
             return EXIT_USAGE;
         }
     };
-    if !inputs.station.uses_simulation() {
+    let sim_flags = args.sim_drop_chance.is_some()
+        || args.sim_corrupt_chance.is_some()
+        || args.sim_camera_timeout_chance.is_some()
+        || args.sim_camera_error_chance.is_some()
+        || !args.sim_outage.is_empty()
+        || args.sim_disk_quota.is_some();
+    if !inputs.station.uses_simulation() && sim_flags {
         eprintln!(
-            "error: station {:?} ({}) uses real devices, and real drivers are not yet wired for `campanile capture`; \
-             use a simulated station (a `Sim` camera and `sim:` ports), e.g. examples/sim-station.ron",
-            inputs.station.name,
-            args.station.display()
+            "error: the --sim-* fault flags are for simulated stations; station {:?} ({}) has real devices",
+            inputs.station.name, inputs.station_label
         );
         return EXIT_USAGE;
     }
@@ -110,31 +190,30 @@ struct Inputs {
     station: Station,
     timeline: Timeline,
     snapshot: Snapshot,
+    /// How to name the plan and station in messages.
+    plan_label: String,
+    station_label: String,
+    /// Whether they were read from a session's snapshot.
+    from_session: bool,
 }
 
 impl Inputs {
     fn load(args: &CaptureArgs) -> Result<Self> {
-        let plan = load_plan(&args.plan).map_err(|e| anyhow::anyhow!("{e}"))?;
-        let loaded = load_station(&args.station).map_err(|e| anyhow::anyhow!("{e}"))?;
-        let station = loaded.value.clone();
-        check_plan_on_station(&plan, &station).map_err(|e| {
-            anyhow::anyhow!(
-                "{e}\nthe plan does not run on station {:?} ({})",
-                station.name,
-                args.station.display()
-            )
-        })?;
-        let scene = match &plan.scene {
-            Some(s) => Some(SceneGeometry::load(&s.value, &s.source.base_dir()).context("reading the plan's scene")?),
-            None => None,
-        };
-        let t = timeline(
-            &plan.plan.value,
-            &station,
-            scene.as_ref(),
-            &TimelineOptions { days: args.days },
-        )
-        .with_context(|| format!("{}: cannot simulate the plan", args.plan.display()))?;
+        match (&args.resume, &args.plan, &args.station) {
+            (Some(dir), None, None) => Self::from_session(dir, args.days),
+            (_, Some(plan), Some(station)) => Self::from_files(plan, station, args.days),
+            (Some(_), _, _) => bail!(
+                "give both PLAN and --station STATION, or neither (to resume with the session's own plan.ron and station.ron)"
+            ),
+            (None, _, _) => bail!("give PLAN and --station STATION"),
+        }
+    }
+
+    /// Read PLAN and STATION (and the plan's scene) from their files.
+    fn from_files(plan_path: &Path, station_path: &Path, days: Option<u32>) -> Result<Self> {
+        let plan = load_plan(plan_path).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let loaded = load_station(station_path).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
         let snapshot = Snapshot {
             plan_ron: plan.plan.source.text.clone(),
             station_ron: loaded.source.text.clone(),
@@ -143,13 +222,109 @@ impl Inputs {
                 campanile_version: env!("CARGO_PKG_VERSION").to_owned(),
                 created_utc: chrono::Utc::now(),
                 calibration: Vec::new(),
+                sources: Some(SourcePaths {
+                    plan: absolute(plan_path),
+                    station: absolute(station_path),
+                    scene: plan.scene.as_ref().map(|s| absolute(&s.source.path)),
+                }),
             },
         };
+        Self::new(
+            plan,
+            loaded.value,
+            snapshot,
+            plan_path.display().to_string(),
+            station_path.display().to_string(),
+            false,
+            days,
+        )
+    }
+
+    /// Read the plan, station and scene from the snapshot of the session
+    /// in `dir`. Their relative paths (the scene's OBJ geometry) resolve
+    /// against the files the session was created from; the scene file
+    /// there must still be the one snapshotted.
+    fn from_session(dir: &Path, days: Option<u32>) -> Result<Self> {
+        let snapshot = Snapshot::read_dir(dir)
+            .with_context(|| format!("reading the snapshot of the session in {}", dir.display()))?;
+        let sources = snapshot.provenance.sources.clone();
+        let plan_path = sources.as_ref().map_or_else(|| dir.join(PLAN_FILE), |s| s.plan.clone());
+        let station_path = sources
+            .as_ref()
+            .map_or_else(|| dir.join(STATION_FILE), |s| s.station.clone());
+        let plan = match load_text(&plan_path, snapshot.plan_ron.clone()) {
+            Ok(Document::Plan(p)) => *p,
+            Ok(_) => bail!(
+                "{}: the session's plan snapshot is not a `Plan(...)`",
+                dir.join(PLAN_FILE).display()
+            ),
+            Err(e) => bail!(
+                "{e}\nthe session's plan snapshot ({}) does not load as if at {}; give PLAN and --station again",
+                dir.join(PLAN_FILE).display(),
+                plan_path.display()
+            ),
+        };
+        if let (Some(scene), Some(snap)) = (&plan.scene, &snapshot.scene_ron)
+            && &scene.source.text != snap
+        {
+            bail!(
+                "the scene file {} has changed since the session in {} began (its snapshot is {}); restore it to resume",
+                scene.source.path.display(),
+                dir.display(),
+                dir.join(SCENE_FILE).display()
+            );
+        }
+        let station = match load_text(&station_path, snapshot.station_ron.clone()) {
+            Ok(Document::Station(s)) => s.value,
+            Ok(_) => bail!(
+                "{}: the session's station snapshot is not a `Station(...)`",
+                dir.join(STATION_FILE).display()
+            ),
+            Err(e) => bail!(
+                "{e}\nthe session's station snapshot ({}) does not load",
+                dir.join(STATION_FILE).display()
+            ),
+        };
+        Self::new(
+            plan,
+            station,
+            snapshot,
+            dir.join(PLAN_FILE).display().to_string(),
+            dir.join(STATION_FILE).display().to_string(),
+            true,
+            days,
+        )
+    }
+
+    fn new(
+        plan: campanile_config::document::LoadedPlan,
+        station: Station,
+        snapshot: Snapshot,
+        plan_label: String,
+        station_label: String,
+        from_session: bool,
+        days: Option<u32>,
+    ) -> Result<Self> {
+        check_plan_on_station(&plan, &station).map_err(|e| {
+            anyhow::anyhow!(
+                "{e}\nthe plan does not run on station {:?} ({station_label})",
+                station.name
+            )
+        })?;
+        let scene = match &plan.scene {
+            Some(s) => Some(SceneGeometry::load(&s.value, &s.source.base_dir()).context("reading the plan's scene")?),
+            None => None,
+        };
+        let t = timeline(&plan.plan.value, &station, scene.as_ref(), &TimelineOptions { days })
+            .with_context(|| format!("{plan_label}: cannot simulate the plan"))?;
         Ok(Self {
             plan,
             station,
             timeline: t,
             snapshot,
+            plan_label,
+            station_label,
+            from_session,
         })
     }
 }
@@ -203,28 +378,78 @@ impl Progress for Bars {
 }
 
 fn capture(args: &CaptureArgs, inputs: &Inputs) -> Result<bool> {
+    let dir = args
+        .out
+        .as_ref()
+        .or(args.resume.as_ref())
+        .context("give --out DIR or --resume DIR")?;
+    if !inputs.station.uses_simulation() {
+        // Before any session directory is made: the ports are real and
+        // distinct, and this build has the camera's driver.
+        check_ports(&inputs.station).with_context(|| format!("station {}", inputs.station_label))?;
+        let driver = inputs.station.camera.driver;
+        let built = match driver {
+            CameraDriver::V4l => cfg!(feature = "v4l"),
+            CameraDriver::Nokhwa => cfg!(feature = "nokhwa"),
+            CameraDriver::Sim => true,
+        };
+        if !built {
+            let why = open_camera(&inputs.station.camera)
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default();
+            bail!("opening the camera of station {}: {why}", inputs.station_label);
+        }
+    }
+    match args.sim_disk_quota {
+        Some(quota) => {
+            if inputs.station.uses_simulation() {
+                // The quota counts what is already in the directory.
+                if args.out.is_some() {
+                    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+                }
+                let storage = QuotaStorage::open(FsStorage, dir, quota)
+                    .with_context(|| format!("measuring {} for the disk quota", dir.display()))?;
+                capture_into(args, inputs, storage)
+            } else {
+                bail!("--sim-disk-quota is for simulated stations")
+            }
+        }
+        None => capture_into(args, inputs, FsStorage),
+    }
+}
+
+/// Open the session (new or resumed) on `storage`, run the timeline on
+/// the station's devices, and report.
+fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> Result<bool> {
     let (mut store, resumed) = match (&args.out, &args.resume) {
         (Some(dir), _) => (
-            SessionStore::create(dir, inputs.snapshot.clone())
+            SessionStore::create_with(storage, dir, inputs.snapshot.clone())
                 .with_context(|| format!("creating the session in {}", dir.display()))?,
             false,
         ),
         (None, Some(dir)) => {
-            let (store, report) =
-                SessionStore::resume(dir).with_context(|| format!("resuming the session in {}", dir.display()))?;
+            let (store, report) = SessionStore::resume_with(storage, dir)
+                .with_context(|| format!("resuming the session in {}", dir.display()))?;
             if store.snapshot().plan_ron != inputs.snapshot.plan_ron
                 || store.snapshot().station_ron != inputs.snapshot.station_ron
             {
                 bail!(
-                    "{} began with another plan or station than {} and {}; give the ones it began with (its plan.ron and station.ron)",
+                    "{} began with another plan or station than {} and {}; resume with `campanile capture --resume {}` alone to use its own plan.ron and station.ron",
                     dir.display(),
-                    args.plan.display(),
-                    args.station.display()
+                    inputs.plan_label,
+                    inputs.station_label,
+                    dir.display()
                 );
             }
             eprintln!(
-                "resuming {}: {} frames and {} missed shots journaled{}",
+                "resuming {}{}: {} frames and {} missed shots journaled{}",
                 dir.display(),
+                if inputs.from_session {
+                    " with its own plan.ron and station.ron"
+                } else {
+                    ""
+                },
                 report.frames,
                 report.missed,
                 if report.is_clean() {
@@ -238,78 +463,18 @@ fn capture(args: &CaptureArgs, inputs: &Inputs) -> Result<bool> {
         }
         (None, None) => bail!("give --out DIR or --resume DIR"),
     };
-    let Some(first) = inputs.timeline.occurrences.first() else {
+    if inputs.timeline.occurrences.is_empty() {
         println!("the plan has no occurrences: nothing to capture");
         return Ok(true);
-    };
-    // The simulated calendar begins a minute before the first occurrence,
-    // or, on resume, a second after the last journaled shot.
-    let last = store.entries().iter().map(|e| match e {
-        JournalEntry::Done(f) | JournalEntry::Late(f) => f.meta.time,
-        JournalEntry::Missed(m) => m.time,
-    });
-    let origin = match (resumed, last.max()) {
-        (true, Some(t)) => t + TimeDelta::seconds(1),
-        _ => first.start - TimeDelta::seconds(60),
-    };
-    let scene_path = inputs
-        .plan
-        .scene
-        .as_ref()
-        .map(|s| s.source.path.clone())
-        .context("a simulated capture needs the plan's scene to photograph (the plan has no `scene`)")?;
-    let mut world = World::new(
-        &inputs.station,
-        load_scene(&scene_path).with_context(|| format!("loading {}", scene_path.display()))?,
-    );
-    world.quality.samples_per_pixel = args.sim_samples.max(1);
-    world.quality.max_bounces = args.sim_bounces;
-    let home = inputs
-        .plan
-        .scene
-        .as_ref()
-        .and_then(|s| s.value.poses.first())
-        .map_or([0.0; 3], |p| [p.position_m.0, p.position_m.1, p.position_m.2]);
-    let faults = FaultPlan {
-        link: (args.sim_drop_chance.is_some() || args.sim_corrupt_chance.is_some()).then(|| LinkFaults {
-            drop_chance: args.sim_drop_chance.unwrap_or(0.0),
-            corrupt_chance: args.sim_corrupt_chance.unwrap_or(0.0),
-        }),
-        ..FaultPlan::default()
-    };
-    let options = SimOptions {
-        origin,
-        position_m: home,
-        faults,
-        ..SimOptions::default()
-    };
+    }
     let promised = inputs.timeline.frames_promised();
     let mut bars = Bars::new(promised);
     let wall = Instant::now();
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_time()
-        .start_paused(true)
-        .build()
-        .context("starting the runtime")?;
-    let result = runtime.block_on(async {
-        let mut sim = SimStation::start(&inputs.station, Arc::new(world), options)
-            .await
-            .context("starting the simulated station")?;
-        let clock = sim.clock();
-        anyhow::Ok(
-            controller::run(
-                &inputs.timeline,
-                &inputs.plan.plan.value,
-                &inputs.station,
-                &mut store,
-                &mut sim,
-                &clock,
-                &RunOptions::default(),
-                &mut bars,
-            )
-            .await,
-        )
-    })?;
+    let result = if inputs.station.uses_simulation() {
+        run_simulated(args, inputs, &mut store, resumed, &mut bars)?
+    } else {
+        run_real(inputs, &mut store, &mut bars)?
+    };
     bars.session.finish_and_clear();
     bars.step.finish_and_clear();
     let elapsed = wall.elapsed();
@@ -356,15 +521,134 @@ fn capture(args: &CaptureArgs, inputs: &Inputs) -> Result<bool> {
     println!("  wall time            {}", seconds(elapsed));
     if let Some(e) = stopped {
         eprintln!("error: {e:#}");
-        eprintln!(
-            "resume with: campanile capture {} --station {} --resume {}",
-            args.plan.display(),
-            args.station.display(),
-            store.dir().display()
-        );
+        eprintln!("resume with: campanile capture --resume {}", store.dir().display());
         return Ok(false);
     }
     Ok(stored == promised && missed == 0)
+}
+
+type RunResult = std::result::Result<RunReport, RunError>;
+
+/// The simulated station under paused time: the day passes as fast as the
+/// frames render.
+fn run_simulated<S: Storage>(
+    args: &CaptureArgs,
+    inputs: &Inputs,
+    store: &mut SessionStore<S>,
+    resumed: bool,
+    bars: &mut Bars,
+) -> Result<RunResult> {
+    let first = &inputs.timeline.occurrences[0];
+    // The simulated calendar begins a minute before the first occurrence,
+    // or, on resume, a second after the last journaled shot.
+    let last = store.entries().iter().map(|e| match e {
+        JournalEntry::Done(f) | JournalEntry::Late(f) => f.meta.time,
+        JournalEntry::Missed(m) => m.time,
+    });
+    let origin = match (resumed, last.max()) {
+        (true, Some(t)) => t + TimeDelta::seconds(1),
+        _ => first.start - TimeDelta::seconds(60),
+    };
+    let scene_path = inputs
+        .plan
+        .scene
+        .as_ref()
+        .map(|s| s.source.path.clone())
+        .context("a simulated capture needs the plan's scene to photograph (the plan has no `scene`)")?;
+    let mut world = World::new(
+        &inputs.station,
+        load_scene(&scene_path).with_context(|| format!("loading {}", scene_path.display()))?,
+    );
+    world.quality.samples_per_pixel = args.sim_samples.max(1);
+    world.quality.max_bounces = args.sim_bounces;
+    let home = inputs
+        .plan
+        .scene
+        .as_ref()
+        .and_then(|s| s.value.poses.first())
+        .map_or([0.0; 3], |p| [p.position_m.0, p.position_m.1, p.position_m.2]);
+    let seed = inputs.station.simulation.as_ref().map_or(0, |s| s.seed);
+    let faults = FaultPlan {
+        link: (args.sim_drop_chance.is_some() || args.sim_corrupt_chance.is_some()).then(|| LinkFaults {
+            drop_chance: args.sim_drop_chance.unwrap_or(0.0),
+            corrupt_chance: args.sim_corrupt_chance.unwrap_or(0.0),
+        }),
+        outages: args.sim_outage.iter().map(|o| o.0).collect(),
+        ..FaultPlan::default()
+    };
+    let camera = CameraOptions {
+        faults: CameraFaultPlan {
+            seed,
+            timeout_chance: args.sim_camera_timeout_chance.unwrap_or(0.0),
+            error_chance: args.sim_camera_error_chance.unwrap_or(0.0),
+            ..CameraFaultPlan::none()
+        },
+        ..CameraOptions::default()
+    };
+    let options = SimOptions {
+        origin,
+        position_m: home,
+        faults,
+        camera,
+        ..SimOptions::default()
+    };
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_time()
+        .start_paused(true)
+        .build()
+        .context("starting the runtime")?;
+    runtime.block_on(async {
+        let mut sim = SimStation::start(&inputs.station, Arc::new(world), options)
+            .await
+            .context("starting the simulated station")?;
+        let clock = sim.clock();
+        Ok(controller::run(
+            &inputs.timeline,
+            &inputs.plan.plan.value,
+            &inputs.station,
+            store,
+            &mut sim,
+            &clock,
+            &RunOptions::default(),
+            bars,
+        )
+        .await)
+    })
+}
+
+/// The station's real devices on the wall clock: the camera its driver
+/// names, the serial devices on their ports, reopened with backoff when a
+/// link drops.
+fn run_real<S: Storage>(inputs: &Inputs, store: &mut SessionStore<S>, bars: &mut Bars) -> Result<RunResult> {
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .context("starting the runtime")?;
+    runtime.block_on(async {
+        let camera = open_camera(&inputs.station.camera)
+            .with_context(|| format!("opening the camera of station {}", inputs.station_label))?;
+        // Sequence numbers from the clock, so that a restarted program does
+        // not reuse numbers a campanile-link device still remembers.
+        let link_seq = (chrono::Utc::now().timestamp_subsec_micros() % 4096) as u16 + 1;
+        let options = StationOptions {
+            link_seq,
+            ..StationOptions::default()
+        };
+        let mut rig = StationRig::connect(&inputs.station, SerialOpener, camera, options)
+            .await
+            .with_context(|| format!("connecting the devices of station {}", inputs.station_label))?;
+        Ok(controller::run(
+            &inputs.timeline,
+            &inputs.plan.plan.value,
+            &inputs.station,
+            store,
+            &mut rig,
+            &SystemClock,
+            &RunOptions::default(),
+            bars,
+        )
+        .await)
+    })
 }
 
 fn seconds(d: Duration) -> String {

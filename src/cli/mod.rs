@@ -3,6 +3,7 @@
 mod capture;
 mod config_check;
 mod demo;
+mod devices;
 mod env;
 mod hdr;
 mod logging;
@@ -72,10 +73,12 @@ pub enum Command {
         #[command(subcommand)]
         action: sky::SkyCommand,
     },
-    /// Run a plan on a station into a session directory, or resume one (simulated stations for now).
+    /// Run a plan on a station into a session directory, or resume one.
     Capture(capture::CaptureArgs),
     /// Process a captured session: response, HDR, sun, sky and environment, with a summary.
     Process(process::ProcessArgs),
+    /// List serial ports and cameras, or test a station's devices (`devices test --station FILE`).
+    Devices(devices::DevicesArgs),
     /// Plans: simulate one forward without devices (timeline, frames, durations, what it will not cover).
     Plan {
         #[command(subcommand)]
@@ -118,6 +121,7 @@ pub fn run() -> ExitCode {
         Command::Capture(args) => capture::run(args),
         Command::Demo(args) => report(demo::run(args)),
         Command::Process(args) => report(process::run(args)),
+        Command::Devices(args) => devices::run(args),
     };
     ExitCode::from(code)
 }

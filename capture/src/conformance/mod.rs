@@ -3,6 +3,9 @@
 //! against the firmware emulators; `campanile devices test` runs the same
 //! functions against real hardware.
 
+pub mod camera;
+pub mod filter_wheel;
+pub mod lights;
 pub mod pan_tilt;
 
 /// The outcome of one check.

@@ -17,7 +17,8 @@
 //!
 //! The [`Camera`] trait takes manual exposure and gain and returns raw
 //! frames with the exposure actually applied (cameras round it); the
-//! simulator's camera implements it, and real V4L2/nokhwa drivers are to.
+//! simulator's camera implements it, and so do the V4L2 and nokhwa
+//! drivers in [`crate::driver`] (cargo features `v4l` and `nokhwa`).
 
 pub mod camera;
 pub mod error;

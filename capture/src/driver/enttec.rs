@@ -24,6 +24,17 @@ impl<T: AsyncRead + AsyncWrite + Unpin + Send> DmxLights<T> {
     }
 }
 
+impl<T: AsyncRead + AsyncWrite + Unpin + Send> DmxLights<T> {
+    /// [`DmxLights::new`], then ask the widget for its serial number, which
+    /// checks the link (sending DMX levels gets no answer).
+    pub async fn connect(io: T, channels: u16) -> Result<Self, DeviceError> {
+        let mut lights = Self::new(io, channels);
+        let serial = lights.widget.serial_number().await?;
+        tracing::debug!(serial, "DMX USB Pro connected");
+        Ok(lights)
+    }
+}
+
 impl<T: AsyncRead + AsyncWrite + Unpin + Send> Lights for DmxLights<T> {
     fn channels(&self) -> u16 {
         self.channels

@@ -10,12 +10,30 @@
 //! | [`flir_ptu::FlirHead`] | FLIR PTU ASCII | `PanTilt` |
 //! | [`fw102c::Fw102cWheel`] | Thorlabs FW102C | `FilterWheel` |
 //! | [`enttec::DmxLights`] | Enttec DMX USB Pro | `Lights` |
+//! | `v4l2::V4l2Camera` (feature `v4l`) | V4L2 | `Camera`, through [`camera_thread`] |
+//! | `nokhwa_camera::NokhwaCamera` (feature `nokhwa`) | nokhwa (V4L2 backend) | `Camera`, through [`camera_thread`] |
+//!
+//! The cameras share [`exposure_control`] (V4L2 exposure and gain
+//! controls) and [`pixel_format`] (buffers to RGB codes), which need no
+//! camera and are tested in every build.
+//!
+//! A link that drops is reopened by [`backoff::reopen`] (exponential
+//! backoff, capped, logged); [`crate::station`] does so for every serial
+//! device of a real station.
 
+pub mod backoff;
+pub mod camera_thread;
 pub mod enttec;
+pub mod exposure_control;
 pub mod flir_ptu;
 pub mod fw102c;
 pub mod link;
+#[cfg(feature = "nokhwa")]
+pub mod nokhwa_camera;
 pub mod pelco_d;
+pub mod pixel_format;
+#[cfg(feature = "v4l")]
+pub mod v4l2;
 
 use std::time::Duration;
 

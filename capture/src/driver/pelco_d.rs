@@ -23,6 +23,16 @@ fn angle(cdeg: i32) -> Angle {
     Angle::from_degrees(f64::from(cdeg) * CENTIDEG)
 }
 
+/// `cdeg` or the same direction a turn away, whichever lies in `min..=max`
+/// (`cdeg` itself if neither does).
+fn into_range(cdeg: i32, min: Angle, max: Angle) -> i32 {
+    let (lo, hi) = (to_cdeg(min), to_cdeg(max));
+    [cdeg, cdeg + 36_000, cdeg - 36_000]
+        .into_iter()
+        .find(|v| (lo..=hi).contains(v))
+        .unwrap_or(cdeg)
+}
+
 /// A Pelco-D head.
 #[derive(Debug)]
 pub struct PelcoHead<T> {
@@ -50,8 +60,31 @@ impl<T: AsyncRead + AsyncWrite + Unpin + Send> PelcoHead<T> {
         }
     }
 
+    /// [`PelcoHead::new`], then ask the head where it is, which checks the
+    /// link (Pelco-D has no handshake) and makes that pose the target, so
+    /// a head reconnected mid-session does not count as moving.
+    pub async fn connect(
+        io: T,
+        address: u8,
+        pan_deg: (f64, f64),
+        tilt_deg: (f64, f64),
+        home: Pose,
+    ) -> Result<Self, DeviceError> {
+        let mut head = Self::new(io, address, pan_deg, tilt_deg, home);
+        head.target = head.position().await?;
+        Ok(head)
+    }
+
+    /// Where the head is, 1/100°. The wire carries angles modulo a turn
+    /// (reported in −180°..180°); each is moved by a whole turn into the
+    /// configured range where that puts it there, so a head whose pan runs
+    /// 0°..360° reports 200°, not −160°.
     async fn position(&mut self) -> Result<(i32, i32), DeviceError> {
-        Ok((self.driver.pan().await?, self.driver.tilt().await?))
+        let (p, t) = (self.driver.pan().await?, self.driver.tilt().await?);
+        Ok((
+            into_range(p, self.limits.pan.min, self.limits.pan.max),
+            into_range(t, self.limits.tilt.min, self.limits.tilt.max),
+        ))
     }
 }
 
@@ -115,6 +148,18 @@ impl<T: AsyncRead + AsyncWrite + Unpin + Send> PanTilt for PelcoHead<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn wire_angles_move_into_the_configured_range() {
+        let a = Angle::from_degrees;
+        // Pan 0..359.99°: −160° is 200°.
+        assert_eq!(into_range(-16_000, a(0.0), a(359.99)), 20_000);
+        assert_eq!(into_range(0, a(0.0), a(359.99)), 0);
+        // Pan ±180°: unchanged.
+        assert_eq!(into_range(-16_000, a(-180.0), a(180.0)), -16_000);
+        // Outside any turn of the range: unchanged.
+        assert_eq!(into_range(5_000, a(-10.0), a(10.0)), 5_000);
+    }
     use crate::conformance::pan_tilt::{Options, run};
     use campanile_firmware_link::emulator::Emulator;
     use campanile_firmware_link::pelco_d::device::{PelcoConfig, PelcoDevice};

@@ -73,5 +73,7 @@ pub use key::{MAX_KEY_BYTES, check_key, frame_file_name};
 pub use reader::SessionReader;
 pub use report::{ResumeReport, TornLine, VerifyReport};
 pub use session::{FRAMES_DIR, JOURNAL_FILE, SessionStore};
-pub use snapshot::{CalibrationRef, PLAN_FILE, PROVENANCE_FILE, Provenance, SCENE_FILE, STATION_FILE, Snapshot};
+pub use snapshot::{
+    CalibrationRef, PLAN_FILE, PROVENANCE_FILE, Provenance, SCENE_FILE, STATION_FILE, Snapshot, SourcePaths,
+};
 pub use storage::{AtomicWriteError, FsStorage, Storage, is_temp_name, write_atomic};

@@ -4,7 +4,7 @@
 use super::*;
 use crate::device::{ExposureTime, Gain};
 use crate::store::fault::{CrashingStorage, Operation, QuotaStorage};
-use crate::store::{CalibrationRef, LightLevel, PoseDeg, Provenance, ShotKind};
+use crate::store::{CalibrationRef, LightLevel, PoseDeg, Provenance, ShotKind, SourcePaths};
 use chrono::TimeZone;
 use std::collections::BTreeSet;
 
@@ -41,6 +41,11 @@ fn snapshot() -> Snapshot {
                 file: "response.csv".into(),
                 checksum: "crc32c:0badf00d".into(),
             }],
+            sources: Some(SourcePaths {
+                plan: "/plans/day.ron".into(),
+                station: "/stations/roof.ron".into(),
+                scene: None,
+            }),
         },
     }
 }
@@ -197,8 +202,10 @@ fn round_trip_keeps_codes_and_journal_fields_exactly() {
         ["{\"status\":\"late\"", "{\"status\":\"done\"", "{\"status\":\"done\""],
         "{text}"
     );
-    // A resume sees the same entries and snapshot, and nothing to repair.
+    // A resume sees the same entries and snapshot, and nothing to repair;
+    // the snapshot (with its source paths) reads back without opening the session.
     drop(store);
+    assert_eq!(Snapshot::read_dir(&dir).unwrap(), snapshot());
     let (store, report) = SessionStore::resume(&dir).unwrap();
     assert!(report.is_clean(), "{report}");
     assert_eq!(report.frames, 3);

@@ -40,6 +40,24 @@ pub struct Provenance {
     pub created_utc: DateTime<Utc>,
     /// Calibration inputs (response curve, mount offset, …).
     pub calibration: Vec<CalibrationRef>,
+    /// Where the descriptions were read from, so that a resumed session
+    /// can resolve their relative paths (the scene's OBJ geometry, a
+    /// response curve) without being given the files again. Absent in
+    /// sessions written before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sources: Option<SourcePaths>,
+}
+
+/// The files a session's descriptions came from, as absolute paths.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SourcePaths {
+    /// The plan file.
+    pub plan: std::path::PathBuf,
+    /// The station file.
+    pub station: std::path::PathBuf,
+    /// The scene file, if the plan names one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scene: Option<std::path::PathBuf>,
 }
 
 /// What a session is captured under, as text (the RON the user wrote).
@@ -70,6 +88,12 @@ impl Snapshot {
         provenance.push(b'\n');
         files.push((PROVENANCE_FILE, provenance));
         files
+    }
+
+    /// Read the snapshot of the session in `dir` without opening the
+    /// session (nothing is repaired or changed).
+    pub fn read_dir(dir: &Path) -> Result<Self, StoreError> {
+        Self::read(&super::storage::FsStorage, dir)
     }
 
     /// Read the snapshot of the session in `dir`.

@@ -9,5 +9,5 @@
 mod head;
 mod pinhole;
 
-pub use head::{HeadPose, Mount};
+pub use head::{HeadPose, Mount, OrientedMount};
 pub use pinhole::Pinhole;

@@ -5,7 +5,7 @@
 use nalgebra::Vector3;
 
 use super::mesh::Ray;
-use crate::pose::{HeadPose, Mount, Pinhole};
+use crate::pose::{HeadPose, Mount, OrientedMount, Pinhole};
 
 /// A camera on its head, at a place.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -24,18 +24,41 @@ pub struct CameraRig {
     pub height: usize,
 }
 
+/// A [`CameraRig`] at its head pose, ready to cast rays.
+#[derive(Debug, Clone, Copy)]
+pub struct RayCaster<'a> {
+    rig: &'a CameraRig,
+    oriented: OrientedMount,
+}
+
+impl RayCaster<'_> {
+    /// The world ray through image point `(u, v)` (see [`CameraRig::ray`]).
+    pub fn ray(&self, u: f64, v: f64) -> Option<Ray> {
+        let d = self.rig.pinhole.unproject(u, v)?;
+        let w = self.oriented.to_world(d);
+        let direction = Vector3::new(w[0], w[1], w[2]).normalize();
+        Some(Ray {
+            origin: self.rig.position,
+            direction,
+        })
+    }
+}
+
 impl CameraRig {
     /// The world ray through image point `(u, v)` (pixel units; pixel
     /// centres at half-integers), or `None` where the distortion model has
     /// no ray.
     pub fn ray(&self, u: f64, v: f64) -> Option<Ray> {
-        let d = self.pinhole.unproject(u, v)?;
-        let w = self.mount.to_world(self.head, d);
-        let direction = Vector3::new(w[0], w[1], w[2]).normalize();
-        Some(Ray {
-            origin: self.position,
-            direction,
-        })
+        self.rays().ray(u, v)
+    }
+
+    /// The rig with its head rotations evaluated once, for casting a
+    /// frame's rays (the same rays as [`CameraRig::ray`], bit for bit).
+    pub fn rays(&self) -> RayCaster<'_> {
+        RayCaster {
+            rig: self,
+            oriented: self.mount.at(self.head),
+        }
     }
 
     /// The pixel a world point projects to, if in front of the camera.

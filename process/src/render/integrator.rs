@@ -186,11 +186,12 @@ pub fn render(scene: &Scene, camera: &CameraRig, lighting: &Lighting, settings: 
     // disc spans a few pixels, and its coverage of each one (what a sun
     // photograph integrates, §5.3.1) would otherwise carry sampling noise
     // of tens of percent.
+    let caster = camera.rays();
     let sun = lighting.sky.and_then(|s| s.sun());
     let pixel_rad = camera.pinhole.focal_px.recip();
     let near_sun = |u: f64, v: f64| {
         sun.as_ref().is_some_and(|disc| {
-            camera.ray(u, v).is_some_and(|r| {
+            caster.ray(u, v).is_some_and(|r| {
                 r.direction.dot(&disc.direction).clamp(-1.0, 1.0).acos() < disc.angular_radius_rad + 3.0 * pixel_rad
             })
         })
@@ -209,7 +210,7 @@ pub fn render(scene: &Scene, camera: &CameraRig, lighting: &Lighting, settings: 
                 let (sx, sy) = (s % side, s / side % side);
                 let u = x as f64 + (f64::from(sx) + rng.random::<f64>()) / f64::from(side);
                 let v = y as f64 + (f64::from(sy) + rng.random::<f64>()) / f64::from(side);
-                if let Some(ray) = camera.ray(u, v) {
+                if let Some(ray) = caster.ray(u, v) {
                     let l = trace(scene, lighting, ray, settings.max_bounces, &mut rng);
                     (0..3).for_each(|c| sum[c] += l[c]);
                 }

@@ -1,0 +1,157 @@
+//! Opening the station's camera with the driver its config names, as far
+//! as this build has it (the V4L2 and nokhwa drivers are cargo features).
+
+use crate::device::DeviceError;
+use crate::driver::camera_thread::ThreadedCamera;
+use campanile_config::camera::{Camera as CameraConfig, CameraDriver};
+
+/// The camera `config` describes, open on its own thread; a clear error if
+/// this build lacks its driver or the camera cannot be set up.
+pub fn open_camera(config: &CameraConfig) -> Result<ThreadedCamera, DeviceError> {
+    match config.driver {
+        CameraDriver::Sim => Err(DeviceError::Camera(
+            "the `Sim` camera exists only in the simulator; a real station names `V4l` or `Nokhwa`".into(),
+        )),
+        CameraDriver::V4l => open_v4l(config),
+        CameraDriver::Nokhwa => open_nokhwa(config),
+    }
+}
+
+#[cfg(feature = "v4l")]
+fn open_v4l(config: &CameraConfig) -> Result<ThreadedCamera, DeviceError> {
+    crate::driver::v4l2::open(config, crate::driver::v4l2::V4l2Options::default())
+}
+
+#[cfg(not(feature = "v4l"))]
+fn open_v4l(_: &CameraConfig) -> Result<ThreadedCamera, DeviceError> {
+    Err(DeviceError::Camera(
+        "this campanile was built without the V4L2 camera driver; rebuild with `--features v4l` (needs libclang)"
+            .into(),
+    ))
+}
+
+#[cfg(feature = "nokhwa")]
+fn open_nokhwa(config: &CameraConfig) -> Result<ThreadedCamera, DeviceError> {
+    crate::driver::nokhwa_camera::open(config)
+}
+
+#[cfg(not(feature = "nokhwa"))]
+fn open_nokhwa(_: &CameraConfig) -> Result<ThreadedCamera, DeviceError> {
+    Err(DeviceError::Camera(
+        "this campanile was built without the nokhwa camera driver; rebuild with `--features nokhwa` (needs libclang)"
+            .into(),
+    ))
+}
+
+/// A video device found on the system.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CameraEntry {
+    /// Its device node, e.g. `/dev/video0`.
+    pub path: std::path::PathBuf,
+    /// The name its driver gives it, if known.
+    pub name: Option<String>,
+}
+
+/// The video devices under `dev` (nodes `videoN`, in order of N), named
+/// from `sys` (`sys/videoN/name`, as /sys/class/video4linux has them).
+/// Absent directories list nothing.
+pub fn list_video_nodes(dev: &std::path::Path, sys: &std::path::Path) -> std::io::Result<Vec<CameraEntry>> {
+    let entries = match std::fs::read_dir(dev) {
+        Ok(e) => e,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(e),
+    };
+    let mut found = Vec::new();
+    for entry in entries {
+        let entry = entry?;
+        let file = entry.file_name();
+        let Some(n) = file
+            .to_str()
+            .and_then(|f| f.strip_prefix("video"))
+            .and_then(|n| n.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        let name = std::fs::read_to_string(sys.join(format!("video{n}")).join("name"))
+            .ok()
+            .map(|s| s.trim().to_owned())
+            .filter(|s| !s.is_empty());
+        found.push((
+            n,
+            CameraEntry {
+                path: entry.path(),
+                name,
+            },
+        ));
+    }
+    found.sort_by_key(|(n, _)| *n);
+    Ok(found.into_iter().map(|(_, e)| e).collect())
+}
+
+/// The system's cameras: through V4L2 when this build has the `v4l`
+/// feature, otherwise the /dev/video* nodes named from /sys.
+pub fn list_cameras() -> std::io::Result<Vec<CameraEntry>> {
+    #[cfg(feature = "v4l")]
+    {
+        let mut found: Vec<CameraEntry> = v4l::context::enum_devices()
+            .into_iter()
+            .map(|node| CameraEntry {
+                path: node.path().to_path_buf(),
+                name: node.name(),
+            })
+            .collect();
+        found.sort_by(|a, b| a.path.cmp(&b.path));
+        Ok(found)
+    }
+    #[cfg(not(feature = "v4l"))]
+    {
+        list_video_nodes(
+            std::path::Path::new("/dev"),
+            std::path::Path::new("/sys/class/video4linux"),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn video_nodes_are_listed_in_order_with_their_names() {
+        let tmp = tempfile::tempdir().unwrap();
+        let (dev, sys) = (tmp.path().join("dev"), tmp.path().join("sys"));
+        std::fs::create_dir_all(&dev).unwrap();
+        for f in ["video10", "video2", "videofoo", "ttyUSB0", "video0"] {
+            std::fs::write(dev.join(f), "").unwrap();
+        }
+        std::fs::create_dir_all(sys.join("video2")).unwrap();
+        std::fs::write(sys.join("video2/name"), "HD Webcam C920\n").unwrap();
+        let got = list_video_nodes(&dev, &sys).unwrap();
+        let paths: Vec<_> = got
+            .iter()
+            .map(|e| e.path.file_name().unwrap().to_str().unwrap())
+            .collect();
+        assert_eq!(paths, ["video0", "video2", "video10"]);
+        assert_eq!(got[1].name.as_deref(), Some("HD Webcam C920"));
+        assert_eq!(got[0].name, None);
+        assert!(list_video_nodes(&tmp.path().join("absent"), &sys).unwrap().is_empty());
+    }
+
+    #[test]
+    fn a_simulated_or_unbuilt_driver_is_a_clear_error() {
+        let station = campanile_config::load_station(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/real-station.ron"),
+        )
+        .unwrap()
+        .value;
+        let mut cfg = station.camera.clone();
+        cfg.driver = CameraDriver::Sim;
+        let e = open_camera(&cfg).unwrap_err().to_string();
+        assert!(e.contains("exists only in the simulator"), "{e}");
+        #[cfg(not(feature = "v4l"))]
+        {
+            let e = open_camera(&station.camera).unwrap_err().to_string();
+            assert!(e.contains("rebuild with `--features v4l`"), "{e}");
+        }
+    }
+}

@@ -1,0 +1,263 @@
+//! `campanile capture` end to end. Disk full: a simulated session
+//! on a directory with a byte quota stops cleanly with a clear message and
+//! a valid journal; `campanile capture --resume DIR` alone (the plan and
+//! station from the session's snapshots), with the space freed, completes
+//! it: every shot of an uninterrupted run once, in order, the frames
+//! before the stop untouched. A resume given another station than the
+//! snapshot's is refused.
+
+mod common;
+
+use campanile_capture::store::{JournalEntry, SessionStore};
+use common::campanile;
+use std::path::Path;
+
+/// The example station with 48×36 frames.
+fn write_inputs(dir: &Path) -> (String, String) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let station = std::fs::read_to_string(root.join("examples/sim-station.ron"))
+        .unwrap()
+        .replace(
+            "resolution: (width: 256, height: 192)",
+            "resolution: (width: 48, height: 36)",
+        );
+    assert!(
+        station.contains("width: 48"),
+        "the example station's resolution line moved"
+    );
+    let scene = root.join("examples/campanile-scene.ron");
+    let plan = format!(
+        r#"Plan(
+    name: "disk test",
+    start_date: "2026-08-28",
+    scene: Some({scene:?}),
+    sessions: [(
+        name: "one",
+        trigger: Clock(time: "20:00:00"),
+        steps: [
+            Bracket(aim: PanTilt(pan_deg: 10.0, tilt_deg: 15.0), exposures_s: [0.0005, 0.002, 0.008, 0.032]),
+            Bracket(aim: PanTilt(pan_deg: 100.0, tilt_deg: 5.0), exposures_s: [0.001, 0.004, 0.016, 0.064]),
+        ],
+    )],
+)"#
+    );
+    let (p, s) = (dir.join("plan.ron"), dir.join("station.ron"));
+    std::fs::write(&p, plan).unwrap();
+    std::fs::write(&s, station).unwrap();
+    (p.display().to_string(), s.display().to_string())
+}
+
+/// (key, crc) of every frame journaled, in order.
+fn frames(dir: &Path) -> Vec<(String, u32)> {
+    let (store, _) = SessionStore::resume(dir).unwrap();
+    store
+        .entries()
+        .iter()
+        .filter_map(|e| match e {
+            JournalEntry::Done(f) | JournalEntry::Late(f) => Some((f.key.clone(), f.crc32c)),
+            JournalEntry::Missed(_) => None,
+        })
+        .collect()
+}
+
+fn dir_size(dir: &Path) -> u64 {
+    let mut total = 0;
+    for e in std::fs::read_dir(dir).unwrap() {
+        let e = e.unwrap();
+        let m = e.metadata().unwrap();
+        total += if m.is_dir() { dir_size(&e.path()) } else { m.len() };
+    }
+    total
+}
+
+#[test]
+fn a_full_disk_stops_cleanly_and_resume_alone_completes_the_session() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (plan, station) = write_inputs(tmp.path());
+
+    // The uninterrupted run.
+    let whole = tmp.path().join("whole");
+    let out = campanile(&[
+        "-q",
+        "capture",
+        &plan,
+        "--station",
+        &station,
+        "--out",
+        whole.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let reference = frames(&whole);
+    assert_eq!(reference.len(), 8);
+
+    // Half the space the whole session needs.
+    let quota = dir_size(&whole) / 2;
+    let dir = tmp.path().join("full");
+    let out = campanile(&[
+        "-q",
+        "capture",
+        &plan,
+        "--station",
+        &station,
+        "--out",
+        dir.to_str().unwrap(),
+        "--sim-disk-quota",
+        &quota.to_string(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("disk full while writing"), "{stderr}");
+    assert!(
+        stderr.contains(&format!("campanile capture --resume {}", dir.display())),
+        "{stderr}"
+    );
+    // The journal is valid and holds a prefix of the uninterrupted run.
+    let partial = frames(&dir);
+    assert!(!partial.is_empty() && partial.len() < reference.len(), "{partial:?}");
+    assert_eq!(partial[..], reference[..partial.len()]);
+    assert!(dir_size(&dir) <= quota, "{} > {quota}", dir_size(&dir));
+
+    // Given another station than the snapshot's, a resume is refused.
+    let other = tmp.path().join("other-station.ron");
+    std::fs::write(
+        &other,
+        std::fs::read_to_string(&station).unwrap().replace("seed: 1", "seed: 2"),
+    )
+    .unwrap();
+    let out = campanile(&[
+        "capture",
+        &plan,
+        "--station",
+        other.to_str().unwrap(),
+        "--resume",
+        dir.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("began with another plan or station"), "{stderr}");
+
+    // Space freed: `--resume DIR` alone completes the session.
+    let out = campanile(&["-q", "capture", "--resume", dir.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("with its own plan.ron and station.ron"), "{stderr}");
+    // Every shot once, in order; the frames stored before the stop are
+    // untouched. (The shots after it are taken later on the simulated
+    // calendar than in the uninterrupted run, so under the moving sun
+    // their pixels differ: the keys are compared, not their checksums.)
+    let done = frames(&dir);
+    let keys = |v: &[(String, u32)]| v.iter().map(|(k, _)| k.clone()).collect::<Vec<_>>();
+    assert_eq!(keys(&done), keys(&reference));
+    assert_eq!(done[..partial.len()], partial[..]);
+    let verify = SessionStore::resume(&dir).unwrap().0.verify().unwrap();
+    assert!(verify.is_ok());
+    assert_eq!(verify.frames_checked, 8);
+}
+
+#[test]
+fn fault_flags_are_checked() {
+    for (flag, value, expected) in [
+        (
+            "--sim-camera-timeout-chance",
+            "1.5",
+            "expected a chance between 0 and 1",
+        ),
+        ("--sim-outage", "tripod:1:2", "expected DEVICE:AFTER_S:DURATION_S"),
+        ("--sim-outage", "head:-1:2", "expected DEVICE:AFTER_S:DURATION_S"),
+    ] {
+        let out = campanile(&[
+            "capture",
+            "examples/campanile-day.ron",
+            "--station",
+            "examples/sim-station.ron",
+            "--out",
+            "/nonexistent/never",
+            flag,
+            value,
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flag} {value}: {stderr}");
+        assert!(stderr.contains(expected), "{flag} {value}: {stderr}");
+    }
+    // Fault flags on a real station are a usage error.
+    let out = campanile(&[
+        "capture",
+        "examples/campanile-day.ron",
+        "--station",
+        "examples/real-station.ron",
+        "--out",
+        "/nonexistent/never",
+        "--sim-camera-timeout-chance",
+        "0.1",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("are for simulated stations"), "{stderr}");
+}
+
+/// The camera-timeout and outage flags reach the simulated station: with a
+/// fifth of the frames timing out and the head away for 10 s just after
+/// the session starts, every frame is still stored, through retries and a
+/// reconnect that the summary counts.
+#[test]
+fn camera_timeouts_and_a_head_outage_from_the_command_line() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (plan, station) = write_inputs(tmp.path());
+    let dir = tmp.path().join("faults");
+    let out = campanile(&[
+        "-q",
+        "capture",
+        &plan,
+        "--station",
+        &station,
+        "--out",
+        dir.to_str().unwrap(),
+        "--sim-camera-timeout-chance",
+        "0.2",
+        "--sim-outage",
+        "head:61:10",
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let line = stdout.lines().find(|l| l.contains("this run")).expect("a summary line");
+    let count = |what: &str| -> usize {
+        let words: Vec<&str> = line.split([' ', ',']).filter(|w| !w.is_empty()).collect();
+        let i = words.iter().position(|w| *w == what).expect(what);
+        words[i - 1].parse().unwrap()
+    };
+    println!("{line}");
+    assert_eq!(count("frames"), 8, "{line}");
+    assert!(count("retries") >= 2, "{line}");
+    assert!(count("reconnects") >= 1, "{line}");
+    assert_eq!(frames(&dir).len(), 8);
+}
+
+/// A real station in a build without its camera driver: nothing is
+/// opened or created, and the message says how to get the driver.
+#[test]
+fn a_real_station_without_its_camera_driver_is_refused_clearly() {
+    if cfg!(feature = "v4l") {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("real");
+    let out = campanile(&[
+        "capture",
+        "examples/campanile-day.ron",
+        "--station",
+        "examples/real-station.ron",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("opening the camera of station examples/real-station.ron: camera failure: this campanile was built without the V4L2 camera driver; rebuild with `--features v4l`"),
+        "{stderr}"
+    );
+    assert!(!dir.exists(), "no session directory is made");
+}
