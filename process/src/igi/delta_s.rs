@@ -17,16 +17,19 @@ use super::geometry::{Geometry, SURFACE_OFFSET};
 use super::input::IgiInput;
 use super::observation::Observation;
 use super::radiosity::RadiosityField;
+use super::specular_albedo::SpecularAlbedo;
 use crate::brdf::{WardLobe, WardMaterial};
 use crate::render::Ray;
 
 /// `S_ind` per channel for every observation, with the lobe shape
 /// `shapes[surface]` (`None`: no specular term, zero).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn indirect_specular(
     geometry: &Geometry,
     input: &IgiInput,
     field: &RadiosityField,
     materials: &[Option<WardMaterial>],
+    albedos: &[Option<SpecularAlbedo>],
     observations: &[Observation],
     shapes: &[Option<WardLobe>],
     rays: u32,
@@ -62,7 +65,7 @@ pub(crate) fn indirect_specular(
                 let Some(hit) = geometry.intersect(&Ray { origin, direction }, f64::INFINITY) else {
                     continue;
                 };
-                let l = field.radiance_toward(geometry, input, materials, hit.triangle, &hit.point, &-direction);
+                let l = field.radiance_toward(geometry, input, materials, albedos, hit.triangle, &hit.point, &-direction);
                 for c in 0..3 {
                     sum[c] += weight * l[c];
                 }

@@ -27,6 +27,7 @@ pub mod input;
 mod observation;
 mod radiosity;
 mod recover;
+mod specular_albedo;
 pub mod table;
 mod ward_fit;
 

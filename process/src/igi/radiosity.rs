@@ -6,13 +6,14 @@
 //!
 //! The radiance leaving a point y toward a point x is modelled as
 //!
-//! `L(y→x) = B(y) + ρs(y) [Σₗ K(ωₗ, ω_x) Iₗ cos θₗ / dₗ² + a E_ind(y) / π]`
+//! `L(y→x) = B(y) + ρs(y) [Σₗ K(ωₗ, ω_x) Iₗ cos θₗ / dₗ² + a(ω_x) E_ind(y) / π]`
 //!
 //! with `B` the cell's diffuse radiance (measured), the direct highlight of
 //! each light toward x (which is what makes a glossy wall throw a bright
 //! spot on its neighbours: the "mirror cones" of §4.5.1), and the lobe's
 //! reflection of the cell's own indirect light taken as diffuse (second
-//! order: ρs times the small variation of the indirect light). The
+//! order: ρs times the small variation of the indirect light), with the
+//! lobe's directional albedo `a` toward x ([`SpecularAlbedo`]). The
 //! indirect irradiance of a cell is the cell-average of `∫ L(y→x) cos θ dω`,
 //! estimated from `gather_rays` cosine-distributed rays leaving points
 //! drawn uniformly over the cell, so that a sharp bright spot narrower than
@@ -26,6 +27,7 @@ use rayon::prelude::*;
 use super::geometry::{Geometry, SURFACE_OFFSET};
 use super::input::IgiInput;
 use super::observation::light_terms;
+use super::specular_albedo::SpecularAlbedo;
 use crate::brdf::{WardMaterial, cosine_direction};
 use crate::render::Ray;
 
@@ -87,6 +89,7 @@ impl RadiosityField {
         geometry: &Geometry,
         input: &IgiInput,
         materials: &[Option<WardMaterial>],
+        albedos: &[Option<SpecularAlbedo>],
         tri: usize,
         y: &Vector3<f64>,
         toward: &Vector3<f64>,
@@ -113,8 +116,9 @@ impl RadiosityField {
                 k[c] += kernel * light.intensity[c];
             }
         }
+        let a = albedos.get(surface).and_then(|a| a.as_ref()).map_or(1.0, |a| a.at(&wo));
         for c in 0..3 {
-            l[c] += lobe.rho_s[c] * (k[c] + self.e_indirect[cell][c] * std::f64::consts::FRAC_1_PI);
+            l[c] += lobe.rho_s[c] * (k[c] + a * self.e_indirect[cell][c] * std::f64::consts::FRAC_1_PI);
         }
         l
     }
@@ -126,6 +130,7 @@ impl RadiosityField {
         geometry: &Geometry,
         input: &IgiInput,
         materials: &[Option<WardMaterial>],
+        albedos: &[Option<SpecularAlbedo>],
         rays: u32,
         seed: u64,
     ) {
@@ -161,7 +166,7 @@ impl RadiosityField {
                     let Some(hit) = geometry.intersect(&Ray { origin, direction }, f64::INFINITY) else {
                         continue;
                     };
-                    let l = self.radiance_toward(geometry, input, materials, hit.triangle, &hit.point, &-direction);
+                    let l = self.radiance_toward(geometry, input, materials, albedos, hit.triangle, &hit.point, &-direction);
                     for c in 0..3 {
                         sum[c] += l[c];
                     }

@@ -18,6 +18,7 @@ use super::highlight::{DetectorSample, HighlightReport, detect};
 use super::input::{IgiInput, IgiOptions};
 use super::observation::{DroppedPixels, Observation, observations};
 use super::radiosity::RadiosityField;
+use super::specular_albedo::SpecularAlbedo;
 use super::delta_s::indirect_specular;
 use super::ward_fit::{FitSample, Shape, anisotropic, isotropic, linear_fit};
 use crate::brdf::{WardLobe, WardMaterial, WardVariant};
@@ -172,10 +173,14 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
         let seed = options.seed.wrapping_add(u64::from(it) * 0x9e37_79b9);
         // (1) Diffuse radiance per cell: measured minus the specular estimate.
         estimate_diffuse(&mut field, &geometry, &obs, &materials, &kind_ind);
+        let albedos: Vec<Option<SpecularAlbedo>> = materials
+            .par_iter()
+            .map(|m| m.and_then(|m| m.lobe).map(|l| SpecularAlbedo::new(&l)))
+            .collect();
         // (2) Indirect irradiance per cell.
-        field.gather(&geometry, input, &materials, options.gather_rays, seed);
+        field.gather(&geometry, input, &materials, &albedos, options.gather_rays, seed);
         // (3) ΔS at every sample.
-        kind_ind = indirect_specular(&geometry, input, &field, &materials, &obs, &shapes, options.lobe_rays, seed ^ 0x5555);
+        kind_ind = indirect_specular(&geometry, input, &field, &materials, &albedos, &obs, &shapes, options.lobe_rays, seed ^ 0x5555);
         if it == 0 {
             for s in 0..n_surf {
                 let samples: Vec<DetectorSample> = by_surface[s]
