@@ -2,7 +2,13 @@
 //! photographs the cube (twelve views), recovers the six walls' Ward BRDFs
 //! and prints them in the layout of Table 4.1 with the thesis's errors.
 //!
-//! `cargo run --release -p campanile-sim --example igi_cube [-- SAMPLES ITERATIONS]`
+//! `cargo run --release -p campanile-sim --example igi_cube [-- SAMPLES ITERATIONS [GATHER_RAYS LOBE_RAYS CELLS SEED [WIDE_PX HIGHLIGHT_PX [SPARSE]]]]`
+//!
+//! SAMPLES: indirect samples per pixel of the photographs (16); ITERATIONS:
+//! ΔS iterations (4); then the solver's gather rays per cell (256), lobe
+//! rays per sample (16), cells per triangle edge (24) and seed (1); then
+//! the sizes of the wide and highlight views (96 and 64 pixels square), and
+//! the sparse set's size per surface (2500).
 
 use std::time::Instant;
 
@@ -14,11 +20,12 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let samples: u32 = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(16);
     let iterations: u32 = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(4);
+    let size = |i: usize, default: usize| args.get(i).and_then(|a| a.parse().ok()).unwrap_or(default);
     let cube = CubeRoom::new(1.0);
     let t0 = Instant::now();
     let input = cube.igi_input(
-        96,
-        64,
+        size(7, 96),
+        size(8, 64),
         &PhotoSettings {
             indirect_samples: samples,
             max_bounces: 6,
@@ -26,9 +33,16 @@ fn main() {
         },
     );
     let photo_s = t0.elapsed().as_secs_f64();
+    let d = IgiOptions::default();
+    let arg = |i: usize, default: u64| args.get(i).and_then(|a| a.parse().ok()).unwrap_or(default);
     let options = IgiOptions {
         iterations,
-        ..IgiOptions::default()
+        gather_rays: arg(3, u64::from(d.gather_rays)) as u32,
+        lobe_rays: arg(4, u64::from(d.lobe_rays)) as u32,
+        cells_per_edge: arg(5, d.cells_per_edge as u64) as usize,
+        seed: arg(6, d.seed),
+        sparse_samples: arg(9, d.sparse_samples as u64) as usize,
+        ..d
     };
     let result = match recover(&input, &options) {
         Ok(r) => r,

@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use super::geometry::{Geometry, SURFACE_OFFSET};
 use super::input::IgiInput;
 use super::observation::Observation;
-use super::radiosity::RadiosityField;
+use super::radiosity::{REFLECTION_DEPTH, RadiosityField};
 use super::specular_albedo::SpecularAlbedo;
 use crate::brdf::{WardLobe, WardMaterial};
 use crate::render::Ray;
@@ -65,7 +65,17 @@ pub(crate) fn indirect_specular(
                 let Some(hit) = geometry.intersect(&Ray { origin, direction }, f64::INFINITY) else {
                     continue;
                 };
-                let l = field.radiance_toward(geometry, input, materials, albedos, hit.triangle, &hit.point, &-direction);
+                let l = field.radiance_toward(
+                    geometry,
+                    input,
+                    materials,
+                    albedos,
+                    hit.triangle,
+                    &hit.point,
+                    &-direction,
+                    REFLECTION_DEPTH,
+                    &mut rng,
+                );
                 for c in 0..3 {
                     sum[c] += weight * l[c];
                 }

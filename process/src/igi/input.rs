@@ -64,6 +64,9 @@ pub struct IgiOptions {
     pub gather_rays: u32,
     /// Lobe-sampled rays per sample for the indirect specular term ΔS.
     pub lobe_rays: u32,
+    /// At most this many samples per surface in the sparse set the
+    /// roughness search uses (§4.5 footnote); the linear step uses all.
+    pub sparse_samples: usize,
     /// ΔS iterations (§4.5.1, Fig. 4.6): each re-estimates the diffuse
     /// radiance, the indirect light and the BRDFs.
     pub iterations: u32,
@@ -83,6 +86,7 @@ impl Default for IgiOptions {
             cells_per_edge: 24,
             gather_rays: 256,
             lobe_rays: 16,
+            sparse_samples: 2500,
             iterations: 4,
             max_view_angle_rad: 84f64.to_radians(),
             allow_anisotropic: true,
@@ -106,6 +110,9 @@ impl IgiOptions {
         }
         if self.lobe_rays == 0 {
             return err("lobe_rays", "0".into(), "at least 1");
+        }
+        if self.sparse_samples < 16 {
+            return err("sparse_samples", self.sparse_samples.to_string(), "at least 16");
         }
         if !(self.max_view_angle_rad > 0.0 && self.max_view_angle_rad < std::f64::consts::FRAC_PI_2) {
             return err(

@@ -11,9 +11,10 @@
 //! with `B` the cell's diffuse radiance (measured), the direct highlight of
 //! each light toward x (which is what makes a glossy wall throw a bright
 //! spot on its neighbours: the "mirror cones" of §4.5.1), and the lobe's
-//! reflection of the cell's own indirect light taken as diffuse (second
-//! order: ρs times the small variation of the indirect light), with the
-//! lobe's directional albedo `a` toward x ([`SpecularAlbedo`]). The
+//! reflection of the light arriving at y from elsewhere, followed by one
+//! lobe-sampled ray (a glossy floor mirrors the bright patch under a lamp),
+//! and beyond that taken as `a E_ind(y) / π` with `a` the lobe's
+//! directional albedo toward x ([`SpecularAlbedo`]). The
 //! indirect irradiance of a cell is the cell-average of `∫ L(y→x) cos θ dω`,
 //! estimated from `gather_rays` cosine-distributed rays leaving points
 //! drawn uniformly over the cell, so that a sharp bright spot narrower than
@@ -30,6 +31,10 @@ use super::observation::light_terms;
 use super::specular_albedo::SpecularAlbedo;
 use crate::brdf::{WardMaterial, cosine_direction};
 use crate::render::Ray;
+
+/// Glossy reflections followed per gather ray (module doc of
+/// [`RadiosityField::radiance_toward`]).
+pub(crate) const REFLECTION_DEPTH: u32 = 1;
 
 /// Per-cell quantities of the radiosity solution.
 #[derive(Debug, Clone)]
@@ -83,7 +88,12 @@ impl RadiosityField {
     }
 
     /// The radiance leaving point `y` of triangle `tri` in unit direction
-    /// `toward` (world), under the surface estimates `materials` (module doc).
+    /// `toward` (world), under the surface estimates `materials` (module
+    /// doc). With `depth` > 0, the lobe's reflection of indirect light is
+    /// estimated by one lobe-sampled ray (a glossy wall mirrors the bright
+    /// patch under a lamp, not the average of its surroundings), recursively
+    /// with `depth − 1`; at depth 0 it is `a E_ind / π`.
+    #[allow(clippy::too_many_arguments)]
     pub fn radiance_toward(
         &self,
         geometry: &Geometry,
@@ -93,6 +103,8 @@ impl RadiosityField {
         tri: usize,
         y: &Vector3<f64>,
         toward: &Vector3<f64>,
+        depth: u32,
+        rng: &mut ChaCha8Rng,
     ) -> [f64; 3] {
         let cell = geometry.cell(tri, y);
         let mut l = self.diffuse[cell];
@@ -116,9 +128,38 @@ impl RadiosityField {
                 k[c] += kernel * light.intensity[c];
             }
         }
-        let a = albedos.get(surface).and_then(|a| a.as_ref()).map_or(1.0, |a| a.at(&wo));
+        let reflected = if depth > 0 {
+            let mut r = [0.0; 3];
+            let u = [rng.random::<f64>(), rng.random::<f64>()];
+            if let Some(wi) = lobe.sample(&wo, u) {
+                let pdf = lobe.pdf(&wi, &wo);
+                if pdf > 0.0 && pdf.is_finite() {
+                    let weight = lobe.kernel(&wi, &wo) * wi.z / pdf;
+                    let direction = frame.to_world(&wi);
+                    let origin = y + frame.normal * SURFACE_OFFSET * (1.0 + y.norm());
+                    if let Some(hit) = geometry.intersect(&Ray { origin, direction }, f64::INFINITY) {
+                        let li = self.radiance_toward(
+                            geometry,
+                            input,
+                            materials,
+                            albedos,
+                            hit.triangle,
+                            &hit.point,
+                            &-direction,
+                            depth - 1,
+                            rng,
+                        );
+                        r = li.map(|v| v * weight);
+                    }
+                }
+            }
+            r
+        } else {
+            let a = albedos.get(surface).and_then(|a| a.as_ref()).map_or(1.0, |a| a.at(&wo));
+            self.e_indirect[cell].map(|e| a * e * std::f64::consts::FRAC_1_PI)
+        };
         for c in 0..3 {
-            l[c] += lobe.rho_s[c] * (k[c] + a * self.e_indirect[cell][c] * std::f64::consts::FRAC_1_PI);
+            l[c] += lobe.rho_s[c] * (k[c] + reflected[c]);
         }
         l
     }
@@ -166,7 +207,17 @@ impl RadiosityField {
                     let Some(hit) = geometry.intersect(&Ray { origin, direction }, f64::INFINITY) else {
                         continue;
                     };
-                    let l = self.radiance_toward(geometry, input, materials, albedos, hit.triangle, &hit.point, &-direction);
+                    let l = self.radiance_toward(
+                        geometry,
+                        input,
+                        materials,
+                        albedos,
+                        hit.triangle,
+                        &hit.point,
+                        &-direction,
+                        REFLECTION_DEPTH,
+                        &mut rng,
+                    );
                     for c in 0..3 {
                         sum[c] += l[c];
                     }

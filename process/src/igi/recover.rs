@@ -107,9 +107,6 @@ pub struct IgiResult {
 /// The roughness assumed for the first ΔS estimate (App. A: "an initial value between 0.1 and 0.2").
 const INITIAL_ALPHA: f64 = 0.15;
 
-/// At most this many samples per surface in the sparse set.
-const SPARSE_TARGET: usize = 2500;
-
 /// Samples whose half vector is within this of the normal for some light
 /// are kept preferentially in the sparse set: 10°.
 const SPARSE_HIGHLIGHT_RAD: f64 = 0.174_532_925_199_432_95;
@@ -208,7 +205,7 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
                     .iter()
                     .map(|&i| fit_sample(&obs[i], &field, kind_ind[i], materials[s].as_ref()))
                     .collect();
-                let sparse = sparse_set(&by_surface[s], &obs, &samples);
+                let sparse = sparse_set(&by_surface[s], &obs, &samples, options.sparse_samples);
                 fit_surface(&samples, &sparse, &highlights[s], options, previous.get(s))
             })
             .collect();
@@ -321,9 +318,10 @@ fn specular_radiance(o: &Observation, m: Option<&WardMaterial>, kind: [f64; 3]) 
 
 /// Step (1): each cell's diffuse radiance, the weighted mean over its
 /// observations of measured minus estimated specular radiance (§4.6:
-/// weights fall with the specular share and with the viewing angle);
-/// cells no camera sees take ρd E / π from the estimate, or their
-/// surface's mean.
+/// weights fall with the specular share and with the viewing angle),
+/// blended toward the estimate's ρd E / π by how much of the cell's light
+/// is specular; cells no camera sees take ρd E / π from the estimate, or
+/// their surface's mean.
 fn estimate_diffuse(
     field: &mut RadiosityField,
     geometry: &Geometry,
@@ -334,6 +332,7 @@ fn estimate_diffuse(
     let n = geometry.cell_count();
     let mut sum = vec![[0.0; 3]; n];
     let mut wsum = vec![0.0; n];
+    let mut cos_sum = vec![0.0; n];
     for (i, o) in obs.iter().enumerate() {
         let m = materials[o.surface].as_ref();
         let s = specular_radiance(o, m, kind[i]);
@@ -345,6 +344,7 @@ fn estimate_diffuse(
             sum[o.cell][c] += w * d[c];
         }
         wsum[o.cell] += w;
+        cos_sum[o.cell] += o.wo.z;
     }
     let mut surface_mean = vec![([0.0; 3], 0.0); materials.len()];
     for cell in 0..n {
@@ -359,14 +359,26 @@ fn estimate_diffuse(
         }
     }
     for cell in 0..n {
+        let s = geometry.triangles()[geometry.cell_triangle(cell)].surface as usize;
+        let model = materials[s].as_ref().map(|m| {
+            [0, 1, 2].map(|c| {
+                m.rho_d[c] * (field.e_direct[cell][c] + field.e_indirect[cell][c]) * std::f64::consts::FRAC_1_PI
+            })
+        });
         if field.observed[cell] {
+            // Where the highlight dominates every view of the cell, the
+            // measured diffuse part is a small difference of large numbers:
+            // lean on the model there, by the mean squared diffuse share.
+            if let Some(model) = model {
+                let r = (wsum[cell] / cos_sum[cell]).clamp(0.0, 1.0);
+                for c in 0..3 {
+                    field.diffuse[cell][c] = r * field.diffuse[cell][c] + (1.0 - r) * model[c];
+                }
+            }
             continue;
         }
-        let s = geometry.triangles()[geometry.cell_triangle(cell)].surface as usize;
-        field.diffuse[cell] = match &materials[s] {
-            Some(m) => [0, 1, 2].map(|c| {
-                m.rho_d[c] * (field.e_direct[cell][c] + field.e_indirect[cell][c]) * std::f64::consts::FRAC_1_PI
-            }),
+        field.diffuse[cell] = match model {
+            Some(m) => m,
             None if surface_mean[s].1 > 0.0 => surface_mean[s].0.map(|v| v / surface_mean[s].1),
             None => [0.0; 3],
         };
@@ -397,18 +409,18 @@ fn fit_sample(o: &Observation, field: &RadiosityField, kind: [f64; 3], previous:
 }
 
 /// The sparse set (§4.5 footnote): every sample near a mirror direction,
-/// thinned evenly so that the set stays near [`SPARSE_TARGET`], plus an
+/// thinned evenly so that the set stays near `target`, plus an
 /// even share of the rest.
-fn sparse_set(indices: &[usize], obs: &[Observation], samples: &[FitSample]) -> Vec<FitSample> {
+fn sparse_set(indices: &[usize], obs: &[Observation], samples: &[FitSample], target: usize) -> Vec<FitSample> {
     let near: Vec<usize> = (0..indices.len())
         .filter(|&k| obs[indices[k]].lights.iter().any(|t| t.delta < SPARSE_HIGHLIGHT_RAD))
         .collect();
     let far: Vec<usize> = (0..indices.len())
         .filter(|&k| !obs[indices[k]].lights.iter().any(|t| t.delta < SPARSE_HIGHLIGHT_RAD))
         .collect();
-    let half = SPARSE_TARGET / 2;
+    let half = target / 2;
     let near_stride = near.len().div_ceil(half).max(1);
-    let far_stride = far.len().div_ceil(SPARSE_TARGET - near.len().min(half)).max(1);
+    let far_stride = far.len().div_ceil(target - near.len().min(half)).max(1);
     near.iter()
         .step_by(near_stride)
         .chain(far.iter().step_by(far_stride))
