@@ -4,7 +4,7 @@
 //!
 //! `cargo run --release -p campanile-sim --example igi_cube [-- SAMPLES ITERATIONS [GATHER_RAYS LOBE_RAYS CELLS SEED [WIDE_PX HIGHLIGHT_PX [SPARSE]]]]`
 //!
-//! SAMPLES: indirect samples per pixel of the photographs (16); ITERATIONS:
+//! SAMPLES: indirect samples per pixel of the photographs (32); ITERATIONS:
 //! ΔS iterations (4); then the solver's gather rays per cell (256), lobe
 //! rays per sample (16), cells per triangle edge (24) and seed (1); then
 //! the sizes of the wide and highlight views (96 and 64 pixels square), and
@@ -12,13 +12,14 @@
 
 use std::time::Instant;
 
-use campanile_process::igi::{IgiOptions, format_table, recover, table::THESIS_TABLE_4_1_ERRORS_PCT};
+use campanile_process::igi::table::{THESIS_TABLE_4_1_ERRORS_PCT, errors};
+use campanile_process::igi::{IgiOptions, format_table, recover};
 use campanile_sim::world::cube_room::CubeRoom;
 use campanile_sim::world::igi_photograph::PhotoSettings;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let samples: u32 = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(16);
+    let samples: u32 = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(32);
     let iterations: u32 = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(4);
     let size = |i: usize, default: usize| args.get(i).and_then(|a| a.parse().ok()).unwrap_or(default);
     let cube = CubeRoom::new(1.0);
@@ -54,10 +55,27 @@ fn main() {
     let truth: Vec<_> = cube.materials.iter().copied().map(Some).collect();
     println!("{}", format_table(&result, &truth, Some(&THESIS_TABLE_4_1_ERRORS_PCT)));
     for (k, it) in result.iterations.iter().enumerate() {
-        println!("ΔS iteration {}: max relative change {:.2e}, {:.2} s", k + 1, it.max_relative_change, it.seconds);
+        println!(
+            "ΔS iteration {}: max relative change {:.2e}, {:.2} s",
+            k + 1,
+            it.max_relative_change,
+            it.seconds
+        );
+    }
+    let mut worst = [0.0f64; 5];
+    for (r, t) in result.surfaces.iter().zip(&cube.materials) {
+        if let Some(m) = &r.material {
+            for (w, e) in worst.iter_mut().zip(errors(m, t)) {
+                *w = w.max(e.unwrap_or(0.0));
+            }
+        }
     }
     println!(
         "photographs: {samples} indirect samples/pixel, {photo_s:.2} s; recovery: {:.2} s",
         result.seconds
+    );
+    println!(
+        "worst: rho_d {:.2} %, rho_s {:.2} %, alpha_x {:.2} %, alpha_y {:.2} %, gamma {:.3} deg",
+        worst[0], worst[1], worst[2], worst[3], worst[4]
     );
 }

@@ -14,7 +14,7 @@ fn the_unit_cube_walls_are_recovered_within_one_percent() {
         96,
         64,
         &PhotoSettings {
-            indirect_samples: 16,
+            indirect_samples: 32,
             max_bounces: 6,
             seed: 7,
         },
@@ -36,7 +36,11 @@ fn the_unit_cube_walls_are_recovered_within_one_percent() {
         let e = errors(&m, truth);
         for k in 0..4 {
             let v = e[k].unwrap();
-            assert!(v.is_finite() && v < 1.0, "{} parameter {k}: {v:.3} % off ({m:?})", r.name);
+            assert!(
+                v.is_finite() && v < 1.0,
+                "{} parameter {k}: {v:.3} % off ({m:?})",
+                r.name
+            );
             worst[k] = worst[k].max(v);
         }
         if expected[i] == SurfaceModel::Anisotropic {
@@ -45,5 +49,8 @@ fn the_unit_cube_walls_are_recovered_within_one_percent() {
             worst[4] = worst[4].max(g);
         }
     }
-    eprintln!("worst errors: ρd {:.2} %, ρs {:.2} %, αx {:.2} %, αy {:.2} %, γ {:.3}°", worst[0], worst[1], worst[2], worst[3], worst[4]);
+    eprintln!(
+        "worst errors: ρd {:.2} %, ρs {:.2} %, αx {:.2} %, αy {:.2} %, γ {:.3}°",
+        worst[0], worst[1], worst[2], worst[3], worst[4]
+    );
 }

@@ -43,13 +43,21 @@ impl ViewCamera {
             return Err(err("look", format!("{:?}", self.look), "a finite non-zero direction"));
         }
         if !finite(&self.up) || self.look.normalize().cross(&self.up).norm() < 1e-9 * self.up.norm().max(1e-300) {
-            return Err(err("up", format!("{:?}", self.up), "a finite direction not parallel to look"));
+            return Err(err(
+                "up",
+                format!("{:?}", self.up),
+                "a finite direction not parallel to look",
+            ));
         }
         if !(self.vfov_rad > 0.0 && self.vfov_rad < std::f64::consts::PI) {
             return Err(err("vfov", format!("{} rad", self.vfov_rad), "an angle in (0, 180°)"));
         }
         if self.width == 0 || self.height == 0 {
-            return Err(err("resolution", format!("{}x{}", self.width, self.height), "at least 1x1 pixels"));
+            return Err(err(
+                "resolution",
+                format!("{}x{}", self.width, self.height),
+                "at least 1x1 pixels",
+            ));
         }
         Ok(())
     }
@@ -87,7 +95,10 @@ impl ViewCamera {
         }
         let x = d.dot(&r) / z / (t * aspect);
         let y = d.dot(&u) / z / t;
-        Some(((x + 1.0) * 0.5 * self.width as f64, (1.0 - y) * 0.5 * self.height as f64))
+        Some((
+            (x + 1.0) * 0.5 * self.width as f64,
+            (1.0 - y) * 0.5 * self.height as f64,
+        ))
     }
 }
 

@@ -25,7 +25,9 @@ pub enum IgiError {
         expected: &'static str,
     },
     /// The image does not have the camera's size.
-    #[error("view {view:?}: the image is {got_width}x{got_height} (with {got_values} values) but the camera is {width}x{height}: expected width x height x 3 values")]
+    #[error(
+        "view {view:?}: the image is {got_width}x{got_height} (with {got_values} values) but the camera is {width}x{height}: expected width x height x 3 values"
+    )]
     ImageSize {
         /// The view's name.
         view: String,
@@ -51,7 +53,9 @@ pub enum IgiError {
         expected: usize,
     },
     /// A radiance that is negative or not finite, on a pixel not masked out.
-    #[error("view {view:?}, pixel ({x}, {y}), channel {channel}: radiance {value}: expected a finite value >= 0 (mask the pixel out if it is invalid)")]
+    #[error(
+        "view {view:?}, pixel ({x}, {y}), channel {channel}: radiance {value}: expected a finite value >= 0 (mask the pixel out if it is invalid)"
+    )]
     Radiance {
         /// The view's name.
         view: String,

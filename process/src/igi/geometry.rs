@@ -13,12 +13,15 @@ use crate::render::{Material, Ray, Scene, SurfaceHit, Triangle};
 /// Offset of a ray origin off the surface it leaves, metres.
 pub(crate) const SURFACE_OFFSET: f64 = 1e-6;
 
+/// A triangle's corner 0, its two edges, and the inverse of their Gram matrix.
+type Corner = (Vector3<f64>, Vector3<f64>, Vector3<f64>, [f64; 3]);
+
 /// Triangles, a ray-casting index and the cell grid.
 #[derive(Debug, Clone)]
 pub(crate) struct Geometry {
     scene: Scene,
     /// Per triangle: corner 0, the edges, and the inverse Gram matrix.
-    corners: Vec<(Vector3<f64>, Vector3<f64>, Vector3<f64>, [f64; 3])>,
+    corners: Vec<Corner>,
     /// Cells per triangle edge.
     pub n: usize,
 }
@@ -47,7 +50,11 @@ impl Geometry {
                 (t.vertices[0], e1, e2, [c / det, -b / det, a / det])
             })
             .collect();
-        let scene = Scene::new(tris, vec![Material::diffuse("placeholder", [0.0; 3])], surfaces.to_vec())?;
+        let scene = Scene::new(
+            tris,
+            vec![Material::diffuse("placeholder", [0.0; 3])],
+            surfaces.to_vec(),
+        )?;
         Ok(Geometry { scene, corners, n })
     }
 
@@ -121,7 +128,11 @@ impl Geometry {
     /// (tangent = the face's texture `s` axis, as the renderer uses).
     pub fn frame(&self, tri: usize, toward: &Vector3<f64>) -> ShadingFrame {
         let t = &self.triangles()[tri];
-        let n = if t.normal.dot(toward) >= 0.0 { t.normal } else { -t.normal };
+        let n = if t.normal.dot(toward) >= 0.0 {
+            t.normal
+        } else {
+            -t.normal
+        };
         ShadingFrame::new(n, t.texture_axes[0]).unwrap_or(ShadingFrame {
             normal: Vector3::z(),
             tangent: Vector3::x(),
@@ -137,7 +148,11 @@ mod tests {
     #[test]
     fn cells_cover_the_triangle_and_find_their_points() {
         let t = Triangle::new(
-            [Vector3::zeros(), Vector3::new(2.0, 0.0, 0.0), Vector3::new(0.0, 1.0, 0.0)],
+            [
+                Vector3::zeros(),
+                Vector3::new(2.0, 0.0, 0.0),
+                Vector3::new(0.0, 1.0, 0.0),
+            ],
             3,
             0,
         )

@@ -84,7 +84,11 @@ pub(crate) fn detect(samples: &[DetectorSample]) -> Vec<HighlightReport> {
             r.min_delta_deg = r.min_delta_deg.min(delta.to_degrees());
             let predicted = rho * s.diffuse;
             // A zero prediction with light arriving is an unbounded excess; cap it.
-            r.excess += if predicted > 0.0 { s.radiance / predicted - 1.0 } else { 1e6 };
+            r.excess += if predicted > 0.0 {
+                s.radiance / predicted - 1.0
+            } else {
+                1e6
+            };
         }
     }
     for r in &mut reports {

@@ -146,7 +146,11 @@ impl IgiInput {
                 return Err(err("radius", l.radius.to_string(), "a finite radius >= 0 m"));
             }
             if !l.intensity.iter().all(|i| i.is_finite() && *i >= 0.0) {
-                return Err(err("intensity", format!("{:?}", l.intensity), "finite values >= 0 W/sr"));
+                return Err(err(
+                    "intensity",
+                    format!("{:?}", l.intensity),
+                    "finite values >= 0 W/sr",
+                ));
             }
         }
         for v in &self.views {

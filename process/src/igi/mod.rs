@@ -18,6 +18,9 @@
 //! [`IgiOptions::variant`] names, by default
 //! [`crate::brdf::WardVariant::Ward1992`], the thesis's eq. A.1/A.2.
 
+// Colour channels are indexed 0..3 alike across several arrays at once.
+#![allow(clippy::needless_range_loop)]
+
 pub mod camera;
 mod delta_s;
 mod error;

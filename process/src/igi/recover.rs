@@ -12,6 +12,7 @@ use std::time::Instant;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
+use super::delta_s::indirect_specular;
 use super::error::IgiError;
 use super::geometry::Geometry;
 use super::highlight::{DetectorSample, HighlightReport, detect};
@@ -19,7 +20,6 @@ use super::input::{IgiInput, IgiOptions};
 use super::observation::{DroppedPixels, Observation, observations};
 use super::radiosity::RadiosityField;
 use super::specular_albedo::SpecularAlbedo;
-use super::delta_s::indirect_specular;
 use super::ward_fit::{FitSample, Shape, anisotropic, isotropic, linear_fit};
 use crate::brdf::{WardLobe, WardMaterial, WardVariant};
 use crate::model_choice::bic;
@@ -111,6 +111,11 @@ const INITIAL_ALPHA: f64 = 0.15;
 /// are kept preferentially in the sparse set: 10°.
 const SPARSE_HIGHLIGHT_RAD: f64 = 0.174_532_925_199_432_95;
 
+/// The predicted radiance in a weight `1 / L̂²` is floored at this fraction
+/// of the surface's mean measured radiance, so that black pixels (a metal
+/// away from its highlight) do not take infinite weight.
+const WEIGHT_FLOOR: f64 = 1e-2;
+
 /// BIC margin the anisotropic model must win by.
 const ANISOTROPY_BIC_MARGIN: f64 = 10.0;
 
@@ -158,7 +163,16 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
 
     let mut materials: Vec<Option<WardMaterial>> = vec![None; n_surf];
     let mut shapes: Vec<Option<WardLobe>> = (0..n_surf)
-        .map(|_| Some(Shape { alpha_x: INITIAL_ALPHA, alpha_y: INITIAL_ALPHA, gamma_rad: 0.0 }.lobe(options.variant)))
+        .map(|_| {
+            Some(
+                Shape {
+                    alpha_x: INITIAL_ALPHA,
+                    alpha_y: INITIAL_ALPHA,
+                    gamma_rad: 0.0,
+                }
+                .lobe(options.variant),
+            )
+        })
         .collect();
     let mut kind_ind: Vec<[f64; 3]> = vec![[0.0; 3]; obs.len()];
     let mut highlights: Vec<Vec<HighlightReport>> = vec![Vec::new(); n_surf];
@@ -177,7 +191,17 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
         // (2) Indirect irradiance per cell.
         field.gather(&geometry, input, &materials, &albedos, options.gather_rays, seed);
         // (3) ΔS at every sample.
-        kind_ind = indirect_specular(&geometry, input, &field, &materials, &albedos, &obs, &shapes, options.lobe_rays, seed ^ 0x5555);
+        kind_ind = indirect_specular(
+            &geometry,
+            input,
+            &field,
+            &materials,
+            &albedos,
+            &obs,
+            &shapes,
+            options.lobe_rays,
+            seed ^ 0x5555,
+        );
         if it == 0 {
             for s in 0..n_surf {
                 let samples: Vec<DetectorSample> = by_surface[s]
@@ -201,9 +225,15 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
         fits = (0..n_surf)
             .into_par_iter()
             .map(|s| {
+                let mean = by_surface[s]
+                    .iter()
+                    .map(|&i| obs[i].radiance.iter().sum::<f64>() / 3.0)
+                    .sum::<f64>()
+                    / by_surface[s].len().max(1) as f64;
+                let floor = (WEIGHT_FLOOR * mean).max(1e-30);
                 let samples: Vec<FitSample> = by_surface[s]
                     .iter()
-                    .map(|&i| fit_sample(&obs[i], &field, kind_ind[i], materials[s].as_ref()))
+                    .map(|&i| fit_sample(&obs[i], &field, kind_ind[i], materials[s].as_ref(), floor))
                     .collect();
                 let sparse = sparse_set(&by_surface[s], &obs, &samples, options.sparse_samples);
                 fit_surface(&samples, &sparse, &highlights[s], options, previous.get(s))
@@ -239,12 +269,20 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
                 Some(l) => {
                     let mean_s = l.rho_s.iter().sum::<f64>();
                     let mean_d = material.map_or(0.0, |m| m.rho_d.iter().sum::<f64>());
-                    if mean_s > mean_d { SpecularKind::Metal } else { SpecularKind::Plastic }
+                    if mean_s > mean_d {
+                        SpecularKind::Metal
+                    } else {
+                        SpecularKind::Plastic
+                    }
                 }
             };
             SurfaceResult {
                 name: input.surfaces[s].clone(),
-                model: if by_surface[s].is_empty() { SurfaceModel::Unobserved } else { f.model },
+                model: if by_surface[s].is_empty() {
+                    SurfaceModel::Unobserved
+                } else {
+                    f.model
+                },
                 reason: if by_surface[s].is_empty() {
                     "no usable pixel sees this surface".to_string()
                 } else {
@@ -386,7 +424,13 @@ fn estimate_diffuse(
 }
 
 /// An observation as the fit sees it, weighted by `1 / L̂²` (App. A).
-fn fit_sample(o: &Observation, field: &RadiosityField, kind: [f64; 3], previous: Option<&WardMaterial>) -> FitSample {
+fn fit_sample(
+    o: &Observation,
+    field: &RadiosityField,
+    kind: [f64; 3],
+    previous: Option<&WardMaterial>,
+    floor: f64,
+) -> FitSample {
     let e = total_irradiance(o, field);
     let diffuse = e.map(|v| v * std::f64::consts::FRAC_1_PI);
     let predicted = match previous {
@@ -396,7 +440,6 @@ fn fit_sample(o: &Observation, field: &RadiosityField, kind: [f64; 3], previous:
         }
         None => o.radiance.iter().sum::<f64>() / 3.0,
     };
-    let floor = 1e-6 * diffuse.iter().sum::<f64>().max(1e-300);
     let p = predicted.max(floor);
     FitSample {
         diffuse,
@@ -462,7 +505,10 @@ fn fit_surface(
         return SurfaceFit {
             model: SurfaceModel::DiffuseOnly,
             reason,
-            material: Some(WardMaterial { rho_d: fit.rho_d, lobe: None }),
+            material: Some(WardMaterial {
+                rho_d: fit.rho_d,
+                lobe: None,
+            }),
             sparse: sparse.len(),
             bic: [Some(bic_d), None, None],
             rms: rms(fit.error, dense.len()),
@@ -470,7 +516,11 @@ fn fit_surface(
     }
     let (alpha, iso, _) = isotropic(sparse, variant, 25);
     let bic_i = bic(iso.error, n, 7);
-    let mut chosen = Shape { alpha_x: alpha, alpha_y: alpha, gamma_rad: 0.0 };
+    let mut chosen = Shape {
+        alpha_x: alpha,
+        alpha_y: alpha,
+        gamma_rad: 0.0,
+    };
     let mut model = SurfaceModel::Isotropic;
     let mut bic_a = None;
     let mut reason = format!(
@@ -486,7 +536,11 @@ fn fit_surface(
             .and_then(|m| m.lobe);
         let (starts, step) = match prev_aniso {
             Some(l) => (
-                vec![Shape { alpha_x: l.alpha_x, alpha_y: l.alpha_y, gamma_rad: l.gamma_rad }],
+                vec![Shape {
+                    alpha_x: l.alpha_x,
+                    alpha_y: l.alpha_y,
+                    gamma_rad: l.gamma_rad,
+                }],
                 0.1,
             ),
             None => (
@@ -530,14 +584,27 @@ fn fit_surface(
     }
     let lobe_shape = chosen.lobe(variant);
     let fit = linear_fit(dense, Some(&lobe_shape));
-    let lobe = WardLobe { rho_s: fit.rho_s, ..lobe_shape };
-    let lobe = if model == SurfaceModel::Anisotropic { canonical_lobe(lobe) } else { lobe };
+    let lobe = WardLobe {
+        rho_s: fit.rho_s,
+        ..lobe_shape
+    };
+    let lobe = if model == SurfaceModel::Anisotropic {
+        canonical_lobe(lobe)
+    } else {
+        lobe
+    };
     let material = if fit.rho_s.iter().all(|&s| s == 0.0) {
         reason.push_str("; the linear step put ρs at 0, so no lobe is kept");
         model = SurfaceModel::DiffuseOnly;
-        WardMaterial { rho_d: fit.rho_d, lobe: None }
+        WardMaterial {
+            rho_d: fit.rho_d,
+            lobe: None,
+        }
     } else {
-        WardMaterial { rho_d: fit.rho_d, lobe: Some(lobe) }
+        WardMaterial {
+            rho_d: fit.rho_d,
+            lobe: Some(lobe),
+        }
     };
     SurfaceFit {
         model,

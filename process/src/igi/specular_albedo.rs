@@ -23,7 +23,10 @@ pub(crate) struct SpecularAlbedo {
 impl SpecularAlbedo {
     /// Tabulates the lobe's albedo by quadrature (32 × 64 nodes per entry).
     pub fn new(lobe: &WardLobe) -> SpecularAlbedo {
-        let unit = WardLobe { rho_s: [1.0; 3], ..*lobe };
+        let unit = WardLobe {
+            rho_s: [1.0; 3],
+            ..*lobe
+        };
         let mut values = Vec::with_capacity((N_THETA + 1) * N_PHI);
         for i in 0..=N_THETA {
             let theta = (i as f64 / N_THETA as f64 * 90.0).min(89.5).to_radians();

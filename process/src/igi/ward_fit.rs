@@ -116,7 +116,11 @@ pub(crate) fn linear_fit(samples: &[FitSample], lobe: Option<&WardLobe>) -> Line
         }
         if a < 0.0 {
             a = 0.0;
-            b = if ss > 0.0 && lobe.is_some() { (sl / ss).max(0.0) } else { 0.0 };
+            b = if ss > 0.0 && lobe.is_some() {
+                (sl / ss).max(0.0)
+            } else {
+                0.0
+            };
         }
         // Σ w (l − a d − b k)², expanded.
         let e = ll - 2.0 * a * dl - 2.0 * b * sl + a * a * dd + 2.0 * a * b * ds + b * b * ss;
@@ -137,7 +141,18 @@ const LN_ALPHA_MAX: f64 = 0.0; // ln 1
 pub(crate) fn isotropic(samples: &[FitSample], variant: WardVariant, scan: usize) -> (f64, LinearFit, usize) {
     let eval = |t: f64| {
         let a = t.exp().max(MIN_ALPHA);
-        linear_fit(samples, Some(&Shape { alpha_x: a, alpha_y: a, gamma_rad: 0.0 }.lobe(variant))).error
+        linear_fit(
+            samples,
+            Some(
+                &Shape {
+                    alpha_x: a,
+                    alpha_y: a,
+                    gamma_rad: 0.0,
+                }
+                .lobe(variant),
+            ),
+        )
+        .error
     };
     let scan = scan.max(3);
     let grid: Vec<f64> = (0..scan)
@@ -168,14 +183,29 @@ pub(crate) fn isotropic(samples: &[FitSample], variant: WardVariant, scan: usize
         evals += 1;
     }
     let alpha = (0.5 * (lo + hi)).exp();
-    let fit = linear_fit(samples, Some(&Shape { alpha_x: alpha, alpha_y: alpha, gamma_rad: 0.0 }.lobe(variant)));
+    let fit = linear_fit(
+        samples,
+        Some(
+            &Shape {
+                alpha_x: alpha,
+                alpha_y: alpha,
+                gamma_rad: 0.0,
+            }
+            .lobe(variant),
+        ),
+    );
     (alpha, fit, evals)
 }
 
 /// Downhill simplex (Nelder–Mead) over (ln αx, ln αy, γ) from each start
 /// (App. A), keeping the best. Returns the shape, the linear fit and the
 /// number of evaluations.
-pub(crate) fn anisotropic(samples: &[FitSample], variant: WardVariant, starts: &[Shape], step: f64) -> (Shape, LinearFit, usize) {
+pub(crate) fn anisotropic(
+    samples: &[FitSample],
+    variant: WardVariant,
+    starts: &[Shape],
+    step: f64,
+) -> (Shape, LinearFit, usize) {
     let clamp_t = |t: f64| t.clamp(LN_ALPHA_MIN, LN_ALPHA_MAX);
     let eval = |p: &[f64; 3]| {
         let shape = Shape {
@@ -207,7 +237,13 @@ pub(crate) fn anisotropic(samples: &[FitSample], variant: WardVariant, starts: &
 /// Nelder–Mead minimization of `f` in three dimensions from `x0` with
 /// initial steps `step`, until the spread of the simplex's values falls
 /// below `ftol` relative or `max_evals` is spent.
-fn nelder_mead(f: &impl Fn(&[f64; 3]) -> f64, x0: [f64; 3], step: [f64; 3], ftol: f64, max_evals: usize) -> ([f64; 3], f64, usize) {
+fn nelder_mead(
+    f: &impl Fn(&[f64; 3]) -> f64,
+    x0: [f64; 3],
+    step: [f64; 3],
+    ftol: f64,
+    max_evals: usize,
+) -> ([f64; 3], f64, usize) {
     let mut pts: Vec<[f64; 3]> = vec![x0];
     for i in 0..3 {
         let mut p = x0;
@@ -310,14 +346,21 @@ mod tests {
         let s = synthetic(&truth, 0.2);
         let (alpha, fit, _) = isotropic(&s, WardVariant::Ward1992, 25);
         assert!((alpha - 0.08).abs() < 1e-5, "{alpha}");
-        assert!((fit.rho_d[0] - 0.2).abs() < 1e-6 && (fit.rho_s[0] - 0.05).abs() < 1e-6, "{fit:?}");
+        assert!(
+            (fit.rho_d[0] - 0.2).abs() < 1e-6 && (fit.rho_s[0] - 0.05).abs() < 1e-6,
+            "{fit:?}"
+        );
     }
 
     #[test]
     fn simplex_recovers_an_anisotropic_lobe() {
         let truth = WardLobe::new([0.05; 3], 0.06, 0.2, 0.5, WardVariant::Ward1992).unwrap();
         let s = synthetic(&truth, 0.2);
-        let start = Shape { alpha_x: 0.1, alpha_y: 0.1, gamma_rad: 0.3 };
+        let start = Shape {
+            alpha_x: 0.1,
+            alpha_y: 0.1,
+            gamma_rad: 0.3,
+        };
         let (shape, fit, _) = anisotropic(&s, WardVariant::Ward1992, &[start], 0.5);
         let lobe = shape.lobe(WardVariant::Ward1992);
         // Compare kernels (the parametrization has a symmetry).

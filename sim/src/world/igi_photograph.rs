@@ -77,7 +77,11 @@ pub fn photograph(
             }
         }
     });
-    RadianceImage { width: w, height: h, data }
+    RadianceImage {
+        width: w,
+        height: h,
+        data,
+    }
 }
 
 /// The radiance along one camera ray.
@@ -104,7 +108,11 @@ fn pixel(
     let tri = &scene.triangles()[hit.triangle];
     let material = &scene.materials()[tri.material as usize];
     let wo = -ray.direction;
-    let normal = if tri.normal.dot(&wo) >= 0.0 { tri.normal } else { -tri.normal };
+    let normal = if tri.normal.dot(&wo) >= 0.0 {
+        tri.normal
+    } else {
+        -tri.normal
+    };
     let bsdf = SurfaceBsdf::at(material, tri, &hit.point, normal);
     let origin = hit.point + normal * 1e-6 * (1.0 + hit.point.norm());
     let mut l = material.emission;
