@@ -198,3 +198,106 @@ impl IgiInput {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::igi::recover;
+    use crate::render::shapes;
+
+    fn input() -> IgiInput {
+        let camera = ViewCamera {
+            position: Vector3::repeat(0.5),
+            look: -Vector3::z(),
+            up: Vector3::y(),
+            vfov_rad: 1.0,
+            width: 4,
+            height: 3,
+        };
+        IgiInput {
+            triangles: shapes::cuboid(Vector3::zeros(), Vector3::repeat(1.0), true, [0; 6], [0, 1, 2, 3, 4, 5]),
+            surfaces: (0..6).map(|i| format!("s{i}")).collect(),
+            lights: vec![IgiLight {
+                position: Vector3::new(0.5, 0.5, 0.8),
+                radius: 0.0,
+                intensity: [1.0; 3],
+            }],
+            views: vec![View {
+                name: "v".into(),
+                camera,
+                image: RadianceImage {
+                    width: 4,
+                    height: 3,
+                    data: vec![0.1; 36],
+                },
+                mask: None,
+            }],
+        }
+    }
+
+    #[test]
+    fn bad_inputs_are_typed_errors_naming_what_is_wrong() {
+        let opts = IgiOptions::default();
+        assert!(recover(&input(), &opts).is_ok());
+        let mut i = input();
+        i.views[0].image.data[(2 * 4 + 1) * 3 + 2] = f32::NAN;
+        let e = recover(&i, &opts).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                IgiError::Radiance {
+                    x: 1,
+                    y: 2,
+                    channel: 2,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert!(e.to_string().contains("pixel (1, 2)"), "{e}");
+        // Masked out, the same pixel is ignored.
+        let mut mask = vec![true; 12];
+        mask[2 * 4 + 1] = false;
+        i.views[0].mask = Some(mask);
+        assert!(recover(&i, &opts).is_ok());
+        let mut i = input();
+        i.views[0].image.width = 5;
+        assert!(matches!(recover(&i, &opts), Err(IgiError::ImageSize { .. })));
+        let mut i = input();
+        i.views[0].mask = Some(vec![true; 5]);
+        assert!(matches!(
+            recover(&i, &opts),
+            Err(IgiError::MaskSize {
+                got: 5,
+                expected: 12,
+                ..
+            })
+        ));
+        let mut i = input();
+        i.lights[0].radius = -1.0;
+        assert!(matches!(
+            recover(&i, &opts),
+            Err(IgiError::Light { field: "radius", .. })
+        ));
+        let mut i = input();
+        i.views[0].camera.vfov_rad = 4.0;
+        assert!(matches!(
+            recover(&i, &opts),
+            Err(IgiError::Camera { field: "vfov", .. })
+        ));
+        let mut i = input();
+        i.triangles.clear();
+        assert!(matches!(recover(&i, &opts), Err(IgiError::NoGeometry)));
+        let bad = IgiOptions {
+            pixel_stride: 0,
+            ..opts
+        };
+        assert!(matches!(
+            recover(&input(), &bad),
+            Err(IgiError::Option {
+                name: "pixel_stride",
+                ..
+            })
+        ));
+    }
+}
