@@ -1,2 +1,42 @@
-//! Inverse global illumination indoors (thesis ch. 4, App. A): Ward BRDFs
-//! and albedo maps recovered despite mutual illumination.
+//! Inverse global illumination indoors (thesis ch. 4, App. A): each
+//! surface's Ward BRDF recovered from radiance images despite mutual
+//! illumination.
+//!
+//! Entry point: [`recover`]`(&IgiInput, &IgiOptions) -> Result<IgiResult, IgiError>`;
+//! [`format_table`] prints the result in the layout of the thesis's Table 4.1.
+//!
+//! - [`camera`]: the views' pinhole cameras.
+//! - [`input`]: geometry, lights, views, options.
+//! - `geometry`: ray casting and the radiosity cells; `observation`: the
+//!   samples; `radiosity`: inverse radiosity (§4.3) and gathering;
+//!   `delta_s`: the indirect specular term (§4.5.1); `ward_fit`: golden
+//!   section / downhill simplex + linear least squares (App. A);
+//!   [`highlight`]: highlight detection (Fig. 4.4); `recover`: the ΔS loop
+//!   and model choice.
+//!
+//! Ward normalization: the solver fits the lobe in the variant
+//! [`IgiOptions::variant`] names, by default
+//! [`crate::brdf::WardVariant::Ward1992`], the thesis's eq. A.1/A.2.
+
+// Colour channels are indexed 0..3 alike across several arrays at once.
+#![allow(clippy::needless_range_loop)]
+
+pub mod camera;
+mod delta_s;
+mod error;
+mod geometry;
+pub mod highlight;
+pub mod input;
+mod observation;
+mod radiosity;
+mod recover;
+mod specular_albedo;
+pub mod table;
+mod ward_fit;
+
+pub use camera::ViewCamera;
+pub use error::IgiError;
+pub use input::{IgiInput, IgiLight, IgiOptions, View};
+pub use observation::DroppedPixels;
+pub use recover::{IgiResult, IterationReport, SpecularKind, SurfaceModel, SurfaceResult, canonical_lobe, recover};
+pub use table::format_table;

@@ -7,6 +7,7 @@
 //! Everything the solvers should recover is exposed here as ground truth.
 
 pub mod cube_room;
+pub mod igi_photograph;
 pub mod rig;
 pub mod scene_file;
 pub mod truth;

@@ -1,0 +1,303 @@
+//! What the solver is given: geometry grouped into named surfaces, known
+//! lights, and calibrated radiance images with their cameras and optional
+//! masks; and the knobs that trade speed against error.
+
+use nalgebra::Vector3;
+
+use super::camera::ViewCamera;
+use super::error::IgiError;
+use crate::brdf::WardVariant;
+use crate::camera::image::RadianceImage;
+use crate::render::Triangle;
+
+/// A known light: a small sphere (radius 0 for a point light) of uniform
+/// radiant intensity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IgiLight {
+    /// Centre, world frame, metres.
+    pub position: Vector3<f64>,
+    /// Bulb radius, metres (0 for a point light). Pixels whose ray meets
+    /// the bulb before a surface are dropped ("a light inside the view");
+    /// its light is treated as coming from the centre.
+    pub radius: f64,
+    /// Radiant intensity per channel, W·sr⁻¹.
+    pub intensity: [f64; 3],
+}
+
+/// One photograph: a camera, its radiance image and an optional mask.
+#[derive(Debug, Clone, PartialEq)]
+pub struct View {
+    /// Name, for diagnostics.
+    pub name: String,
+    /// The camera.
+    pub camera: ViewCamera,
+    /// Radiance, W·m⁻²·sr⁻¹ per channel, `width × height` pixels.
+    pub image: RadianceImage,
+    /// `true` for pixels to use, row-major; `None` uses every pixel.
+    pub mask: Option<Vec<bool>>,
+}
+
+/// Everything the solver is given.
+#[derive(Debug, Clone)]
+pub struct IgiInput {
+    /// Triangles; `Triangle::surface` names the surface (a group sharing one
+    /// BRDF), `texture_axes[0]` is the tangent from which γ is measured.
+    pub triangles: Vec<Triangle>,
+    /// Surface names, indexed by `Triangle::surface`.
+    pub surfaces: Vec<String>,
+    /// The lights that were on for every view.
+    pub lights: Vec<IgiLight>,
+    /// The photographs.
+    pub views: Vec<View>,
+}
+
+/// The solver's knobs (speed against error).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IgiOptions {
+    /// Ward normalization fitted (the thesis's eq. A.1/A.2 is `Ward1992`).
+    pub variant: WardVariant,
+    /// Use every `pixel_stride`-th pixel in each direction.
+    pub pixel_stride: usize,
+    /// Cells per triangle edge of the radiosity grid (`n × n` per triangle).
+    pub cells_per_edge: usize,
+    /// Cosine-distributed gather rays per cell for the indirect irradiance.
+    pub gather_rays: u32,
+    /// Lobe-sampled rays per sample for the indirect specular term ΔS.
+    pub lobe_rays: u32,
+    /// At most this many samples per surface in the sparse set the
+    /// roughness search uses (§4.5 footnote); the linear step uses all.
+    pub sparse_samples: usize,
+    /// ΔS iterations (§4.5.1, Fig. 4.6): each re-estimates the diffuse
+    /// radiance, the indirect light and the BRDFs.
+    pub iterations: u32,
+    /// Views more grazing than this (angle from the normal) are dropped, radians.
+    pub max_view_angle_rad: f64,
+    /// Whether the anisotropic model may be chosen.
+    pub allow_anisotropic: bool,
+    /// Seed of every random choice.
+    pub seed: u64,
+}
+
+impl Default for IgiOptions {
+    fn default() -> Self {
+        IgiOptions {
+            variant: WardVariant::Ward1992,
+            pixel_stride: 1,
+            cells_per_edge: 24,
+            gather_rays: 256,
+            lobe_rays: 16,
+            sparse_samples: 2500,
+            iterations: 4,
+            max_view_angle_rad: 84f64.to_radians(),
+            allow_anisotropic: true,
+            seed: 1,
+        }
+    }
+}
+
+impl IgiOptions {
+    /// Checks every option.
+    pub fn validate(&self) -> Result<(), IgiError> {
+        let err = |name, value: String, expected| Err(IgiError::Option { name, value, expected });
+        if self.pixel_stride == 0 {
+            return err("pixel_stride", "0".into(), "at least 1");
+        }
+        if !(1..=512).contains(&self.cells_per_edge) {
+            return err("cells_per_edge", self.cells_per_edge.to_string(), "1 to 512");
+        }
+        if self.gather_rays == 0 {
+            return err("gather_rays", "0".into(), "at least 1");
+        }
+        if self.lobe_rays == 0 {
+            return err("lobe_rays", "0".into(), "at least 1");
+        }
+        if self.sparse_samples < 16 {
+            return err("sparse_samples", self.sparse_samples.to_string(), "at least 16");
+        }
+        if !(self.max_view_angle_rad > 0.0 && self.max_view_angle_rad < std::f64::consts::FRAC_PI_2) {
+            return err(
+                "max_view_angle_rad",
+                self.max_view_angle_rad.to_string(),
+                "an angle in (0, π/2)",
+            );
+        }
+        Ok(())
+    }
+}
+
+impl IgiInput {
+    /// Checks lights, cameras, image and mask sizes, and every radiance
+    /// that is not masked out.
+    pub fn validate(&self) -> Result<(), IgiError> {
+        if self.triangles.is_empty() {
+            return Err(IgiError::NoGeometry);
+        }
+        for (index, l) in self.lights.iter().enumerate() {
+            let err = |field, value: String, expected| IgiError::Light {
+                index,
+                field,
+                value,
+                expected,
+            };
+            if !l.position.iter().all(|c| c.is_finite()) {
+                return Err(err("position", format!("{:?}", l.position), "finite coordinates"));
+            }
+            if !(l.radius.is_finite() && l.radius >= 0.0) {
+                return Err(err("radius", l.radius.to_string(), "a finite radius >= 0 m"));
+            }
+            if !l.intensity.iter().all(|i| i.is_finite() && *i >= 0.0) {
+                return Err(err(
+                    "intensity",
+                    format!("{:?}", l.intensity),
+                    "finite values >= 0 W/sr",
+                ));
+            }
+        }
+        for v in &self.views {
+            v.camera.validate(&v.name)?;
+            let (w, h) = (v.camera.width, v.camera.height);
+            if v.image.width != w || v.image.height != h || v.image.data.len() != w * h * 3 {
+                return Err(IgiError::ImageSize {
+                    view: v.name.clone(),
+                    got_width: v.image.width,
+                    got_height: v.image.height,
+                    got_values: v.image.data.len(),
+                    width: w,
+                    height: h,
+                });
+            }
+            if let Some(m) = &v.mask
+                && m.len() != w * h
+            {
+                return Err(IgiError::MaskSize {
+                    view: v.name.clone(),
+                    got: m.len(),
+                    expected: w * h,
+                });
+            }
+            for y in 0..h {
+                for x in 0..w {
+                    if v.mask.as_ref().is_some_and(|m| !m[y * w + x]) {
+                        continue;
+                    }
+                    for channel in 0..3 {
+                        let value = v.image.radiance(x, y, channel);
+                        if !(value.is_finite() && value >= 0.0) {
+                            return Err(IgiError::Radiance {
+                                view: v.name.clone(),
+                                x,
+                                y,
+                                channel,
+                                value,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::igi::recover;
+    use crate::render::shapes;
+
+    fn input() -> IgiInput {
+        let camera = ViewCamera {
+            position: Vector3::repeat(0.5),
+            look: -Vector3::z(),
+            up: Vector3::y(),
+            vfov_rad: 1.0,
+            width: 4,
+            height: 3,
+        };
+        IgiInput {
+            triangles: shapes::cuboid(Vector3::zeros(), Vector3::repeat(1.0), true, [0; 6], [0, 1, 2, 3, 4, 5]),
+            surfaces: (0..6).map(|i| format!("s{i}")).collect(),
+            lights: vec![IgiLight {
+                position: Vector3::new(0.5, 0.5, 0.8),
+                radius: 0.0,
+                intensity: [1.0; 3],
+            }],
+            views: vec![View {
+                name: "v".into(),
+                camera,
+                image: RadianceImage {
+                    width: 4,
+                    height: 3,
+                    data: vec![0.1; 36],
+                },
+                mask: None,
+            }],
+        }
+    }
+
+    #[test]
+    fn bad_inputs_are_typed_errors_naming_what_is_wrong() {
+        let opts = IgiOptions::default();
+        assert!(recover(&input(), &opts).is_ok());
+        let mut i = input();
+        i.views[0].image.data[(2 * 4 + 1) * 3 + 2] = f32::NAN;
+        let e = recover(&i, &opts).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                IgiError::Radiance {
+                    x: 1,
+                    y: 2,
+                    channel: 2,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert!(e.to_string().contains("pixel (1, 2)"), "{e}");
+        // Masked out, the same pixel is ignored.
+        let mut mask = vec![true; 12];
+        mask[2 * 4 + 1] = false;
+        i.views[0].mask = Some(mask);
+        assert!(recover(&i, &opts).is_ok());
+        let mut i = input();
+        i.views[0].image.width = 5;
+        assert!(matches!(recover(&i, &opts), Err(IgiError::ImageSize { .. })));
+        let mut i = input();
+        i.views[0].mask = Some(vec![true; 5]);
+        assert!(matches!(
+            recover(&i, &opts),
+            Err(IgiError::MaskSize {
+                got: 5,
+                expected: 12,
+                ..
+            })
+        ));
+        let mut i = input();
+        i.lights[0].radius = -1.0;
+        assert!(matches!(
+            recover(&i, &opts),
+            Err(IgiError::Light { field: "radius", .. })
+        ));
+        let mut i = input();
+        i.views[0].camera.vfov_rad = 4.0;
+        assert!(matches!(
+            recover(&i, &opts),
+            Err(IgiError::Camera { field: "vfov", .. })
+        ));
+        let mut i = input();
+        i.triangles.clear();
+        assert!(matches!(recover(&i, &opts), Err(IgiError::NoGeometry)));
+        let bad = IgiOptions {
+            pixel_stride: 0,
+            ..opts
+        };
+        assert!(matches!(
+            recover(&input(), &bad),
+            Err(IgiError::Option {
+                name: "pixel_stride",
+                ..
+            })
+        ));
+    }
+}

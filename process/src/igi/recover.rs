@@ -1,0 +1,649 @@
+//! The solver's loop (§4.5, Fig. 4.6): gather the samples; then, for each
+//! ΔS iteration, (1) read each cell's diffuse radiance from the images with
+//! the current specular estimate removed, (2) gather every cell's indirect
+//! irradiance, (3) estimate the indirect specular term ΔS at every sample
+//! around its mirror cone, (4) refit every surface's BRDF. Highlights are
+//! detected once, after the first gathering; each surface's model is chosen
+//! on every pass (diffuse-only without a seen highlight; isotropic or
+//! anisotropic by BIC).
+
+use std::time::Instant;
+
+use nalgebra::Vector3;
+use rayon::prelude::*;
+
+use super::delta_s::indirect_specular;
+use super::error::IgiError;
+use super::geometry::Geometry;
+use super::highlight::{DetectorSample, HighlightReport, detect};
+use super::input::{IgiInput, IgiOptions};
+use super::observation::{DroppedPixels, Observation, observations};
+use super::radiosity::RadiosityField;
+use super::specular_albedo::SpecularAlbedo;
+use super::ward_fit::{FitSample, Shape, anisotropic, isotropic, linear_fit};
+use crate::brdf::{WardLobe, WardMaterial, WardVariant};
+use crate::model_choice::bic;
+
+/// The model chosen for a surface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SurfaceModel {
+    /// No pixel of the surface was usable: nothing recovered.
+    Unobserved,
+    /// Lambertian: no highlight was seen.
+    DiffuseOnly,
+    /// Diffuse + isotropic Ward lobe (eq. A.1).
+    Isotropic,
+    /// Diffuse + anisotropic Ward lobe (eq. A.2).
+    Anisotropic,
+}
+
+/// Plastic or metal, by the thesis's test (App. A): a specular reflectance
+/// above the diffuse one means metal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SpecularKind {
+    /// No specular term.
+    None,
+    /// Specular below diffuse: a dielectric, whose highlight has the light's colour.
+    Plastic,
+    /// Specular above diffuse: a metal, whose highlight takes the surface's colour.
+    Metal,
+}
+
+/// What was recovered for one surface, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfaceResult {
+    /// The surface's name.
+    pub name: String,
+    /// The model chosen.
+    pub model: SurfaceModel,
+    /// Why that model, in words (BIC values, highlights seen).
+    pub reason: String,
+    /// The recovered BRDF (`None` when unobserved). Anisotropic lobes are
+    /// given with γ in [0°, 90°) (the representation (αx, αy, γ) ≡ (αy, αx, γ + 90°) ≡ (αx, αy, γ + 180°)).
+    pub material: Option<WardMaterial>,
+    /// Plastic or metal.
+    pub kind: SpecularKind,
+    /// Observations used (dense set).
+    pub samples: usize,
+    /// Observations in the sparse set the roughness search used.
+    pub sparse_samples: usize,
+    /// Highlight reports per (view, light) whose mirror cone is in view.
+    pub highlights: Vec<HighlightReport>,
+    /// BIC of the diffuse-only, isotropic and anisotropic fits (those made).
+    pub bic: [Option<f64>; 3],
+    /// Root-mean-square relative residual of the final fit.
+    pub rms_relative: f64,
+    /// Largest directional albedo over channels at normal and at 60°
+    /// incidence (energy bound: must be ≤ 1).
+    pub directional_albedo: [f64; 2],
+    /// Whether the energy bound holds (ρd + ρs ≤ 1 and both albedos ≤ 1).
+    pub energy_ok: bool,
+}
+
+/// One ΔS iteration's convergence.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IterationReport {
+    /// Largest relative change of any ρd, ρs, αx or αy from the previous pass.
+    pub max_relative_change: f64,
+    /// Wall time of the pass, seconds.
+    pub seconds: f64,
+}
+
+/// Everything [`recover`] found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IgiResult {
+    /// Per surface, in the input's order.
+    pub surfaces: Vec<SurfaceResult>,
+    /// Per ΔS iteration.
+    pub iterations: Vec<IterationReport>,
+    /// Per view (name), the pixels dropped and used.
+    pub pixels: Vec<(String, DroppedPixels)>,
+    /// The Ward normalization fitted.
+    pub variant: WardVariant,
+    /// Total wall time, seconds.
+    pub seconds: f64,
+}
+
+/// The roughness assumed for the first ΔS estimate (App. A: "an initial value between 0.1 and 0.2").
+const INITIAL_ALPHA: f64 = 0.15;
+
+/// Samples whose half vector is within this of the normal for some light
+/// are kept preferentially in the sparse set: 10°.
+const SPARSE_HIGHLIGHT_RAD: f64 = 0.174_532_925_199_432_95;
+
+/// The predicted radiance in a weight `1 / L̂²` is floored at this fraction
+/// of the surface's mean measured radiance, so that black pixels (a metal
+/// away from its highlight) do not take infinite weight.
+const WEIGHT_FLOOR: f64 = 1e-2;
+
+/// BIC margin the anisotropic model must win by.
+const ANISOTROPY_BIC_MARGIN: f64 = 10.0;
+
+/// Smallest αmax/αmin of an anisotropic fit that counts as anisotropic.
+const ANISOTROPY_MIN_RATIO: f64 = 1.05;
+
+/// The (αx, αy, γ) representation with γ in [0, π/2).
+pub fn canonical_lobe(mut lobe: WardLobe) -> WardLobe {
+    let half = std::f64::consts::FRAC_PI_2;
+    let mut g = lobe.gamma_rad.rem_euclid(std::f64::consts::PI);
+    if g >= half {
+        g -= half;
+        std::mem::swap(&mut lobe.alpha_x, &mut lobe.alpha_y);
+    }
+    lobe.gamma_rad = g;
+    lobe
+}
+
+/// Recovers every surface's Ward BRDF from `input` (module doc).
+///
+/// Errors: the input's and options' validation errors ([`IgiError`]).
+/// Surfaces that no pixel sees come back as [`SurfaceModel::Unobserved`].
+pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiError> {
+    let start = Instant::now();
+    options.validate()?;
+    input.validate()?;
+    let geometry = Geometry::new(&input.triangles, &input.surfaces, options.cells_per_edge)?;
+    let (obs, dropped) = observations(&geometry, input, options);
+    let n_surf = input.surfaces.len();
+
+    // The side of each triangle the cameras see.
+    let mut side: Vec<Vector3<f64>> = vec![Vector3::zeros(); geometry.triangles().len()];
+    for o in &obs {
+        side[o.triangle] += o.frame.normal;
+    }
+    for (s, t) in side.iter_mut().zip(geometry.triangles()) {
+        *s = if s.dot(&t.normal) >= 0.0 { t.normal } else { -t.normal };
+    }
+    let mut field = RadiosityField::new(&geometry, input, side);
+
+    let mut by_surface: Vec<Vec<usize>> = vec![Vec::new(); n_surf];
+    for (i, o) in obs.iter().enumerate() {
+        by_surface[o.surface].push(i);
+    }
+
+    let mut materials: Vec<Option<WardMaterial>> = vec![None; n_surf];
+    let mut shapes: Vec<Option<WardLobe>> = (0..n_surf)
+        .map(|_| {
+            Some(
+                Shape {
+                    alpha_x: INITIAL_ALPHA,
+                    alpha_y: INITIAL_ALPHA,
+                    gamma_rad: 0.0,
+                }
+                .lobe(options.variant),
+            )
+        })
+        .collect();
+    let mut kind_ind: Vec<[f64; 3]> = vec![[0.0; 3]; obs.len()];
+    let mut highlights: Vec<Vec<HighlightReport>> = vec![Vec::new(); n_surf];
+    let mut fits: Vec<SurfaceFit> = Vec::new();
+    let mut iterations = Vec::new();
+
+    for it in 0..options.iterations.max(1) {
+        let t0 = Instant::now();
+        let seed = options.seed.wrapping_add(u64::from(it) * 0x9e37_79b9);
+        // (1) Diffuse radiance per cell: measured minus the specular estimate.
+        estimate_diffuse(&mut field, &geometry, &obs, &materials, &kind_ind);
+        let albedos: Vec<Option<SpecularAlbedo>> = materials
+            .par_iter()
+            .map(|m| m.and_then(|m| m.lobe).map(|l| SpecularAlbedo::new(&l)))
+            .collect();
+        // (2) Indirect irradiance per cell.
+        field.gather(&geometry, input, &materials, &albedos, options.gather_rays, seed);
+        // (3) ΔS at every sample.
+        kind_ind = indirect_specular(
+            &geometry,
+            input,
+            &field,
+            &materials,
+            &albedos,
+            &obs,
+            &shapes,
+            options.lobe_rays,
+            seed ^ 0x5555,
+        );
+        if it == 0 {
+            for s in 0..n_surf {
+                let samples: Vec<DetectorSample> = by_surface[s]
+                    .iter()
+                    .map(|&i| {
+                        let o = &obs[i];
+                        let e = total_irradiance(o, &field);
+                        DetectorSample {
+                            view: o.view,
+                            radiance: o.radiance.iter().sum::<f64>() / 3.0,
+                            diffuse: e.iter().sum::<f64>() / (3.0 * std::f64::consts::PI),
+                            deltas: o.lights.iter().map(|t| (t.light, t.delta)).collect(),
+                        }
+                    })
+                    .collect();
+                highlights[s] = detect(&samples);
+            }
+        }
+        // (4) Refit.
+        let previous = fits.clone();
+        fits = (0..n_surf)
+            .into_par_iter()
+            .map(|s| {
+                let mean = by_surface[s]
+                    .iter()
+                    .map(|&i| obs[i].radiance.iter().sum::<f64>() / 3.0)
+                    .sum::<f64>()
+                    / by_surface[s].len().max(1) as f64;
+                let floor = (WEIGHT_FLOOR * mean).max(1e-30);
+                let samples: Vec<FitSample> = by_surface[s]
+                    .iter()
+                    .map(|&i| fit_sample(&obs[i], &field, kind_ind[i], materials[s].as_ref(), floor))
+                    .collect();
+                let sparse = sparse_set(&by_surface[s], &obs, &samples, options.sparse_samples);
+                fit_surface(&samples, &sparse, &highlights[s], options, previous.get(s))
+            })
+            .collect();
+        let mut change: f64 = 0.0;
+        for (s, f) in fits.iter().enumerate() {
+            if let (Some(new), Some(old)) = (&f.material, &materials[s]) {
+                change = change.max(relative_change(new, old));
+            }
+            materials[s] = f.material;
+            shapes[s] = f.material.and_then(|m| m.lobe).or(shapes[s]);
+        }
+        if it == 0 {
+            change = f64::INFINITY;
+        }
+        iterations.push(IterationReport {
+            max_relative_change: change,
+            seconds: t0.elapsed().as_secs_f64(),
+        });
+    }
+
+    let surfaces = (0..n_surf)
+        .map(|s| {
+            let f = fits.get(s).cloned().unwrap_or_default();
+            let material = f.material;
+            let (directional_albedo, energy_ok) = match &material {
+                Some(m) => energy(m),
+                None => ([0.0; 2], true),
+            };
+            let kind = match material.and_then(|m| m.lobe) {
+                None => SpecularKind::None,
+                Some(l) => {
+                    let mean_s = l.rho_s.iter().sum::<f64>();
+                    let mean_d = material.map_or(0.0, |m| m.rho_d.iter().sum::<f64>());
+                    if mean_s > mean_d {
+                        SpecularKind::Metal
+                    } else {
+                        SpecularKind::Plastic
+                    }
+                }
+            };
+            SurfaceResult {
+                name: input.surfaces[s].clone(),
+                model: if by_surface[s].is_empty() {
+                    SurfaceModel::Unobserved
+                } else {
+                    f.model
+                },
+                reason: if by_surface[s].is_empty() {
+                    "no usable pixel sees this surface".to_string()
+                } else {
+                    f.reason.clone()
+                },
+                material,
+                kind,
+                samples: by_surface[s].len(),
+                sparse_samples: f.sparse,
+                highlights: highlights[s].clone(),
+                bic: f.bic,
+                rms_relative: f.rms,
+                directional_albedo,
+                energy_ok,
+            }
+        })
+        .collect();
+    Ok(IgiResult {
+        surfaces,
+        iterations,
+        pixels: input.views.iter().map(|v| v.name.clone()).zip(dropped).collect(),
+        variant: options.variant,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// One surface's fit in one pass.
+#[derive(Debug, Clone, PartialEq)]
+struct SurfaceFit {
+    model: SurfaceModel,
+    reason: String,
+    material: Option<WardMaterial>,
+    sparse: usize,
+    bic: [Option<f64>; 3],
+    rms: f64,
+}
+
+impl Default for SurfaceFit {
+    fn default() -> Self {
+        SurfaceFit {
+            model: SurfaceModel::Unobserved,
+            reason: String::new(),
+            material: None,
+            sparse: 0,
+            bic: [None; 3],
+            rms: 0.0,
+        }
+    }
+}
+
+/// Direct plus indirect irradiance at an observation.
+fn total_irradiance(o: &Observation, field: &RadiosityField) -> [f64; 3] {
+    let e = field.e_indirect[o.cell];
+    [0, 1, 2].map(|c| o.e_direct[c] + e[c])
+}
+
+/// The specular radiance of the estimate `m` at observation `o`, with ΔS per unit ρs `kind`.
+fn specular_radiance(o: &Observation, m: Option<&WardMaterial>, kind: [f64; 3]) -> [f64; 3] {
+    let Some(lobe) = m.and_then(|m| m.lobe) else {
+        return [0.0; 3];
+    };
+    let mut s = kind;
+    for t in &o.lights {
+        let k = lobe.kernel(&t.wi, &o.wo);
+        for c in 0..3 {
+            s[c] += k * t.irradiance[c];
+        }
+    }
+    [0, 1, 2].map(|c| lobe.rho_s[c] * s[c])
+}
+
+/// Step (1): each cell's diffuse radiance, the weighted mean over its
+/// observations of measured minus estimated specular radiance (§4.6:
+/// weights fall with the specular share and with the viewing angle),
+/// blended toward the estimate's ρd E / π by how much of the cell's light
+/// is specular; cells no camera sees take ρd E / π from the estimate, or
+/// their surface's mean.
+fn estimate_diffuse(
+    field: &mut RadiosityField,
+    geometry: &Geometry,
+    obs: &[Observation],
+    materials: &[Option<WardMaterial>],
+    kind: &[[f64; 3]],
+) {
+    let n = geometry.cell_count();
+    let mut sum = vec![[0.0; 3]; n];
+    let mut wsum = vec![0.0; n];
+    let mut cos_sum = vec![0.0; n];
+    for (i, o) in obs.iter().enumerate() {
+        let m = materials[o.surface].as_ref();
+        let s = specular_radiance(o, m, kind[i]);
+        let d: [f64; 3] = [0, 1, 2].map(|c| (o.radiance[c] - s[c]).max(0.0));
+        let (dm, sm) = (d.iter().sum::<f64>(), s.iter().sum::<f64>());
+        let share = if dm + sm > 0.0 { dm / (dm + sm) } else { 1.0 };
+        let w = o.wo.z * share * share;
+        for c in 0..3 {
+            sum[o.cell][c] += w * d[c];
+        }
+        wsum[o.cell] += w;
+        cos_sum[o.cell] += o.wo.z;
+    }
+    let mut surface_mean = vec![([0.0; 3], 0.0); materials.len()];
+    for cell in 0..n {
+        field.observed[cell] = wsum[cell] > 0.0;
+        if wsum[cell] > 0.0 {
+            field.diffuse[cell] = sum[cell].map(|v| v / wsum[cell]);
+            let s = geometry.triangles()[geometry.cell_triangle(cell)].surface as usize;
+            for c in 0..3 {
+                surface_mean[s].0[c] += field.diffuse[cell][c];
+            }
+            surface_mean[s].1 += 1.0;
+        }
+    }
+    for cell in 0..n {
+        let s = geometry.triangles()[geometry.cell_triangle(cell)].surface as usize;
+        let model = materials[s].as_ref().map(|m| {
+            [0, 1, 2].map(|c| {
+                m.rho_d[c] * (field.e_direct[cell][c] + field.e_indirect[cell][c]) * std::f64::consts::FRAC_1_PI
+            })
+        });
+        if field.observed[cell] {
+            // Where the highlight dominates every view of the cell, the
+            // measured diffuse part is a small difference of large numbers:
+            // lean on the model there, by the mean squared diffuse share.
+            if let Some(model) = model {
+                let r = (wsum[cell] / cos_sum[cell]).clamp(0.0, 1.0);
+                for c in 0..3 {
+                    field.diffuse[cell][c] = r * field.diffuse[cell][c] + (1.0 - r) * model[c];
+                }
+            }
+            continue;
+        }
+        field.diffuse[cell] = match model {
+            Some(m) => m,
+            None if surface_mean[s].1 > 0.0 => surface_mean[s].0.map(|v| v / surface_mean[s].1),
+            None => [0.0; 3],
+        };
+    }
+}
+
+/// An observation as the fit sees it, weighted by `1 / L̂²` (App. A).
+fn fit_sample(
+    o: &Observation,
+    field: &RadiosityField,
+    kind: [f64; 3],
+    previous: Option<&WardMaterial>,
+    floor: f64,
+) -> FitSample {
+    let e = total_irradiance(o, field);
+    let diffuse = e.map(|v| v * std::f64::consts::FRAC_1_PI);
+    let predicted = match previous {
+        Some(m) => {
+            let s = specular_radiance(o, Some(m), kind);
+            (0..3).map(|c| m.rho_d[c] * diffuse[c] + s[c]).sum::<f64>() / 3.0
+        }
+        None => o.radiance.iter().sum::<f64>() / 3.0,
+    };
+    let p = predicted.max(floor);
+    FitSample {
+        diffuse,
+        lights: o.lights.iter().map(|t| (t.wi, t.irradiance)).collect(),
+        wo: o.wo,
+        indirect: kind,
+        radiance: o.radiance,
+        weight: 1.0 / (p * p),
+    }
+}
+
+/// The sparse set (§4.5 footnote): every sample near a mirror direction,
+/// thinned evenly so that the set stays near `target`, plus an
+/// even share of the rest.
+fn sparse_set(indices: &[usize], obs: &[Observation], samples: &[FitSample], target: usize) -> Vec<FitSample> {
+    let near: Vec<usize> = (0..indices.len())
+        .filter(|&k| obs[indices[k]].lights.iter().any(|t| t.delta < SPARSE_HIGHLIGHT_RAD))
+        .collect();
+    let far: Vec<usize> = (0..indices.len())
+        .filter(|&k| !obs[indices[k]].lights.iter().any(|t| t.delta < SPARSE_HIGHLIGHT_RAD))
+        .collect();
+    let half = target / 2;
+    let near_stride = near.len().div_ceil(half).max(1);
+    let far_stride = far.len().div_ceil(target - near.len().min(half)).max(1);
+    near.iter()
+        .step_by(near_stride)
+        .chain(far.iter().step_by(far_stride))
+        .map(|&k| samples[k].clone())
+        .collect()
+}
+
+/// Fits one surface: model choice, roughness search on the sparse set,
+/// final linear step on the dense set.
+fn fit_surface(
+    dense: &[FitSample],
+    sparse: &[FitSample],
+    highlights: &[HighlightReport],
+    options: &IgiOptions,
+    previous: Option<&SurfaceFit>,
+) -> SurfaceFit {
+    if dense.is_empty() {
+        return SurfaceFit::default();
+    }
+    let variant = options.variant;
+    let n = 3 * sparse.len();
+    let diffuse_fit = linear_fit(sparse, None);
+    let bic_d = bic(diffuse_fit.error, n, 3);
+    let seen: Vec<&HighlightReport> = highlights.iter().filter(|h| h.seen).collect();
+    let rms = |e: f64, m: usize| (e / (3 * m).max(1) as f64).sqrt();
+    if seen.is_empty() {
+        let fit = linear_fit(dense, None);
+        let reason = if highlights.is_empty() {
+            "diffuse only: no light's mirror direction falls in any view of this surface, so ρs and α cannot be measured".to_string()
+        } else {
+            let best = highlights.iter().map(|h| h.excess).fold(f64::NEG_INFINITY, f64::max);
+            format!(
+                "diffuse only: {} mirror cone(s) in view, but the brightest is only {:.1} % above the diffuse fit (< {:.0} %)",
+                highlights.len(),
+                100.0 * best,
+                100.0 * super::highlight::MIN_EXCESS
+            )
+        };
+        return SurfaceFit {
+            model: SurfaceModel::DiffuseOnly,
+            reason,
+            material: Some(WardMaterial {
+                rho_d: fit.rho_d,
+                lobe: None,
+            }),
+            sparse: sparse.len(),
+            bic: [Some(bic_d), None, None],
+            rms: rms(fit.error, dense.len()),
+        };
+    }
+    let (alpha, iso, _) = isotropic(sparse, variant, 25);
+    let bic_i = bic(iso.error, n, 7);
+    let mut chosen = Shape {
+        alpha_x: alpha,
+        alpha_y: alpha,
+        gamma_rad: 0.0,
+    };
+    let mut model = SurfaceModel::Isotropic;
+    let mut bic_a = None;
+    let mut reason = format!(
+        "isotropic: {} highlight(s) seen; BIC diffuse {:.1}, isotropic {:.1}",
+        seen.len(),
+        bic_d,
+        bic_i
+    );
+    if options.allow_anisotropic {
+        let prev_aniso = previous
+            .filter(|p| p.model == SurfaceModel::Anisotropic)
+            .and_then(|p| p.material)
+            .and_then(|m| m.lobe);
+        let (starts, step) = match prev_aniso {
+            Some(l) => (
+                vec![Shape {
+                    alpha_x: l.alpha_x,
+                    alpha_y: l.alpha_y,
+                    gamma_rad: l.gamma_rad,
+                }],
+                0.1,
+            ),
+            None => (
+                [0.0, 45.0, 90.0, 135.0]
+                    .iter()
+                    .map(|g: &f64| Shape {
+                        alpha_x: alpha * 2.0,
+                        alpha_y: alpha * 0.5,
+                        gamma_rad: g.to_radians(),
+                    })
+                    .collect(),
+                0.5,
+            ),
+        };
+        let (shape, aniso, _) = anisotropic(sparse, variant, &starts, step);
+        let b = bic(aniso.error, n, 9);
+        bic_a = Some(b);
+        let ratio = shape.alpha_x.max(shape.alpha_y) / shape.alpha_x.min(shape.alpha_y);
+        if b < bic_i - ANISOTROPY_BIC_MARGIN && ratio > ANISOTROPY_MIN_RATIO {
+            chosen = shape;
+            model = SurfaceModel::Anisotropic;
+            reason = format!(
+                "anisotropic: {} highlight(s) seen; BIC isotropic {:.1} vs anisotropic {:.1} (wins by more than {:.0}), αmax/αmin = {:.2}",
+                seen.len(),
+                bic_i,
+                b,
+                ANISOTROPY_BIC_MARGIN,
+                ratio
+            );
+        } else {
+            reason = format!(
+                "isotropic: {} highlight(s) seen; BIC diffuse {:.1}, isotropic {:.1}, anisotropic {:.1} (αmax/αmin = {:.3}) does not win by {:.0}",
+                seen.len(),
+                bic_d,
+                bic_i,
+                b,
+                ratio,
+                ANISOTROPY_BIC_MARGIN
+            );
+        }
+    }
+    let lobe_shape = chosen.lobe(variant);
+    let fit = linear_fit(dense, Some(&lobe_shape));
+    let lobe = WardLobe {
+        rho_s: fit.rho_s,
+        ..lobe_shape
+    };
+    let lobe = if model == SurfaceModel::Anisotropic {
+        canonical_lobe(lobe)
+    } else {
+        lobe
+    };
+    let material = if fit.rho_s.iter().all(|&s| s == 0.0) {
+        reason.push_str("; the linear step put ρs at 0, so no lobe is kept");
+        model = SurfaceModel::DiffuseOnly;
+        WardMaterial {
+            rho_d: fit.rho_d,
+            lobe: None,
+        }
+    } else {
+        WardMaterial {
+            rho_d: fit.rho_d,
+            lobe: Some(lobe),
+        }
+    };
+    SurfaceFit {
+        model,
+        reason,
+        material: Some(material),
+        sparse: sparse.len(),
+        bic: [Some(bic_d), Some(bic_i), bic_a],
+        rms: rms(fit.error, dense.len()),
+    }
+}
+
+/// Largest relative change of the parameters between two estimates.
+fn relative_change(a: &WardMaterial, b: &WardMaterial) -> f64 {
+    let rel = |x: f64, y: f64| if y.abs() > 0.0 { ((x - y) / y).abs() } else { x.abs() };
+    let mut m: f64 = 0.0;
+    for c in 0..3 {
+        m = m.max(rel(a.rho_d[c], b.rho_d[c]));
+    }
+    match (a.lobe, b.lobe) {
+        (Some(x), Some(y)) => {
+            for c in 0..3 {
+                m = m.max(rel(x.rho_s[c], y.rho_s[c]));
+            }
+            m.max(rel(x.alpha_x, y.alpha_x)).max(rel(x.alpha_y, y.alpha_y))
+        }
+        (None, None) => m,
+        _ => f64::INFINITY,
+    }
+}
+
+/// The energy bound (App. A's model must not reflect more than it
+/// receives): the largest directional albedo over channels at normal and
+/// at 60° incidence, by quadrature, and whether both and ρd + ρs are ≤ 1.
+fn energy(m: &WardMaterial) -> ([f64; 2], bool) {
+    let at = |theta: f64| {
+        let wo = Vector3::new(theta.sin(), 0.0, theta.cos());
+        m.directional_albedo(&wo, 64, 128).into_iter().fold(0.0, f64::max)
+    };
+    let a = [at(0.0), at(60f64.to_radians())];
+    let sum_ok = (0..3).all(|c| m.rho_d[c] + m.lobe.map_or(0.0, |l| l.rho_s[c]) <= 1.0);
+    (a, sum_ok && a.iter().all(|&v| v <= 1.0))
+}
