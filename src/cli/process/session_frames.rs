@@ -41,7 +41,19 @@ impl SessionInputs {
             }
             (None, Some(text)) => {
                 let scene: Scene = parse("scene.ron", text).parse().map_err(|e| anyhow!("{e}"))?;
-                Some((scene, dir.to_path_buf()))
+                // The geometry beside the snapshot, else beside the scene
+                // file the session was captured from.
+                let original = snap
+                    .provenance
+                    .sources
+                    .as_ref()
+                    .and_then(|s| s.scene.as_ref())
+                    .and_then(|p| p.parent().map(Path::to_path_buf));
+                let base = match original {
+                    Some(o) if !dir.join(&scene.geometry).is_file() && o.join(&scene.geometry).is_file() => o,
+                    _ => dir.to_path_buf(),
+                };
+                Some((scene, base))
             }
             (None, None) => None,
         };
