@@ -9,8 +9,7 @@
 use campanile_process::camera::image::RadianceImage;
 use campanile_process::outdoor::rerender::{relative_rmse, target_mask};
 use campanile_process::outdoor::{
-    CellStatus, Illumination, Photo, Reflectance, ReflectanceSettings, RerenderSettings, recover_reflectance,
-    rerender,
+    CellStatus, Illumination, Photo, Reflectance, ReflectanceSettings, RerenderSettings, recover_reflectance, rerender,
 };
 use campanile_process::pose::HeadPose;
 use campanile_process::render::CameraRig;
@@ -18,8 +17,8 @@ use campanile_process::sky::Daylight;
 use campanile_sim::world::{World, examples_dir, load_scene};
 use chrono::{DateTime, Utc};
 
-fn width() -> usize { std::env::var("W").map(|v| v.parse().unwrap()).unwrap_or(128) }
-fn height() -> usize { width() * 3 / 4 }
+const WIDTH: usize = 128;
+const HEIGHT: usize = 96;
 
 fn station() -> campanile_config::Station {
     campanile_config::document::load_station(&examples_dir().join("sim-station.ron"))
@@ -32,7 +31,7 @@ fn world() -> World {
         &station(),
         load_scene(&examples_dir().join("campanile-scene.ron")).unwrap(),
     );
-    w.quality.samples_per_pixel = std::env::var("SPP").map(|v| v.parse().unwrap()).unwrap_or(16);
+    w.quality.samples_per_pixel = 16;
     w.quality.max_bounces = 2;
     w
 }
@@ -60,8 +59,11 @@ fn rig(w: &World, name: &str) -> CameraRig {
         tilt_rad: tilt.to_radians(),
     };
     let (x, y, z) = pose.position_m;
-    w.rig(head, [x, y, z], width(), height())
+    w.rig(head, [x, y, z], WIDTH, HEIGHT)
 }
+
+/// Grid spacing of the tests, metres (about three pixels of the 128-px photos).
+const SPACING_M: f64 = 2.0;
 
 const VIEWS: [&str; 4] = ["view-se", "view-sw", "view-nw", "view-ne"];
 
@@ -133,8 +135,7 @@ fn errors(refl: &Reflectance, truth: &[[f64; 3]], keep: impl Fn(usize) -> bool) 
     (sun, se)
 }
 
-fn quantile(v: &[f64], q: f64) -> f64 {
-    let mut v = v.to_vec();
+fn quantile(v: &mut [f64], q: f64) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
     v[((v.len() - 1) as f64 * q).round() as usize]
 }
@@ -155,131 +156,230 @@ fn texture_correlation(refl: &Reflectance, truth: &[[f64; 3]], surface: usize) -
     cov / (va * vb).sqrt()
 }
 
+/// Block-averaged images (k × k pixels, blocks wholly inside `mask`) and
+/// the relative RMSE between them: the comparison at the grid's resolution.
+fn block_rmse(a: &RadianceImage, b: &RadianceImage, mask: &[bool], k: usize) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    for by in 0..a.height / k {
+        for bx in 0..a.width / k {
+            let px: Vec<usize> = (0..k * k)
+                .map(|q| (by * k + q / k) * a.width + bx * k + q % k)
+                .collect();
+            if !px.iter().all(|&i| mask[i]) {
+                continue;
+            }
+            for ch in 0..3 {
+                let sa: f64 = px.iter().map(|&i| f64::from(a.data[i * 3 + ch])).sum::<f64>() / px.len() as f64;
+                let sb: f64 = px.iter().map(|&i| f64::from(b.data[i * 3 + ch])).sum::<f64>() / px.len() as f64;
+                num += (sa - sb).powi(2);
+                den += sb * sb;
+            }
+        }
+    }
+    (num / den).sqrt()
+}
+
+/// The training day's photos, rendered once for all tests of this file.
+fn training_photos(w: &World) -> &'static [Photo] {
+    static PHOTOS: std::sync::OnceLock<Vec<Photo>> = std::sync::OnceLock::new();
+    PHOTOS.get_or_init(|| photos(w, &TRAINING))
+}
+
+fn median_signed(refl: &Reflectance, truth: &[[f64; 3]], surface: usize, sun: bool) -> f64 {
+    let mut v: Vec<f64> = (0..truth.len())
+        .filter(|&c| refl.grid.cells[c].surface == surface && refl.cells[c].status == CellStatus::Solved)
+        .flat_map(|c| {
+            let e = &refl.cells[c];
+            (0..3).map(move |ch| if sun { e.rho_sun[ch] } else { e.rho_se[ch] } / truth[c][ch] - 1.0)
+        })
+        .collect();
+    quantile(&mut v, 0.5)
+}
+
 fn recover(w: &World, photos: &[Photo], times: &[&str]) -> Reflectance {
     let days = daylights(w, times);
     let lights: Vec<Illumination> = days.iter().map(|(t, d)| Illumination { time: *t, sky: d }).collect();
-    let mut settings = ReflectanceSettings {
-        spacing_m: std::env::var("SPACING").map(|v| v.parse().unwrap()).unwrap_or(2.0),
+    let settings = ReflectanceSettings {
+        spacing_m: SPACING_M,
         ..ReflectanceSettings::default()
     };
-    settings.gather.bounce_rays_per_side = 20;
     recover_reflectance(&w.scene.scene, &targets(w), photos, &lights, &settings)
         .unwrap()
         .0
 }
 
+/// Thesis §5.4 on the simulated day: pseudo-albedos from the four training
+/// times (true sun and sky), and the re-render at the held-out time.
+///
+/// The simulator's 16-spp photographs carry Monte Carlo noise of several
+/// percent per pixel where the sky and the ground light the walls, and its
+/// brick texture is finer than the 128-px photos resolve, so a 2 m cell's
+/// estimate scatters about its true mean (measured: median |error| ≈ 5.5%
+/// for ρ_se, 6% for ρ_sun, p95 ≈ 27% / 90% over all solved cells, the
+/// worst on the small pillars). The estimator is unbiased: the median
+/// signed error per wall is within 2%. Re-rendered radiance at the
+/// held-out time is compared with a 64-spp render at the grid's resolution
+/// (4 × 4-pixel blocks ≈ one 2 m cell): the renderer's own noise floor
+/// between two 64-spp seeds is 4–9% per pixel, 1–2% per block.
 #[test]
-fn explore() {
+fn pseudo_albedos_and_the_held_out_time_match_the_world() {
     let w = world();
-    let t0 = std::time::Instant::now();
-    let ph = photos(&w, &TRAINING);
-    eprintln!("photos {:?}", t0.elapsed());
-    let refl = recover(&w, &ph, &TRAINING);
-    eprintln!("recover {:?}", t0.elapsed());
+    let photos = training_photos(&w);
+    let refl = recover(&w, photos, &TRAINING);
     let tr = truth(&w, &refl);
-    for s in [CellStatus::Solved, CellStatus::NeverSunlit, CellStatus::NeverShadowed, CellStatus::IllConditioned, CellStatus::Unseen] {
-        let (a, b) = errors(&refl, &tr, |c| refl.cells[c].status == s);
-        if !a.is_empty() {
-            eprintln!("{s:?}: {} cells; sun median {:.4} p95 {:.4}; se median {:.4} p95 {:.4}", a.len() / 3, quantile(&a, 0.5), quantile(&a, 0.95), quantile(&b, 0.5), quantile(&b, 0.95));
-        }
+    let solved = |c: usize| refl.cells[c].status == CellStatus::Solved;
+    assert!(
+        refl.count(CellStatus::Solved) > 800,
+        "{} cells solved",
+        refl.count(CellStatus::Solved)
+    );
+    let (mut sun, mut se) = errors(&refl, &tr, solved);
+    let (ms, ps, me, pe) = (
+        quantile(&mut sun, 0.5),
+        quantile(&mut sun, 0.95),
+        quantile(&mut se, 0.5),
+        quantile(&mut se, 0.95),
+    );
+    eprintln!("ρ_sun |error| median {ms:.4} p95 {ps:.4}; ρ_se median {me:.4} p95 {pe:.4}");
+    assert!(ms < 0.08 && me < 0.08, "median errors ρ_sun {ms}, ρ_se {me}");
+    for name in ["south-face", "east-face", "north-face", "west-face"] {
+        let s = w.scene.scene.surface_index(name).unwrap();
+        let (a, b) = (median_signed(&refl, &tr, s, true), median_signed(&refl, &tr, s, false));
+        eprintln!("{name}: median signed error ρ_sun {a:+.4} ρ_se {b:+.4}");
+        assert!(a.abs() < 0.03 && b.abs() < 0.03, "{name}: bias ρ_sun {a}, ρ_se {b}");
     }
-    let seen = |c: usize| refl.cells[c].status != CellStatus::Unseen;
-    let (a, b) = errors(&refl, &tr, seen);
-    eprintln!("seen: sun median {:.4} p95 {:.4}; se median {:.4} p95 {:.4}", quantile(&a, 0.5), quantile(&a, 0.95), quantile(&b, 0.5), quantile(&b, 0.95));
-    for s in 0..6 {
-        let surf = targets(&w)[s];
-        eprintln!("surface {} texture corr {:.3}", w.scene.scene.surfaces()[surf], texture_correlation(&refl, &tr, surf));
+    assert!(refl.photos.iter().all(|p| !p.outlier), "{:?}", refl.photos);
+    for name in ["south-face", "east-face", "west-face"] {
+        let s = w.scene.scene.surface_index(name).unwrap();
+        // Reported, not asserted: the brick texture averaged over 2 m cells
+        // varies by a few percent, about as much as the estimates scatter.
+        eprintln!("{name}: texture correlation {:.3}", texture_correlation(&refl, &tr, s));
     }
-    for s in 0..5 {
-        let surf = targets(&w)[s];
-        let mut v: Vec<f64> = (0..tr.len()).filter(|&c| refl.grid.cells[c].surface == surf && refl.cells[c].status == CellStatus::Solved).map(|c| refl.cells[c].rho_se[1] / tr[c][1] - 1.0).collect();
-        let mut u: Vec<f64> = (0..tr.len()).filter(|&c| refl.grid.cells[c].surface == surf && refl.cells[c].status == CellStatus::Solved).map(|c| refl.cells[c].rho_sun[1] / tr[c][1] - 1.0).collect();
-        if v.is_empty() { continue; }
-        v.sort_by(|a, b| a.total_cmp(b)); u.sort_by(|a, b| a.total_cmp(b));
-        eprintln!("signed {}: se q25 {:.3} q50 {:.3} q75 {:.3} | sun q25 {:.3} q50 {:.3} q75 {:.3}", w.scene.scene.surfaces()[surf], v[v.len()/4], v[v.len()/2], v[3*v.len()/4], u[u.len()/4], u[u.len()/2], u[3*u.len()/4]);
-    }
-    let mut perfect = refl.clone();
-    for c in 0..tr.len() { perfect.cells[c].rho_se = tr[c]; perfect.cells[c].rho_sun = tr[c]; }
-    if std::env::var("DIAG").is_ok() { for d in &refl.diagnostics { eprintln!("{d}"); } }
-    for p in &refl.photos { eprintln!("{:?} {:.4} {}", p.label, p.median_log_ratio, p.observations); }
-    eprintln!("{:?}", refl.sampling);
-    // Held-out.
+
+    // The held-out time, with the true sun and sky.
     let held = daylights(&w, &[HELD_OUT]);
-    let light = Illumination { time: held[0].0, sky: &held[0].1 };
+    let light = Illumination {
+        time: held[0].0,
+        sky: &held[0].1,
+    };
+    let mut fine = w.clone();
+    fine.quality.samples_per_pixel = 64;
     for v in ["view-se", "view-sw", "view-nw"] {
         let r = rig(&w, v);
-        let mut wq = w.clone();
-        wq.quality.samples_per_pixel = 64;
-        let reference: RadianceImage = wq.render(time(HELD_OUT), &r, &[], 7).unwrap();
-        for (bil, rf) in [(false, &refl), (true, &refl), (true, &perfect)] {
-            let (img, _) = rerender(&w.scene.scene, rf, &r, &light, &RerenderSettings { bilinear: bil, ..Default::default() });
-            let mask = target_mask(&w.scene.scene, &refl, &r);
-            eprintln!("{v} bilinear {bil}: rel rmse {:.4}", relative_rmse(&img, &reference, &mask).unwrap());
-        }
+        let reference = fine.render(time(HELD_OUT), &r, &[], 7).unwrap();
+        let (image, _) = rerender(&w.scene.scene, &refl, &r, &light, &RerenderSettings::default());
+        let mask = target_mask(&w.scene.scene, &refl, &r);
+        let pixel = relative_rmse(&image, &reference, &mask).unwrap();
+        let block = block_rmse(&image, &reference, &mask, 4);
+        eprintln!("{v}: relative RMSE per pixel {pixel:.4}, per 4×4 block {block:.4}");
+        assert!(block <= 0.03, "{v}: block relative RMSE {block}");
+        assert!(pixel <= 0.12, "{v}: pixel relative RMSE {pixel}");
     }
-    eprintln!("total {:?}", t0.elapsed());
 }
 
+/// A face never sunlit (the north walls, photographed only at noon and in
+/// the afternoon) is reported, and its ρ_sun filled from the ratio of its
+/// neighbours: within 10% of the truth (median), ρ_se as good as elsewhere.
 #[test]
-fn explore_irradiance() {
+fn a_face_never_sunlit_is_reported_and_filled() {
     let w = world();
-    let ph = photos(&w, &TRAINING[..2]);
-    let days = daylights(&w, &TRAINING[..2]);
-    let lights: Vec<Illumination> = days.iter().map(|(t, d)| Illumination { time: *t, sky: d }).collect();
-    let mut settings = ReflectanceSettings { spacing_m: 2.0, ..ReflectanceSettings::default() };
-    let b: usize = std::env::var("BOUNCE").map(|v| v.parse().unwrap()).unwrap_or(16);
-    let e: usize = std::env::var("ENVRAYS").map(|v| v.parse().unwrap()).unwrap_or(6);
-    let ts: u32 = std::env::var("TRUTHS").map(|v| v.parse().unwrap()).unwrap_or(4000);
-    settings.gather.bounce_rays_per_side = b;
-    settings.gather.environment_rays_per_side = e;
-    let t0 = std::time::Instant::now();
-    let (refl, tls) = recover_reflectance(&w.scene.scene, &targets(&w), &ph, &lights, &settings).unwrap();
-    eprintln!("recover {:?}", t0.elapsed());
+    let photos: Vec<Photo> = training_photos(&w)[4..12].to_vec();
+    let times = &TRAINING[1..3];
+    let refl = recover(&w, &photos, times);
     let tr = truth(&w, &refl);
-    let mut ratios = Vec::new();
-    for c in (0..refl.grid.cells.len()).step_by(37) {
-        let cell = &refl.grid.cells[c];
-        for (k, tl) in tls.iter().enumerate() {
-            let se = tl.se_irradiance(c, &tr, &tr);
-            let sun = tl.sun_irradiance(c);
-            let vis = tl.sun.map_or(false, |s| campanile_process::outdoor::cell_irradiance::sun_visible(&w.scene.scene, &s, &cell.centre, &cell.normal));
-            let mine: Vec<f64> = (0..3).map(|ch| se[ch] + if vis { sun[ch] } else { 0.0 }).collect();
-            let p = cell.centre;
-            let n = cell.normal;
-            let truth_e = w.irradiance(lights[k].time, [p.x, p.y, p.z], [n.x, n.y, n.z], &[], ts, 3).unwrap();
-            let sky_only = tl.cells[c].sky;
-            eprintln!("cell {c} {} t{k} vis {vis}: mine {:.1} truth {:.1} ratio {:.3}  sky {:.1} env {:.1} refl {:.1}", w.scene.scene.surfaces()[cell.surface], mine[1], truth_e[1], mine[1] / truth_e[1], sky_only[1], tl.cells[c].environment[1], se[1] - sky_only[1] - tl.cells[c].environment[1]);
-            ratios.push(mine[1] / truth_e[1]);
-        }
-    }
-    eprintln!("median ratio {:.4}", quantile(&ratios, 0.5));
+    let north = w.scene.scene.surface_index("north-face").unwrap();
+    let shaft = refl
+        .grid
+        .faces
+        .iter()
+        .position(|f| f.surface == north && f.cells.len() > 100)
+        .unwrap();
+    let face = &refl.grid.faces[shaft];
+    let seen: Vec<usize> = face
+        .cells
+        .iter()
+        .copied()
+        .filter(|&c| refl.cells[c].status != CellStatus::Unseen)
+        .collect();
+    assert!(seen.len() > 100);
+    assert!(
+        seen.iter().all(|&c| refl.cells[c].status == CellStatus::NeverSunlit),
+        "statuses {:?}",
+        seen.iter().map(|&c| refl.cells[c].status).collect::<Vec<_>>()
+    );
+    let said = refl
+        .diagnostics
+        .iter()
+        .find(|d| d.contains("north-face") && d.contains("never seen sunlit"));
+    assert!(said.is_some(), "diagnostics {:#?}", refl.diagnostics);
+    let (mut sun, mut se) = errors(&refl, &tr, |c| seen.contains(&c));
+    let (ms, me) = (quantile(&mut sun, 0.5), quantile(&mut se, 0.5));
+    eprintln!(
+        "north face filled: ρ_sun median |error| {ms:.4}, ρ_se {me:.4}; {}",
+        said.unwrap()
+    );
+    assert!(ms < 0.10 && me < 0.08, "ρ_sun {ms}, ρ_se {me}");
+    // The stated uncertainty of the filled ρ_sun is larger than of ρ_se.
+    let c = seen[seen.len() / 2];
+    assert!(refl.cells[c].sigma_sun[1] > refl.cells[c].sigma_se[1]);
 }
 
+/// A photo whose exposure metadata is wrong by a factor of two (its
+/// radiance doubled) is caught as an outlier and left out; the others are
+/// kept and the estimates stay as good as without it.
 #[test]
-fn explore_obs() {
-    use campanile_process::outdoor::observation::observe;
+fn a_photo_with_a_wrong_exposure_is_rejected() {
     let w = world();
-    let ph = photos(&w, &TRAINING);
-    let days = daylights(&w, &TRAINING);
-    let lights: Vec<Illumination> = days.iter().map(|(t, d)| Illumination { time: *t, sky: d }).collect();
-    let mut settings = ReflectanceSettings { spacing_m: std::env::var("SPACING").map(|v| v.parse().unwrap()).unwrap_or(2.0), ..ReflectanceSettings::default() };
-    settings.gather.bounce_rays_per_side = 20;
-    let (refl, tls) = recover_reflectance(&w.scene.scene, &targets(&w), &ph, &lights, &settings).unwrap();
+    let mut photos: Vec<Photo> = training_photos(&w).to_vec();
+    for v in photos[5].image.data.iter_mut() {
+        *v *= 2.0;
+    }
+    let refl = recover(&w, &photos, &TRAINING);
+    let flagged: Vec<usize> = (0..photos.len()).filter(|&k| refl.photos[k].outlier).collect();
+    eprintln!(
+        "flagged {flagged:?}; {:?}",
+        refl.diagnostics.iter().find(|d| d.contains("outlier"))
+    );
+    assert_eq!(flagged, vec![5]);
+    assert!(refl.photos[5].median_log_ratio > 0.4, "{:?}", refl.photos[5]);
     let tr = truth(&w, &refl);
-    let times: Vec<usize> = (0..ph.len()).map(|k| k / 4).collect();
-    let (obs, _) = observe(&w.scene.scene, &refl.grid, &ph, &lights, &times).unwrap();
-    let mut all = Vec::new();
-    for o in &obs {
-        let c = o.cell;
-        let tl = &tls[o.time];
-        let se = tl.se_irradiance(c, &tr, &tr);
-        let sun = if o.sunlit { tl.sun_irradiance(c) } else { [0.0; 3] };
-        let r = std::f64::consts::PI * o.radiance[1] / (tr[c][1] * (se[1] + sun[1]));
-        all.push(r);
-        if c % 97 == 0 {
-            eprintln!("cell {c} {} photo {} t{} lit {} px {} ratio {:.3}  (E_se {:.1} E_sun {:.1}) est se {:.3} sun {:.3} truth {:.3}", w.scene.scene.surfaces()[refl.grid.cells[c].surface], o.photo, o.time, o.sunlit, o.pixels, r, se[1], sun[1], refl.cells[c].rho_se[1], refl.cells[c].rho_sun[1], tr[c][1]);
+    let (mut sun, mut se) = errors(&refl, &tr, |c| refl.cells[c].status == CellStatus::Solved);
+    let (ms, me) = (quantile(&mut sun, 0.5), quantile(&mut se, 0.5));
+    assert!(ms < 0.08 && me < 0.08, "ρ_sun {ms}, ρ_se {me}");
+}
+
+/// Without the evening, cells lose their sunlit or shadowed view and are
+/// filled; the estimates degrade but their stated uncertainty says so:
+/// at least 80% of the errors lie within three stated standard deviations.
+#[test]
+fn a_missing_time_degrades_with_stated_uncertainty() {
+    let w = world();
+    let photos: Vec<Photo> = training_photos(&w)[..12].to_vec();
+    let refl = recover(&w, &photos, &TRAINING[..3]);
+    let tr = truth(&w, &refl);
+    let seen: Vec<usize> = (0..tr.len())
+        .filter(|&c| refl.cells[c].status != CellStatus::Unseen)
+        .collect();
+    let (mut inside, mut total) = (0, 0);
+    for &c in &seen {
+        let e = &refl.cells[c];
+        for ch in 0..3 {
+            for (est, sigma) in [(e.rho_sun[ch], e.sigma_sun[ch]), (e.rho_se[ch], e.sigma_se[ch])] {
+                total += 1;
+                if (est - tr[c][ch]).abs() <= 3.0 * sigma {
+                    inside += 1;
+                }
+            }
         }
     }
-    let dev: Vec<f64> = all.iter().map(|r| (r - 1.0).abs()).collect();
-    eprintln!("obs ratio: median {:.4} |dev| median {:.4} p90 {:.4}", quantile(&all, 0.5), quantile(&dev, 0.5), quantile(&dev, 0.9));
+    let coverage = f64::from(inside) / f64::from(total);
+    let filled = seen.len() - refl.count(CellStatus::Solved);
+    let (mut sun, mut se) = errors(&refl, &tr, |c| seen.contains(&c));
+    let (ms, me) = (quantile(&mut sun, 0.5), quantile(&mut se, 0.5));
+    eprintln!(
+        "3 times: {filled} of {} seen cells filled; coverage of 3σ {coverage:.3}; median |error| ρ_sun {ms:.4} ρ_se {me:.4}",
+        seen.len()
+    );
+    assert!(coverage >= 0.8, "coverage {coverage}");
+    assert!(ms < 0.12 && me < 0.10, "ρ_sun {ms}, ρ_se {me}");
 }

@@ -130,8 +130,15 @@ fn cosine_directions(n: &Vector3<f64>, m: usize, seed: u64) -> Vec<Vector3<f64>>
 }
 
 enum Hit {
-    Target { cell: usize, lit: bool },
-    Environment { key: EnvKey, albedo: [f64; 3], lit_cos: f64 },
+    Target {
+        cell: usize,
+        lit: bool,
+    },
+    Environment {
+        key: EnvKey,
+        albedo: [f64; 3],
+        lit_cos: f64,
+    },
     Sky,
     Nothing,
 }
@@ -141,7 +148,14 @@ pub(super) type EnvKey = (usize, bool, i32, i64, i64);
 
 /// The environment lattice square of `point` on non-target triangle `tri`
 /// seen from side `front`, its spacing growing with the distance from `centre`.
-pub(super) fn env_key(scene: &Scene, tri: usize, point: &Vector3<f64>, front: bool, centre: &Vector3<f64>, base_m: f64) -> EnvKey {
+pub(super) fn env_key(
+    scene: &Scene,
+    tri: usize,
+    point: &Vector3<f64>,
+    front: bool,
+    centre: &Vector3<f64>,
+    base_m: f64,
+) -> EnvKey {
     let r = (point - centre).norm();
     let level = (r / 16.0).log2().floor().max(0.0) as i32;
     let k = base_m * 2f64.powi(level);
@@ -241,7 +255,11 @@ pub fn gather(scene: &Scene, grid: &Grid, light: &Illumination, settings: &Gathe
                         }
                     }
                     let tri = &scene.triangles()[h.triangle];
-                    let n_hit = if tri.normal.dot(&d) < 0.0 { tri.normal } else { -tri.normal };
+                    let n_hit = if tri.normal.dot(&d) < 0.0 {
+                        tri.normal
+                    } else {
+                        -tri.normal
+                    };
                     let lit_cos = sun
                         .as_ref()
                         .filter(|s| sun_visible(scene, s, &h.point, &n_hit))
@@ -249,12 +267,22 @@ pub fn gather(scene: &Scene, grid: &Grid, light: &Illumination, settings: &Gathe
                     if let Some(vn) = grid.visible_normal(scene, h.triangle) {
                         return match grid.cell_at(scene, h.triangle, &h.point) {
                             // The back of a target (inside the building) reflects nothing.
-                            Some(cell) if vn.dot(&d) < 0.0 => Hit::Target { cell, lit: lit_cos > 0.0 },
+                            Some(cell) if vn.dot(&d) < 0.0 => Hit::Target {
+                                cell,
+                                lit: lit_cos > 0.0,
+                            },
                             _ => Hit::Nothing,
                         };
                     }
                     Hit::Environment {
-                        key: env_key(scene, h.triangle, &h.point, n_hit.dot(&tri.normal) > 0.0, &centre, base_m),
+                        key: env_key(
+                            scene,
+                            h.triangle,
+                            &h.point,
+                            n_hit.dot(&tri.normal) > 0.0,
+                            &centre,
+                            base_m,
+                        ),
                         albedo: scene.albedo_at(h.triangle, &h.point),
                         lit_cos,
                     }
@@ -387,7 +415,9 @@ mod tests {
         ];
         let scene = Scene::new(tris, vec![Material::diffuse("m", [0.5; 3])], vec!["floor".into()]).unwrap();
         let grid = Grid::new(&scene, &[0], 1.0, &[Vector3::new(1.0, 1.0, 5.0)]).unwrap();
-        let sky = UniformSky { radiance: [1.0, 2.0, 3.0] };
+        let sky = UniformSky {
+            radiance: [1.0, 2.0, 3.0],
+        };
         let light = Illumination {
             time: chrono::DateTime::UNIX_EPOCH,
             sky: &sky,
@@ -412,14 +442,25 @@ mod tests {
             let c = Vector3::new(x, 50.0, 50.0);
             let d = Vector3::new(x, -50.0, 50.0);
             if flip {
-                [Triangle::new([a, c, b], 0, 1).unwrap(), Triangle::new([a, d, c], 0, 1).unwrap()]
+                [
+                    Triangle::new([a, c, b], 0, 1).unwrap(),
+                    Triangle::new([a, d, c], 0, 1).unwrap(),
+                ]
             } else {
-                [Triangle::new([a, b, c], 0, 0).unwrap(), Triangle::new([a, c, d], 0, 0).unwrap()]
+                [
+                    Triangle::new([a, b, c], 0, 0).unwrap(),
+                    Triangle::new([a, c, d], 0, 0).unwrap(),
+                ]
             }
         };
         let mut tris = q(0.0, false).to_vec();
         tris.extend(q(1.0, true));
-        let scene = Scene::new(tris, vec![Material::diffuse("m", [0.5; 3])], vec!["a".into(), "b".into()]).unwrap();
+        let scene = Scene::new(
+            tris,
+            vec![Material::diffuse("m", [0.5; 3])],
+            vec!["a".into(), "b".into()],
+        )
+        .unwrap();
         // Target: wall a, seen from x > 0; wall b is environment.
         let grid = Grid::new(&scene, &[0, 1], 25.0, &[Vector3::new(0.5, 0.0, 0.0)]).unwrap();
         let sky = UniformSky { radiance: [1.0; 3] };

@@ -168,7 +168,11 @@ fn median(v: &mut [f64]) -> Option<f64> {
     }
     v.sort_by(|a, b| a.total_cmp(b));
     let n = v.len();
-    Some(if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) })
+    Some(if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    })
 }
 
 /// Weighted least squares of `y ≈ a·x1 + b·x2` on relative residuals with
@@ -194,12 +198,7 @@ fn fit2(rows: &[(f64, f64, f64, f64)], huber: f64) -> Option<(Vector2<f64>, Matr
         }
         // Condition of the column-scaled matrix.
         let d = Vector2::new(m[(0, 0)].sqrt(), m[(1, 1)].sqrt());
-        let scaled = Matrix2::new(
-            1.0,
-            m[(0, 1)] / (d[0] * d[1]),
-            m[(1, 0)] / (d[0] * d[1]),
-            1.0,
-        );
+        let scaled = Matrix2::new(1.0, m[(0, 1)] / (d[0] * d[1]), m[(1, 0)] / (d[0] * d[1]), 1.0);
         let eig = scaled.symmetric_eigenvalues();
         let cond = eig.max() / eig.min().max(1e-300);
         sol = Some((p, inv, cond));
@@ -263,6 +262,9 @@ fn rows_of(
         })
         .collect()
 }
+
+/// A photo is judged an outlier only on at least this many solved cells.
+pub const MIN_OUTLIER_EVIDENCE: usize = 30;
 
 /// Sunlit rows whose sun term is at least this fraction of the sky term count as "seen sunlit".
 const SUNLIT_SIGNIFICANT: f64 = 0.05;
@@ -366,7 +368,10 @@ pub fn recover_reflectance(
     let viewpoints: Vec<_> = photos.iter().map(|p| p.rig.position).collect();
     let grid = Grid::new(scene, targets, settings.spacing_m, &viewpoints)?;
     let (obs, sampling) = observe(scene, &grid, photos, lights, &times)?;
-    let tls: Vec<TimeLight> = lights.iter().map(|l| gather(scene, &grid, l, &settings.gather)).collect();
+    let tls: Vec<TimeLight> = lights
+        .iter()
+        .map(|l| gather(scene, &grid, l, &settings.gather))
+        .collect();
     let n = grid.cells.len();
     let mut by_cell: Vec<Vec<&Observation>> = vec![Vec::new(); n];
     for o in &obs {
@@ -504,7 +509,11 @@ pub fn recover_reflectance(
         if let Some((worst, c)) = checks
             .iter()
             .enumerate()
-            .filter(|(p, c)| active[*p] && c.median_log_ratio.abs() > settings.outlier_log_ratio)
+            .filter(|(p, c)| {
+                active[*p]
+                    && c.observations >= MIN_OUTLIER_EVIDENCE
+                    && c.median_log_ratio.abs() > settings.outlier_log_ratio
+            })
             .max_by(|a, b| a.1.median_log_ratio.abs().total_cmp(&b.1.median_log_ratio.abs()))
             && active.iter().filter(|a| **a).count() > 1
         {
@@ -524,8 +533,12 @@ pub fn recover_reflectance(
     for (fi, f) in grid.faces.iter().enumerate() {
         let count = |s: CellStatus| f.cells.iter().filter(|&&c| estimates[c].status == s).count();
         let name = scene.surfaces()[f.surface].as_str();
-        let (ns, nsh, unseen) = (count(CellStatus::NeverSunlit), count(CellStatus::NeverShadowed), count(CellStatus::Unseen));
-        if ns == f.cells.len() {
+        let (ns, nsh, unseen) = (
+            count(CellStatus::NeverSunlit),
+            count(CellStatus::NeverShadowed),
+            count(CellStatus::Unseen),
+        );
+        if ns > 0 && ns + unseen == f.cells.len() {
             diagnostics.push(format!(
                 "face {fi} of {name:?} (normal {:.2?}): never seen sunlit; ρ_sun filled with ratio {:.3?} from neighbouring faces of the same surface or the scene",
                 f.normal.as_slice(),

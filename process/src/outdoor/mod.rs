@@ -24,6 +24,9 @@
 //! (§5.6.4, eq. 5.16); specular pseudo-BRDFs (the surfaces are taken as
 //! Lambertian); landscape radiance from an environment map.
 
+// Channel loops index several arrays at once; they read better with an index.
+#![allow(clippy::needless_range_loop)]
+
 pub mod atlas;
 pub mod cell_irradiance;
 pub mod estimate;

@@ -179,8 +179,12 @@ fn observe_photo(
                     let mut seen = 0;
                     let mut asked = 0;
                     for (du, dv) in [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)] {
-                        let Some(r) = photo.rig.ray(x as f64 + du, y as f64 + dv) else { continue };
-                        let Some(hh) = scene.intersect(&r, f64::INFINITY) else { continue };
+                        let Some(r) = photo.rig.ray(x as f64 + du, y as f64 + dv) else {
+                            continue;
+                        };
+                        let Some(hh) = scene.intersect(&r, f64::INFINITY) else {
+                            continue;
+                        };
                         let nn = grid.visible_normal(scene, hh.triangle).unwrap_or(n);
                         asked += 1;
                         if sun_visible(scene, s, &hh.point, &nn) {

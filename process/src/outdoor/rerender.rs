@@ -44,6 +44,7 @@ impl Default for RerenderSettings {
 }
 
 /// The pseudo-albedos at `point` on target `triangle`, in cell `cell`.
+#[allow(clippy::too_many_arguments)]
 fn albedos_at(
     scene: &Scene,
     refl: &Reflectance,
@@ -132,14 +133,20 @@ pub fn rerender(
                     count += 1.0;
                     let Some(hit) = scene.intersect(&ray, f64::INFINITY) else {
                         let l = light.sky.radiance(&ray.direction);
-                        let disc = sun.filter(|s| s.contains(&ray.direction)).map_or([0.0; 3], |s| s.radiance);
+                        let disc = sun
+                            .filter(|s| s.contains(&ray.direction))
+                            .map_or([0.0; 3], |s| s.radiance);
                         for ch in 0..3 {
                             sum[ch] += l[ch] + disc[ch];
                         }
                         continue;
                     };
                     let tri = &scene.triangles()[hit.triangle];
-                    let n = if tri.normal.dot(&ray.direction) < 0.0 { tri.normal } else { -tri.normal };
+                    let n = if tri.normal.dot(&ray.direction) < 0.0 {
+                        tri.normal
+                    } else {
+                        -tri.normal
+                    };
                     let lit = sun.as_ref().is_some_and(|s| sun_visible(scene, s, &hit.point, &n));
                     let cos = sun.map_or(0.0, |s| n.dot(&s.direction).max(0.0));
                     let cell = grid
@@ -147,8 +154,16 @@ pub fn rerender(
                         .filter(|vn| vn.dot(&n) > 0.0)
                         .and_then(|_| grid.cell_at(scene, hit.triangle, &hit.point));
                     if let Some(c) = cell {
-                        let (rs, re) =
-                            albedos_at(scene, refl, &rho_sun, &rho_se, c, hit.triangle, &hit.point, settings.bilinear);
+                        let (rs, re) = albedos_at(
+                            scene,
+                            refl,
+                            &rho_sun,
+                            &rho_se,
+                            c,
+                            hit.triangle,
+                            &hit.point,
+                            settings.bilinear,
+                        );
                         for ch in 0..3 {
                             let es = if lit { e_sun[ch] * cos } else { 0.0 };
                             sum[ch] += (rs[ch] * es + re[ch] * e_se[c][ch]) / std::f64::consts::PI;
@@ -161,7 +176,14 @@ pub fn rerender(
                             .entry((hit.triangle, front))
                             .or_insert_with(|| open_sky(light, &n, &settings.gather.sky));
                         let es = *cache.entry(key).or_insert_with(|| {
-                            env_sky(scene, key, base_m, o, &sky_of, settings.gather.environment_rays_per_side)
+                            env_sky(
+                                scene,
+                                key,
+                                base_m,
+                                o,
+                                &sky_of,
+                                settings.gather.environment_rays_per_side,
+                            )
                         });
                         for ch in 0..3 {
                             let direct = if lit { e_sun[ch] * cos } else { 0.0 };
@@ -177,7 +199,14 @@ pub fn rerender(
             }
         }
     });
-    (RadianceImage { width: w, height: h, data }, tl)
+    (
+        RadianceImage {
+            width: w,
+            height: h,
+            data,
+        },
+        tl,
+    )
 }
 
 /// Pixels of `rig`'s image whose centre sees a target cell of `refl`.
@@ -198,8 +227,7 @@ pub fn target_mask(scene: &Scene, refl: &Reflectance, rig: &CameraRig) -> Vec<bo
 /// (all channels): `√(Σ (a − b)²) / √(Σ b²)`. `None` when the mask is
 /// empty, the sizes differ or the reference is black there.
 pub fn relative_rmse(image: &RadianceImage, reference: &RadianceImage, mask: &[bool]) -> Option<f64> {
-    if image.width != reference.width || image.height != reference.height || mask.len() != image.width * image.height
-    {
+    if image.width != reference.width || image.height != reference.height || mask.len() != image.width * image.height {
         return None;
     }
     let (mut num, mut den) = (0.0, 0.0);
@@ -215,4 +243,87 @@ pub fn relative_rmse(image: &RadianceImage, reference: &RadianceImage, mask: &[b
         }
     }
     (den > 0.0).then(|| (num / den).sqrt())
+}
+
+/// A photo from the camera being rendered, with the light it was taken
+/// under: the source of texture finer than the grid (§5.6.4).
+#[derive(Clone, Copy)]
+pub struct Reference<'a> {
+    /// The photo.
+    pub photo: &'a super::photo::Photo,
+    /// The illumination at its time.
+    pub light: &'a Illumination<'a>,
+}
+
+/// Largest |ln f| departure from the references' median texture factor
+/// still averaged in (shadow edges and outliers beyond it are dropped).
+pub const TEXTURE_FACTOR_SPREAD: f64 = 0.3;
+
+/// The view-dependent re-rendering of §5.6.4, eq. (5.16): the grid's
+/// pseudo-albedos give a low-resolution image `Ĩ` at any time; a reference
+/// photo `I` from the same camera gives, per pixel, the factor
+/// `f = I / Ĩ_ref` by which the true pseudo-albedo departs from the grid's
+/// (`ρ = I / Ẽ`, `Ẽ = Ĩ / ρ̃`), and the new image is `Ĩ_new · f`.
+/// Several references are averaged (weighted by their radiance, after
+/// dropping factors more than [`TEXTURE_FACTOR_SPREAD`] in log from their
+/// median, which removes shadow edges that moved); pixels that see no
+/// target, or no reference from this camera, keep `Ĩ_new`. Returns the
+/// image and how many references matched the camera.
+pub fn rerender_with_references(
+    scene: &Scene,
+    refl: &Reflectance,
+    rig: &CameraRig,
+    light: &Illumination,
+    references: &[Reference],
+    settings: &RerenderSettings,
+) -> (RadianceImage, usize) {
+    let (base, _) = rerender(scene, refl, rig, light, settings);
+    let same = |r: &CameraRig| {
+        r.width == rig.width
+            && r.height == rig.height
+            && (r.position - rig.position).norm() < 1e-3
+            && (r.head.pan_rad - rig.head.pan_rad).abs() < 1e-6
+            && (r.head.tilt_rad - rig.head.tilt_rad).abs() < 1e-6
+    };
+    let refs: Vec<&Reference> = references.iter().filter(|r| same(&r.photo.rig)).collect();
+    if refs.is_empty() {
+        return (base, 0);
+    }
+    let mask = target_mask(scene, refl, rig);
+    let low: Vec<RadianceImage> = refs
+        .iter()
+        .map(|r| rerender(scene, refl, rig, r.light, settings).0)
+        .collect();
+    let mut out = base.clone();
+    for (i, m) in mask.iter().enumerate() {
+        if !*m {
+            continue;
+        }
+        for ch in 0..3 {
+            let mut f: Vec<(f64, f64)> = refs
+                .iter()
+                .zip(&low)
+                .filter_map(|(r, l)| {
+                    let lo = f64::from(l.data[i * 3 + ch]);
+                    let hi = f64::from(r.photo.image.data[i * 3 + ch]);
+                    let ok = lo > 0.0 && hi.is_finite() && hi > 0.0 && r.photo.mask.as_ref().is_none_or(|m| m[i]);
+                    ok.then(|| ((hi / lo).ln(), lo))
+                })
+                .collect();
+            if f.is_empty() {
+                continue;
+            }
+            f.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let med = f[f.len() / 2].0;
+            let (mut s, mut w) = (0.0, 0.0);
+            for (lf, lo) in f.iter().filter(|(lf, _)| (lf - med).abs() <= TEXTURE_FACTOR_SPREAD) {
+                s += lf * lo;
+                w += lo;
+            }
+            if w > 0.0 {
+                out.data[i * 3 + ch] = (f64::from(base.data[i * 3 + ch]) * (s / w).exp()) as f32;
+            }
+        }
+    }
+    (out, refs.len())
 }
