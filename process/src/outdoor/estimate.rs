@@ -80,6 +80,9 @@ pub enum CellStatus {
     IllConditioned,
     /// No photo saw it: the median of its nearest seen neighbours.
     Unseen,
+    /// Read from a materials file ([`super::atlas`]); its findings are in
+    /// the file's diagnostics.
+    FromFile,
 }
 
 /// One cell's pseudo-albedos and how far to trust them.

@@ -90,6 +90,24 @@ impl Grid {
         spacing_m: f64,
         viewpoints: &[Vector3<f64>],
     ) -> Result<Grid, OutdoorError> {
+        Grid::with_sides(scene, targets, spacing_m, &|tri: &Triangle| {
+            let centroid = (tri.vertices[0] + tri.vertices[1] + tri.vertices[2]) / 3.0;
+            let facing: f64 = viewpoints
+                .iter()
+                .map(|v| (v - centroid).normalize().dot(&tri.normal).signum())
+                .sum();
+            if facing < 0.0 { -1.0 } else { 1.0 }
+        })
+    }
+
+    /// The grid with each target triangle's visible side given by `side`
+    /// (+1: along its stored normal, −1: against it).
+    pub fn with_sides(
+        scene: &Scene,
+        targets: &[usize],
+        spacing_m: f64,
+        side_of: &dyn Fn(&Triangle) -> f64,
+    ) -> Result<Grid, OutdoorError> {
         if !(spacing_m.is_finite() && spacing_m > 0.0) {
             return Err(OutdoorError::BadSpacing { spacing_m });
         }
@@ -112,12 +130,7 @@ impl Grid {
             if !targets.contains(&(tri.surface as usize)) {
                 continue;
             }
-            let centroid = (tri.vertices[0] + tri.vertices[1] + tri.vertices[2]) / 3.0;
-            let facing: f64 = viewpoints
-                .iter()
-                .map(|v| (v - centroid).normalize().dot(&tri.normal).signum())
-                .sum();
-            let sgn = if facing < 0.0 { -1.0 } else { 1.0 };
+            let sgn = if side_of(tri) < 0.0 { -1.0 } else { 1.0 };
             side[ti] = Some(sgn);
             let normal = tri.normal * sgn;
             let offset = normal.dot(&tri.vertices[0]);

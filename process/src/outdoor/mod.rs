@@ -11,6 +11,7 @@
 //!   rejection, neighbour fill and per-cell conditioning and uncertainty.
 //! - [`rerender`]: radiance images at any time and sky (§5.5, §5.6).
 //! - [`atlas`]: pseudo-albedo texture atlases (EXR) and the materials file.
+//! - [`photograph`]: renders through a response curve at a chosen shutter.
 //!
 //! The environment is the scene's non-target surfaces (ground, landscape)
 //! with their materials' albedo, lit by the same sun and sky: the lead sets
@@ -33,6 +34,7 @@ pub mod estimate;
 pub mod grid;
 pub mod observation;
 pub mod photo;
+pub mod photograph;
 pub mod rerender;
 
 use chrono::{DateTime, Utc};
