@@ -6,6 +6,7 @@ mod env;
 mod hdr;
 mod logging;
 mod plan;
+mod render;
 mod ron_output;
 mod site;
 mod sky;
@@ -70,6 +71,8 @@ pub enum Command {
     },
     /// Run a plan on a station into a session directory, or resume one (simulated stations for now).
     Capture(capture::CaptureArgs),
+    /// Render the scene at a time, a sunrise-to-sunset sequence or overcast, from recovered pseudo-albedos.
+    Render(render::RenderArgs),
     /// Plans: simulate one forward without devices (timeline, frames, durations, what it will not cover).
     Plan {
         #[command(subcommand)]
@@ -110,6 +113,7 @@ pub fn run() -> ExitCode {
         Command::Env { action } => report(env::run(action)),
         Command::Plan { action } => plan::run(action),
         Command::Capture(args) => capture::run(args),
+        Command::Render(args) => report(render::run(args)),
     };
     ExitCode::from(code)
 }
