@@ -223,6 +223,30 @@ impl Grid {
         self.lookup.get(&(triangle, i, j)).copied()
     }
 
+    /// The cell containing `point` on `triangle`, or else the nearest cell
+    /// of the same face within two lattice steps (slivers of a triangle too
+    /// thin to hold a cell sub-sample have none of their own).
+    pub fn nearest_cell(&self, scene: &Scene, triangle: usize, point: &Vector3<f64>) -> Option<usize> {
+        if let Some(c) = self.cell_at(scene, triangle, point) {
+            return Some(c);
+        }
+        let face = self.face_of(triangle)?;
+        let [s, t] = scene.triangles()[triangle].texture_coordinates(point);
+        let (i, j) = ((s / self.spacing_m).floor() as i64, (t / self.spacing_m).floor() as i64);
+        let mut best: Option<(f64, usize)> = None;
+        for di in -2..=2i64 {
+            for dj in -2..=2i64 {
+                for &c in self.by_face.get(&(face, i + di, j + dj)).into_iter().flatten() {
+                    let d = (self.cells[c].centre - point).norm();
+                    if best.is_none_or(|b| d < b.0) {
+                        best = Some((d, c));
+                    }
+                }
+            }
+        }
+        best.map(|b| b.1)
+    }
+
     /// The cells of the same face within `ring` lattice steps of `cell`
     /// (itself excluded).
     pub fn neighbours(&self, cell: usize, ring: i64) -> Vec<usize> {

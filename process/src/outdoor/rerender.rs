@@ -8,7 +8,8 @@
 //! the pseudo-albedos are interpolated bilinearly between the cell centres
 //! of the face (or taken per cell). A ray that meets a non-target surface
 //! returns its material's albedo times its direct irradiance over π; a ray
-//! that escapes returns the sky (and the solar disc).
+//! that escapes returns the sky (and the solar disc). The back of a target
+//! surface, which no photo saw, is shaded like the environment.
 
 use std::collections::HashMap;
 
@@ -152,7 +153,7 @@ pub fn rerender(
                     let cell = grid
                         .visible_normal(scene, hit.triangle)
                         .filter(|vn| vn.dot(&n) > 0.0)
-                        .and_then(|_| grid.cell_at(scene, hit.triangle, &hit.point));
+                        .and_then(|_| grid.nearest_cell(scene, hit.triangle, &hit.point));
                     if let Some(c) = cell {
                         let (rs, re) = albedos_at(
                             scene,
@@ -168,7 +169,9 @@ pub fn rerender(
                             let es = if lit { e_sun[ch] * cos } else { 0.0 };
                             sum[ch] += (rs[ch] * es + re[ch] * e_se[c][ch]) / std::f64::consts::PI;
                         }
-                    } else if grid.visible_normal(scene, hit.triangle).is_none() {
+                    } else {
+                        // The environment, and the back of a target (seen
+                        // from the side no photo saw): the scene's material.
                         let albedo = scene.albedo_at(hit.triangle, &hit.point);
                         let front = n.dot(&tri.normal) > 0.0;
                         let key = env_key(scene, hit.triangle, &hit.point, front, &centre, base_m);
@@ -209,15 +212,19 @@ pub fn rerender(
     )
 }
 
-/// Pixels of `rig`'s image whose centre sees a target cell of `refl`.
+/// Pixels of `rig`'s image whose centre sees a target cell of `refl` on its visible side.
 pub fn target_mask(scene: &Scene, refl: &Reflectance, rig: &CameraRig) -> Vec<bool> {
     let mut out = vec![false; rig.width * rig.height];
     for y in 0..rig.height {
         for x in 0..rig.width {
-            out[y * rig.width + x] = rig
-                .ray(x as f64 + 0.5, y as f64 + 0.5)
-                .and_then(|r| scene.intersect(&r, f64::INFINITY))
-                .is_some_and(|h| refl.grid.cell_at(scene, h.triangle, &h.point).is_some());
+            out[y * rig.width + x] = rig.ray(x as f64 + 0.5, y as f64 + 0.5).is_some_and(|r| {
+                scene.intersect(&r, f64::INFINITY).is_some_and(|h| {
+                    refl.grid
+                        .visible_normal(scene, h.triangle)
+                        .is_some_and(|n| n.dot(&r.direction) < 0.0)
+                        && refl.grid.cell_at(scene, h.triangle, &h.point).is_some()
+                })
+            });
         }
     }
     out
