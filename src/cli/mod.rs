@@ -9,6 +9,7 @@ mod hdr;
 mod logging;
 mod plan;
 mod process;
+mod render;
 mod ron_output;
 mod site;
 mod sky;
@@ -79,6 +80,8 @@ pub enum Command {
     Process(process::ProcessArgs),
     /// List serial ports and cameras, or test a station's devices (`devices test --station FILE`).
     Devices(devices::DevicesArgs),
+    /// Render the scene at a time, a sunrise-to-sunset sequence or overcast, from recovered pseudo-albedos.
+    Render(render::RenderArgs),
     /// Plans: simulate one forward without devices (timeline, frames, durations, what it will not cover).
     Plan {
         #[command(subcommand)]
@@ -122,6 +125,7 @@ pub fn run() -> ExitCode {
         Command::Demo(args) => report(demo::run(args)),
         Command::Process(args) => report(process::run(args)),
         Command::Devices(args) => devices::run(args),
+        Command::Render(args) => report(render::run(args)),
     };
     ExitCode::from(code)
 }

@@ -1,0 +1,219 @@
+//! `campanile render`: the scene under new light from recovered
+//! pseudo-albedos (thesis §5.5–§5.6): one time, a sunrise-to-sunset
+//! sequence, or an overcast sky.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use campanile_process::camera::image::RadianceImage;
+use campanile_process::exr_io::write_radiance_exr;
+use campanile_process::hdr::curve::ResponseCurve;
+use campanile_process::hdr::image_file::write_png;
+use campanile_process::hdr::merge::RadianceMap;
+use campanile_process::outdoor::atlas::read_materials;
+use campanile_process::outdoor::photograph::photograph;
+use campanile_process::outdoor::{Illumination, RerenderSettings, rerender};
+use campanile_process::pose::HeadPose;
+use campanile_process::render::CameraRig;
+use campanile_process::sky::{Atmosphere, Daylight};
+use campanile_process::sun::{Observer, sun_position};
+use campanile_sim::world::load_scene;
+use campanile_sim::world::rig::{mount, pinhole_at};
+use chrono::{DateTime, Duration, NaiveDate, Utc};
+use clap::Args;
+use nalgebra::Vector3;
+
+/// Overcast zenith radiance per channel (W·m⁻²·sr⁻¹) blended in with --overcast.
+const OVERCAST_ZENITH: [f64; 3] = [30.0, 32.0, 36.0];
+
+/// Render the scene at a date and time from a materials file.
+///
+/// The scene's target surfaces take the pseudo-albedos of MATERIALS
+/// (written by the outdoor reflectance recovery: materials.ron with its
+/// EXR atlases); the other surfaces keep the scene's materials. The sun
+/// comes from the ephemeris at the station's site; the sky is the clear
+/// daylight model (CIE clear sky per channel, extinction, reddening near
+/// the horizon) — not yet skies fitted to a session. --overcast P blends
+/// an overcast sky blocking a fraction P of the sunlight (§5.6.3).
+///
+/// Writes OpenEXR radiance (render-<time>.exr) and, with --curve, 8-bit
+/// PNGs through that response curve at --shutter-s (the thesis's figures
+/// use 1/1500 s).
+///
+/// Example: campanile render --scene examples/campanile-scene.ron \
+///            --station examples/sim-station.ron --materials out/materials.ron \
+///            --pose view-se --time 2026-08-29T20:30:00Z --out renders/
+///          campanile render ... --sequence 2026-08-29 --step-min 60 --out day/
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub struct RenderArgs {
+    /// Scene description (RON) with its geometry.
+    #[arg(long)]
+    scene: PathBuf,
+    /// Station description (RON): the site and the camera.
+    #[arg(long)]
+    station: PathBuf,
+    /// Materials file (RON) from the reflectance recovery.
+    #[arg(long)]
+    materials: PathBuf,
+    /// Camera pose named in the scene.
+    #[arg(long)]
+    pose: String,
+    /// UTC time to render (RFC 3339).
+    #[arg(long, conflicts_with = "sequence")]
+    time: Option<DateTime<Utc>>,
+    /// Render from sunrise to sunset of this date (the site's solar day).
+    #[arg(long)]
+    sequence: Option<NaiveDate>,
+    /// Minutes between frames of a sequence.
+    #[arg(long, default_value_t = 60.0)]
+    step_min: f64,
+    /// Fraction of sunlight blocked by clouds, 0–1.
+    #[arg(long, default_value_t = 0.0)]
+    overcast: f64,
+    /// Image width, pixels.
+    #[arg(long, default_value_t = 256)]
+    width: usize,
+    /// Image height, pixels.
+    #[arg(long, default_value_t = 192)]
+    height: usize,
+    /// Response curve (CSV from `hdr calibrate`) for 8-bit output.
+    #[arg(long)]
+    curve: Option<PathBuf>,
+    /// Shutter time for 8-bit output, seconds.
+    #[arg(long, default_value_t = 1.0 / 1500.0)]
+    shutter_s: f64,
+    /// Radiance of one unit of relative exposure per second (the merge's radiometric scale).
+    #[arg(long, default_value_t = 1.0)]
+    scale: f64,
+    /// Output directory.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+fn write_exr(image: &RadianceImage, path: &Path) -> Result<()> {
+    let n = image.width * image.height;
+    let map = RadianceMap {
+        width: image.width,
+        height: image.height,
+        rgb: image.data.clone(),
+        variance: vec![0.0; n * 3],
+        mask: vec![0; n],
+    };
+    write_radiance_exr(&map, path).with_context(|| format!("writing {}", path.display()))
+}
+
+pub fn run(args: RenderArgs) -> Result<()> {
+    if !(0.0..=1.0).contains(&args.overcast) {
+        bail!("--overcast {} must be a fraction in [0, 1]", args.overcast);
+    }
+    if args.width == 0 || args.height == 0 || args.width * args.height > 4096 * 4096 {
+        bail!(
+            "--width {} --height {}: expected 1 to 4096 pixels each",
+            args.width,
+            args.height
+        );
+    }
+    if !(args.step_min.is_finite() && args.step_min >= 1.0) {
+        bail!("--step-min {} must be at least 1 minute", args.step_min);
+    }
+    let station = campanile_config::document::load_station(&args.station)
+        .map_err(|e| anyhow::anyhow!("{e}"))
+        .with_context(|| format!("reading {}", args.station.display()))?
+        .value;
+    let loaded = load_scene(&args.scene).with_context(|| format!("reading {}", args.scene.display()))?;
+    let scene = &loaded.scene;
+    let refl =
+        read_materials(scene, &args.materials).with_context(|| format!("reading {}", args.materials.display()))?;
+    let pose = loaded.description.pose(&args.pose).with_context(|| {
+        let names: Vec<&str> = loaded.description.poses.iter().map(|p| p.name.as_str()).collect();
+        format!(
+            "--pose {:?} is not in {}: it has {names:?}",
+            args.pose,
+            args.scene.display()
+        )
+    })?;
+    let (pan, tilt) = station
+        .head
+        .reach(pose.azimuth_deg, pose.elevation_deg)
+        .with_context(|| format!("the head cannot reach pose {:?}", pose.name))?;
+    let (x, y, z) = pose.position_m;
+    let rig = CameraRig {
+        pinhole: pinhole_at(&station.camera, args.width, args.height),
+        mount: mount(&station.head.mount),
+        head: HeadPose {
+            pan_rad: pan.to_radians(),
+            tilt_rad: tilt.to_radians(),
+        },
+        position: Vector3::new(x, y, z),
+        width: args.width,
+        height: args.height,
+    };
+    let site = &station.site;
+    let observer = Observer::from_degrees(
+        site.latitude_deg,
+        site.longitude_deg,
+        site.elevation_m,
+        site.pressure_mbar,
+        site.temperature_c,
+    );
+    let times: Vec<DateTime<Utc>> = match (args.time, args.sequence) {
+        (Some(t), None) => vec![t],
+        (None, Some(date)) => {
+            // The solar day: local mean midnight to midnight at the site's longitude.
+            let start = date.and_hms_opt(0, 0, 0).context("date")?.and_utc()
+                - Duration::seconds((site.longitude_deg / 15.0 * 3600.0) as i64);
+            let step = Duration::seconds((args.step_min * 60.0) as i64);
+            let mut out = Vec::new();
+            let mut t = start;
+            while t < start + Duration::hours(24) {
+                let sun = sun_position(t, &observer, site.delta_t_s).map_err(|e| anyhow::anyhow!("{e}"))?;
+                if sun.elevation_rad() > 0.0 {
+                    out.push(t);
+                }
+                t += step;
+            }
+            out
+        }
+        _ => bail!("give --time or --sequence"),
+    };
+    let curve = match &args.curve {
+        Some(p) => {
+            let text = std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()))?;
+            Some(ResponseCurve::from_csv(&text, p).map_err(|e| anyhow::anyhow!("{e}"))?)
+        }
+        None => None,
+    };
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    for t in times {
+        let sun = sun_position(t, &observer, site.delta_t_s).map_err(|e| anyhow::anyhow!("{e}"))?;
+        if sun.elevation_rad() <= 0.0 {
+            bail!(
+                "the sun is below the horizon at {t} ({:.1}°): nothing to render in daylight",
+                sun.elevation_rad().to_degrees()
+            );
+        }
+        let mut day = Daylight::clear(sun.direction(), &Atmosphere::clear());
+        if args.overcast > 0.0 {
+            day = day.with_clouds(args.overcast, OVERCAST_ZENITH);
+        }
+        let light = Illumination { time: t, sky: &day };
+        let (image, _) = rerender(scene, &refl, &rig, &light, &RerenderSettings::default());
+        let stem = format!("render-{}", t.format("%Y%m%dT%H%M%SZ"));
+        let exr = args.out.join(format!("{stem}.exr"));
+        write_exr(&image, &exr)?;
+        println!(
+            "{}  sun elevation {:.1}°  {}",
+            t.to_rfc3339(),
+            sun.elevation_rad().to_degrees(),
+            exr.display()
+        );
+        if let Some(c) = &curve {
+            let png = args.out.join(format!("{stem}.png"));
+            write_png(&photograph(&image, c, args.shutter_s, args.scale), &png)
+                .map_err(|e| anyhow::anyhow!("{e}"))
+                .with_context(|| format!("writing {}", png.display()))?;
+        }
+    }
+    Ok(())
+}
