@@ -23,6 +23,9 @@ fn the_quick_demo_runs_end_to_end_and_its_figures_match_the_simulator() {
     // The report: every section, every figure inline.
     let html = std::fs::read_to_string(demo.join("report.html")).unwrap();
     for title in [
+        "Pseudo-albedos",
+        "Held-out time",
+        "Sunrise to sunset",
         "Camera response",
         "Sun and extinction",
         "Sky",
@@ -48,6 +51,24 @@ fn the_quick_demo_runs_end_to_end_and_its_figures_match_the_simulator() {
     );
     assert!(worst < 0.05, "cube worst relative error {worst}");
     assert!(gamma < 0.5, "cube worst γ error {gamma}°");
+
+    // Outdoors, at the quick plan's two training times and two views (2
+    // render samples per pixel): the pseudo-albedo medians within 30% and
+    // the held-out views within 25% per 4×4 block. These are loose: the
+    // full day does better (BENCHMARKS.md), and issue 9's 2% / 3% are not
+    // met yet.
+    for key in ["albedo_se_median", "albedo_sun_median"] {
+        let v = figures[key].as_f64().unwrap_or(f64::NAN);
+        println!("{key}: {:.1}%", 100.0 * v);
+        assert!(v < 0.30, "{key} = {v}");
+    }
+    let held = figures["held_out_rmse_pixel_block"].as_array().unwrap();
+    assert!(!held.is_empty(), "no held-out view was compared");
+    for v in held {
+        let block = v[1].as_f64().unwrap_or(f64::NAN);
+        println!("held-out view: {:.1}% per 4×4 block", 100.0 * block);
+        assert!(block < 0.25, "held-out block RMSE {block}");
+    }
 
     // `campanile process` on the demo's session, finding the scene's
     // geometry through the session's record of where it was captured from.

@@ -81,9 +81,11 @@ fn inside(tri: &Triangle, p: &Vector3<f64>) -> bool {
 
 impl Grid {
     /// The grid of `spacing_m` over the surfaces named in `targets` of
-    /// `scene`. Each triangle's visible side is the one facing most of
-    /// `viewpoints` (the camera positions); with none given, the stored
-    /// normal's side.
+    /// `scene`. Each triangle's visible side is the one facing most of the
+    /// `viewpoints` (the camera positions) that have a clear line of sight
+    /// to its centroid; with none, the stored normal's side. (Counting
+    /// viewpoints that cannot see the triangle would let cameras on the far
+    /// side of a building outvote those that see it.)
     pub fn new(
         scene: &Scene,
         targets: &[usize],
@@ -94,6 +96,21 @@ impl Grid {
             let centroid = (tri.vertices[0] + tri.vertices[1] + tri.vertices[2]) / 3.0;
             let facing: f64 = viewpoints
                 .iter()
+                .filter(|v| {
+                    let d = centroid - *v;
+                    let dist = d.norm();
+                    if dist <= 0.0 {
+                        return false;
+                    }
+                    let ray = crate::render::Ray {
+                        origin: **v,
+                        direction: d / dist,
+                    };
+                    // Clear when nothing is hit before the triangle's plane.
+                    scene
+                        .intersect(&ray, dist * (1.0 - 1e-6))
+                        .is_none_or(|h| h.t >= dist * (1.0 - 1e-3))
+                })
                 .map(|v| (v - centroid).normalize().dot(&tri.normal).signum())
                 .sum();
             if facing < 0.0 { -1.0 } else { 1.0 }

@@ -20,7 +20,8 @@ use super::process::{self, report_sections::Truth};
 ///   1. builds the simulated station (examples/sim-station.ron);
 ///   2. captures a simulated day at the campanile (examples/campanile-day.ron:
 ///      four training times and one held-out time; --quick: two and one);
-///   3. processes it (response, HDR, sun, sky, environment);
+///   3. processes it (response, HDR, sun, sky, environment, pseudo-albedos,
+///      the held-out time re-rendered under the predicted light);
 ///   4. recovers the BRDFs of the thesis's simulated cube (inverse global
 ///      illumination, §4.7.1);
 ///   5. writes OUT/report.html, with every figure beside the simulator's truth.
@@ -45,6 +46,11 @@ pub struct DemoArgs {
 struct Figures {
     cube_worst_relative: f64,
     cube_worst_gamma_deg: f64,
+    albedo_se_median: Option<f64>,
+    albedo_se_p95: Option<f64>,
+    albedo_sun_median: Option<f64>,
+    albedo_sun_p95: Option<f64>,
+    held_out_rmse_pixel_block: Vec<(f64, f64)>,
 }
 
 /// Parses a `capture` command line, as the user would type it.
@@ -85,6 +91,10 @@ pub fn run(args: DemoArgs) -> Result<()> {
         station.as_os_str(),
         "--out".as_ref(),
         session.as_os_str(),
+        // Three bounces: the light the ground reflects onto shaded walls,
+        // which the pseudo-albedo model includes (one bounce would omit it).
+        "--sim-bounces".as_ref(),
+        "3".as_ref(),
     ])?;
     let t = Instant::now();
     if super::capture::run(line.args) != super::EXIT_OK {
@@ -113,12 +123,35 @@ pub fn run(args: DemoArgs) -> Result<()> {
         world: &world,
     };
     let mut sections = process::stage_sections(&processed, Some(&truth))?;
+    let mut speed = sections.pop().unwrap_or_default();
+
+    // Outdoors: pseudo-albedos, the held-out time, the day.
+    eprintln!("recovering pseudo-albedos and re-rendering the held-out time …");
+    let outdoor = process::outdoor_stages(&processed)?;
+    let mut albedo_figures = None;
+    let mut held_out_rmse = Vec::new();
+    if let Some(o) = &outdoor {
+        process::write_outdoor(o, &products)?;
+        let truth_albedo = |triangle: usize, point: [f64; 3]| world.pseudo_albedos(triangle, point).sky_environment;
+        let (outdoor_sections, figures) =
+            process::outdoor_sections(&processed, o, Some(&truth_albedo), if args.quick { 4 } else { 7 })?;
+        sections.extend(outdoor_sections);
+        albedo_figures = figures;
+        held_out_rmse = o
+            .products
+            .held_out
+            .iter()
+            .map(|v| (v.rmse_pixel, v.rmse_block))
+            .collect();
+        for (stage, s) in &o.products.seconds {
+            speed.tables[0].rows.push(vec![stage.clone(), format!("{s:.2}")]);
+        }
+    }
 
     // Indoors: the thesis's cube.
     eprintln!("recovering the cube's BRDFs (inverse global illumination) …");
     let (px, samples) = if args.quick { (64, 16) } else { (96, 32) };
     let cube = indoor::cube(px, samples)?;
-    let mut speed = sections.pop().unwrap_or_default();
     sections.push(cube.section);
     let rows = &mut speed.tables[0].rows;
     rows.insert(
@@ -137,6 +170,11 @@ pub fn run(args: DemoArgs) -> Result<()> {
     let figures = Figures {
         cube_worst_relative: cube.worst_relative,
         cube_worst_gamma_deg: cube.worst_gamma_deg,
+        albedo_se_median: albedo_figures.map(|f| f.0),
+        albedo_se_p95: albedo_figures.map(|f| f.1),
+        albedo_sun_median: albedo_figures.map(|f| f.2),
+        albedo_sun_p95: albedo_figures.map(|f| f.3),
+        held_out_rmse_pixel_block: held_out_rmse,
     };
     let json = serde_json::to_vec_pretty(&figures)?;
     std::fs::write(args.out.join("demo-figures.json"), json)

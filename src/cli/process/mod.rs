@@ -1,6 +1,8 @@
 //! `campanile process`: a captured session to radiance, light and
 //! reflectance, with a machine-readable summary of every figure.
 
+pub mod outdoor_report;
+pub mod outdoor_stage;
 pub mod report_sections;
 mod session_frames;
 
@@ -101,7 +103,6 @@ pub struct OccurrenceSummary {
 }
 
 /// The products of stages 1 and 2, in memory, for the demo and the report.
-#[allow(dead_code)] // The outdoor and report stages read the rest.
 pub struct Processed {
     pub inputs: SessionInputs,
     pub optics: StationOptics,
@@ -125,6 +126,27 @@ pub fn run(args: ProcessArgs) -> Result<()> {
         (args.env_rows, args.env_cols),
     )?;
     write_outputs(&processed, &out)?;
+    let outdoor = outdoor_stages(&processed)?;
+    let mut sections = stage_sections(&processed, None)?;
+    if let Some(o) = &outdoor {
+        write_outdoor(o, &out)?;
+        let speed = sections.pop();
+        sections.extend(outdoor_sections(&processed, o, None, 6)?.0);
+        if let Some(mut speed) = speed {
+            for (stage, s) in &o.products.seconds {
+                speed.tables[0].rows.push(vec![stage.clone(), format!("{s:.2}")]);
+            }
+            sections.push(speed);
+        }
+        for v in &o.products.held_out {
+            println!(
+                "  held out {:<32} relative RMSE {:.2}% per pixel, {:.2}% per 4×4 block",
+                v.label,
+                100.0 * v.rmse_pixel,
+                100.0 * v.rmse_block
+            );
+        }
+    }
     let report = Report {
         title: format!("Campanile: {}", args.session.display()),
         intro: vec![format!(
@@ -132,7 +154,7 @@ pub fn run(args: ProcessArgs) -> Result<()> {
             args.session.display(),
             env!("CARGO_PKG_VERSION")
         )],
-        sections: stage_sections(&processed, None)?,
+        sections,
     };
     write_report(&report, &out.join("report.html"))?;
     println!("processed {} → {}", args.session.display(), out.display());
@@ -255,6 +277,118 @@ pub fn stage_sections(p: &Processed, truth: Option<&report_sections::Truth>) -> 
         report_sections::environment(p)?,
         report_sections::speed(p),
     ])
+}
+
+/// The scene (geometry and the description's materials) and the outdoor
+/// stages' products, when the session has a scene with views.
+pub struct Outdoor {
+    pub scene: campanile_sim::world::LoadedScene,
+    pub products: outdoor_stage::OutdoorProducts,
+}
+
+/// Stages 3–5: pseudo-albedos from the training views, the held-out views
+/// re-rendered. `None` when the session has no scene or no views.
+///
+/// The scene's triangles come from its OBJ; non-target surfaces (the
+/// ground, the landscape), which light the targets as environment, take the
+/// albedo the scene's materials give them (through the simulator's scene
+/// loader, the only loader of scene files with materials so far).
+pub fn outdoor_stages(p: &Processed) -> Result<Option<Outdoor>> {
+    let Some(geometry) = p.inputs.geometry()? else {
+        return Ok(None);
+    };
+    if !p.merged.iter().any(|g| matches!(g.purpose, Purpose::View { .. })) {
+        return Ok(None);
+    }
+    let Some((description, _)) = p.inputs.scene.as_ref() else {
+        return Ok(None);
+    };
+    let description = description.clone();
+    let scene = campanile_sim::world::from_description(description, &geometry)
+        .with_context(|| format!("loading the scene geometry {}", geometry.display()))?;
+    let b = bar(1, "pseudo-albedos");
+    let products = outdoor_stage::outdoor(
+        p,
+        &scene.scene,
+        &campanile_process::outdoor::ReflectanceSettings::default(),
+    )?;
+    b.finish_and_clear();
+    Ok(Some(Outdoor { scene, products }))
+}
+
+/// Writes the pseudo-albedo atlases and materials, and the held-out renders.
+pub fn write_outdoor(o: &Outdoor, out: &Path) -> Result<()> {
+    campanile_process::outdoor::atlas::write_materials(&o.scene.scene, &o.products.reflectance, &out.join("albedo"))?;
+    std::fs::create_dir_all(out.join("held-out")).with_context(|| format!("{}: cannot create", out.display()))?;
+    for v in &o.products.held_out {
+        let map = campanile_process::hdr::merge::RadianceMap {
+            width: v.rendered.width,
+            height: v.rendered.height,
+            rgb: v.rendered.data.clone(),
+            variance: vec![0.0; v.rendered.data.len()],
+            mask: vec![0; v.rendered.width * v.rendered.height],
+        };
+        let path = out.join("held-out").join(format!("{}.exr", file_name(&v.label)));
+        campanile_process::exr_io::write_radiance_exr(&map, &path)
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    let summary: Vec<serde_json::Value> = o
+        .products
+        .held_out
+        .iter()
+        .map(|v| serde_json::json!({"view": v.label, "rmse_pixel": v.rmse_pixel, "rmse_block_4x4": v.rmse_block}))
+        .collect();
+    let refl = &o.products.reflectance;
+    let photos: Vec<serde_json::Value> = refl
+        .photos
+        .iter()
+        .map(|c| serde_json::json!({"photo": c.label, "observations": c.observations, "median_log_ratio": c.median_log_ratio, "outlier": c.outlier}))
+        .collect();
+    let json = serde_json::json!({
+        "cells": refl.cells.len(),
+        "photos": photos,
+        "pixels": {"used": refl.sampling.used, "shadow_edge": refl.sampling.shadow_edge, "mirror": refl.sampling.mirror, "grazing": refl.sampling.grazing, "invalid": refl.sampling.invalid},
+        "diagnostics": refl.diagnostics,
+        "held_out": summary,
+        "stage_seconds": o.products.seconds,
+    });
+    std::fs::write(out.join("outdoor.json"), serde_json::to_vec_pretty(&json)?)
+        .with_context(|| format!("{}: cannot write", out.display()))?;
+    Ok(())
+}
+
+/// Median and p95 relative errors of ρ_se, then of ρ_sun, against the truth.
+pub type AlbedoQuantiles = (f64, f64, f64, f64);
+
+/// The outdoor report sections; `truth(triangle, point)` gives true albedos.
+pub fn outdoor_sections(
+    p: &Processed,
+    o: &Outdoor,
+    truth: Option<&dyn Fn(usize, [f64; 3]) -> [f64; 3]>,
+    strip_frames: usize,
+) -> Result<(Vec<Section>, Option<AlbedoQuantiles>)> {
+    let scene = &o.scene.scene;
+    let view = p
+        .merged
+        .iter()
+        .find(|g| !g.held_out && matches!(g.purpose, Purpose::View { .. }))
+        .ok_or_else(|| anyhow::anyhow!("no training view"))?;
+    let rig = campanile_process::render::CameraRig {
+        pinhole: view.pinhole,
+        mount: p.optics.mount,
+        head: view.head,
+        position: nalgebra::Vector3::from(view.position_m),
+        width: view.map.width,
+        height: view.map.height,
+    };
+    let mut albedo = outdoor_report::albedo_section(scene, &o.products, &rig, truth)?;
+    let figures = truth.map(|t| {
+        let mut e = outdoor_report::albedo_errors(scene, &o.products.reflectance, t);
+        outdoor_report::add_albedo_errors(&mut albedo, &mut e)
+    });
+    let held = outdoor_report::held_out_section(&o.products)?;
+    let strip = outdoor_report::day_strip(p, scene, &o.products, &rig, strip_frames)?;
+    Ok((vec![albedo, held, strip], figures))
 }
 
 /// Writes a report page (through a temporary file).

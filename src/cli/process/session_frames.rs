@@ -66,7 +66,6 @@ impl SessionInputs {
     }
 
     /// The OBJ geometry of the scene, checked to exist.
-    #[allow(dead_code)] // The outdoor stage reads it.
     pub fn geometry(&self) -> Result<Option<PathBuf>> {
         let Some((scene, base)) = &self.scene else {
             return Ok(None);

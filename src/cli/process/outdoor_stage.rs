@@ -1,0 +1,232 @@
+//! Stages 3–5 of `process` outdoors: irradiance and pseudo-albedos from the
+//! training views under the measured light (thesis §5.2, §5.4), then the
+//! held-out views re-rendered under the *predicted* light (§5.5) and
+//! compared with what the camera saw.
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use anyhow::{Context, Result, anyhow};
+use campanile_config::scene::MaterialModel;
+use campanile_process::camera::image::RadianceImage;
+use campanile_process::outdoor::rerender::{relative_rmse, target_mask};
+use campanile_process::outdoor::{
+    Illumination, Photo, Reflectance, ReflectanceSettings, RerenderSettings, recover_reflectance, rerender,
+};
+use campanile_process::pipeline::{MeasuredSky, MergedGroup, Purpose, measured_sky, predicted_sky};
+use campanile_process::render::{CameraRig, Scene};
+use campanile_process::sun::sun_position;
+use chrono::{DateTime, Utc};
+use nalgebra::Vector3;
+
+use super::Processed;
+
+/// A held-out view, measured and re-rendered.
+pub struct HeldOutView {
+    /// The group's key.
+    pub label: String,
+    /// What the camera saw (HDR).
+    pub measured: RadianceImage,
+    /// The re-render under the predicted light.
+    pub rendered: RadianceImage,
+    /// Pixels on the target surfaces, valid in the measurement.
+    pub mask: Vec<bool>,
+    /// Relative RMSE per pixel over the mask.
+    pub rmse_pixel: f64,
+    /// Relative RMSE of 4×4-pixel block means over the mask.
+    pub rmse_block: f64,
+}
+
+/// What the outdoor stages made.
+pub struct OutdoorProducts {
+    /// The pseudo-albedos and their diagnostics.
+    pub reflectance: Reflectance,
+    /// The held-out views.
+    pub held_out: Vec<HeldOutView>,
+    /// Stage times.
+    pub seconds: Vec<(String, f64)>,
+}
+
+/// The surfaces that get pseudo-albedos: those whose material is a
+/// pseudo-BRDF (§5.2), except the ground, which lights them as environment.
+pub fn targets(p: &Processed, scene: &Scene) -> Result<Vec<usize>> {
+    let (description, _) = p
+        .inputs
+        .scene
+        .as_ref()
+        .ok_or_else(|| anyhow!("the session has no scene: pseudo-albedos need its geometry"))?;
+    let pseudo: Vec<&str> = description
+        .materials
+        .iter()
+        .filter(|m| m.model == MaterialModel::PseudoBrdf)
+        .map(|m| m.name.as_str())
+        .collect();
+    description
+        .surfaces
+        .iter()
+        .filter(|s| pseudo.contains(&s.material.as_str()) && s.name != "ground")
+        .map(|s| {
+            scene
+                .surface_index(&s.name)
+                .ok_or_else(|| anyhow!("surface {:?} is not in the scene's geometry", s.name))
+        })
+        .collect()
+}
+
+fn rig_of(p: &Processed, g: &MergedGroup) -> CameraRig {
+    CameraRig {
+        pinhole: g.pinhole,
+        mount: p.optics.mount,
+        head: g.head,
+        position: Vector3::from(g.position_m),
+        width: g.map.width,
+        height: g.map.height,
+    }
+}
+
+fn photo_of(p: &Processed, g: &MergedGroup, time: DateTime<Utc>) -> Photo {
+    Photo {
+        label: g.key.clone(),
+        image: RadianceImage {
+            width: g.map.width,
+            height: g.map.height,
+            data: g.map.rgb.clone(),
+        },
+        rig: rig_of(p, g),
+        time,
+        mask: Some(g.map.mask.iter().map(|&m| m == 0).collect()),
+    }
+}
+
+fn mean_time(groups: &[&MergedGroup]) -> DateTime<Utc> {
+    let t0 = groups[0].time;
+    let ms = groups
+        .iter()
+        .map(|g| (g.time - t0).num_milliseconds() as f64)
+        .sum::<f64>()
+        / groups.len() as f64;
+    t0 + chrono::Duration::milliseconds(ms.round() as i64)
+}
+
+/// 4×4-block relative RMSE over blocks with at least half their pixels in the mask.
+fn block_rmse(a: &RadianceImage, b: &RadianceImage, mask: &[bool], k: usize) -> Option<f64> {
+    let (mut num, mut den) = (0.0, 0.0);
+    for by in 0..a.height / k {
+        for bx in 0..a.width / k {
+            let (mut sa, mut sb, mut n) = (0.0, 0.0, 0usize);
+            for y in by * k..(by + 1) * k {
+                for x in bx * k..(bx + 1) * k {
+                    let i = y * a.width + x;
+                    if mask[i] {
+                        sa += (0..3).map(|c| f64::from(a.data[3 * i + c])).sum::<f64>();
+                        sb += (0..3).map(|c| f64::from(b.data[3 * i + c])).sum::<f64>();
+                        n += 1;
+                    }
+                }
+            }
+            if 2 * n >= k * k {
+                num += (sa - sb).powi(2);
+                den += sb * sb;
+            }
+        }
+    }
+    (den > 0.0).then(|| (num / den).sqrt())
+}
+
+/// Pseudo-albedos from the training views, then the held-out views.
+pub fn outdoor(p: &Processed, scene: &Scene, settings: &ReflectanceSettings) -> Result<OutdoorProducts> {
+    let targets = targets(p, scene)?;
+    let mut seconds = Vec::new();
+    let t = Instant::now();
+    // One illumination per training occurrence, at the mean time of its
+    // views (within a minute or two of each), the sun where it was then.
+    let mut by_occurrence: BTreeMap<&str, Vec<&MergedGroup>> = BTreeMap::new();
+    for g in &p.merged {
+        if matches!(g.purpose, Purpose::View { .. }) {
+            by_occurrence.entry(&g.occurrence).or_default().push(g);
+        }
+    }
+    let mut skies: Vec<(DateTime<Utc>, MeasuredSky)> = Vec::new();
+    let mut photos = Vec::new();
+    for (occurrence, groups) in &by_occurrence {
+        let Some(light) = p.light.iter().find(|l| l.occurrence == *occurrence) else {
+            continue;
+        };
+        if light.held_out {
+            continue;
+        }
+        let time = mean_time(groups);
+        let sun = sun_position(time, &p.optics.observer, p.optics.delta_t_s)
+            .map_err(|e| anyhow!("sun position at {time}: {e}"))?;
+        let mut sky = measured_sky(light).with_context(|| format!("the light of {occurrence}"))?;
+        sky.sun_direction = sun.direction();
+        skies.push((time, sky));
+        photos.extend(groups.iter().map(|g| photo_of(p, g, time)));
+    }
+    let lights: Vec<Illumination> = skies
+        .iter()
+        .map(|(time, sky)| Illumination { time: *time, sky })
+        .collect();
+    let (reflectance, _) =
+        recover_reflectance(scene, &targets, &photos, &lights, settings).map_err(|e| anyhow!("pseudo-albedos: {e}"))?;
+    seconds.push((
+        format!(
+            "irradiance and pseudo-albedos ({} photos, {} cells)",
+            photos.len(),
+            reflectance.cells.len()
+        ),
+        t.elapsed().as_secs_f64(),
+    ));
+
+    let t = Instant::now();
+    let mut held_out = Vec::new();
+    for g in p
+        .merged
+        .iter()
+        .filter(|g| g.held_out && matches!(g.purpose, Purpose::View { .. }))
+    {
+        let sun = sun_position(g.time, &p.optics.observer, p.optics.delta_t_s)
+            .map_err(|e| anyhow!("sun position at {}: {e}", g.time))?;
+        let sky = predicted_sky(&p.light, &sun).with_context(|| format!("predicting the light of {}", g.key))?;
+        let rig = rig_of(p, g);
+        let (rendered, _) = rerender(
+            scene,
+            &reflectance,
+            &rig,
+            &Illumination {
+                time: g.time,
+                sky: &sky,
+            },
+            &RerenderSettings::default(),
+        );
+        let measured = RadianceImage {
+            width: g.map.width,
+            height: g.map.height,
+            data: g.map.rgb.clone(),
+        };
+        let mask: Vec<bool> = target_mask(scene, &reflectance, &rig)
+            .into_iter()
+            .zip(&g.map.mask)
+            .map(|(t, &m)| t && m == 0)
+            .collect();
+        let rmse_pixel = relative_rmse(&rendered, &measured, &mask).unwrap_or(f64::NAN);
+        let rmse_block = block_rmse(&rendered, &measured, &mask, 4).unwrap_or(f64::NAN);
+        held_out.push(HeldOutView {
+            label: g.key.clone(),
+            measured,
+            rendered,
+            mask,
+            rmse_pixel,
+            rmse_block,
+        });
+    }
+    seconds.push((
+        format!("held-out re-renders ({})", held_out.len()),
+        t.elapsed().as_secs_f64(),
+    ));
+    Ok(OutdoorProducts {
+        reflectance,
+        held_out,
+        seconds,
+    })
+}
