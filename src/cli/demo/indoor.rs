@@ -71,7 +71,16 @@ pub fn cube(wide_px: usize, indirect_samples: u32) -> Result<CubeRun> {
             Some(g) => format!("{t:.4} / {g:.4} ({:.2}%)", 100.0 * rel(g, t)),
             None => format!("{t:.4} / —"),
         };
-        let (tl, gl) = (truth.lobe, got.and_then(|m| m.lobe));
+        let (tl, mut gl) = (truth.lobe, got.and_then(|m| m.lobe));
+        // (αx, αy, γ) and (αy, αx, γ + 90°) are the same lobe: compare in
+        // the truth's labelling.
+        if let (Some(t), Some(g)) = (tl, gl.as_mut()) {
+            let err = |ax: f64, ay: f64| rel(ax, t.alpha_x) + rel(ay, t.alpha_y);
+            if err(g.alpha_y, g.alpha_x) < err(g.alpha_x, g.alpha_y) {
+                std::mem::swap(&mut g.alpha_x, &mut g.alpha_y);
+                g.gamma_rad += std::f64::consts::FRAC_PI_2;
+            }
+        }
         let rho_d = got.map(|m| m.rho_d[1]);
         let rho_s = gl.map(|l| l.rho_s[1]);
         let ax = gl.map(|l| l.alpha_x);
