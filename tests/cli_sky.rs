@@ -41,6 +41,7 @@ fn a_noisy_cie_clear_sky_is_fitted_as_cie_type_12_and_evaluates_back() {
     let dir_tmp = tempfile::tempdir().expect("temp");
     let samples = dir_tmp.path().join("scan.csv");
     let sky = dir_tmp.path().join("sky.ron");
+    let residuals = dir_tmp.path().join("residuals.png");
     std::fs::write(&samples, csv).expect("write");
     let out = campanile(&[
         "sky",
@@ -52,10 +53,30 @@ fn a_noisy_cie_clear_sky_is_fitted_as_cie_type_12_and_evaluates_back() {
         "190",
         "--out",
         sky.to_str().expect("utf-8"),
+        "--residual-map",
+        residuals.to_str().expect("utf-8"),
     ]);
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     let text = std::fs::read_to_string(&sky).expect("written");
     assert_eq!(text.matches("chosen: \"Cie(12)\"").count(), 3, "{text}");
+
+    // The residual map: a 256² fisheye, grey where no sample fell, and
+    // within ±1.5% where one did (the noise is ±1%): the false colour's
+    // channels stay above 255·(1 − 0.15) there.
+    let map = image::open(&residuals).expect("a PNG").into_rgb8();
+    assert_eq!(map.dimensions(), (256, 256));
+    let (mut binned, mut off) = (0, 0);
+    for p in map.pixels() {
+        if p.0 == [128, 128, 128] {
+            continue;
+        }
+        binned += 1;
+        if p.0.iter().any(|&v| v < 216) {
+            off += 1;
+        }
+    }
+    assert!(binned >= 500, "{binned} fisheye pixels carry a residual");
+    assert_eq!(off, 0, "{off} of {binned} pixels show a residual beyond 1.5%");
 
     let dirs = dir_tmp.path().join("dirs.csv");
     std::fs::write(&dirs, "zenith_deg,azimuth_deg\n0,0\n60,300\n").expect("write");

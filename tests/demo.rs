@@ -84,6 +84,20 @@ fn the_quick_demo_runs_end_to_end_and_its_figures_match_the_simulator() {
     println!("{}", String::from_utf8_lossy(&out.stdout));
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(processed.join("report.html").is_file());
+    // The morning's environment map as EXR: 36 × 18 regions, those the tiles
+    // saw (elevations −30° to 10°: 4 of the 18 bands at least) with radiance.
+    let env = std::fs::read_dir(processed.join("light"))
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .find(|p| p.to_string_lossy().ends_with("-environment.exr"))
+        .expect("an environment EXR");
+    let map = campanile_process::exr_io::read_radiance_exr(&env).unwrap();
+    assert_eq!((map.width, map.height), (36, 18));
+    let seen = (0..36 * 18)
+        .filter(|&i| map.mask[i] == 0 && map.rgb[3 * i + 1] > 0.0)
+        .count();
+    println!("environment map: {seen} of 648 regions seen");
+    assert!(seen >= 4 * 36, "{seen} regions seen");
 
     // The response, from the plan's dense calibration bracket: shape within
     // 0.025 log-RMS of the simulated camera's over codes 400–3800, and the

@@ -45,6 +45,12 @@ pub enum SkyCommand {
         /// Where to write the fitted skies (RON); standard output when absent.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Also write a residual map (PNG): measured / fitted − 1 of the
+        /// first channel's samples, binned on a fisheye (zenith at the
+        /// centre, horizon on the circle, north up, east right, as seen from
+        /// above), −10% blue to +10% red; masked samples count too.
+        #[arg(long, value_name = "PNG")]
+        residual_map: Option<PathBuf>,
     },
     /// Predict the sky at another sun position from skies fitted at others.
     ///
@@ -142,6 +148,31 @@ impl SunArgs {
     }
 }
 
+/// Values toward unit directions averaged on a `size`² fisheye: zenith at
+/// the centre, the horizon on the inscribed circle (equidistant in zenith
+/// angle), north up, east right; NaN where nothing fell.
+fn fisheye(points: &[([f64; 3], f64)], size: usize) -> Vec<f64> {
+    let mut sum = vec![0.0; size * size];
+    let mut n = vec![0u32; size * size];
+    let half = size as f64 / 2.0;
+    for &(d, v) in points {
+        if d[2] < 0.0 || !v.is_finite() {
+            continue;
+        }
+        let r = d[2].clamp(-1.0, 1.0).acos() / std::f64::consts::FRAC_PI_2 * half;
+        let h = (d[0] * d[0] + d[1] * d[1]).sqrt().max(1e-12);
+        let (x, y) = ((half + r * d[0] / h) as usize, (half - r * d[1] / h) as usize);
+        if x < size && y < size {
+            sum[y * size + x] += v;
+            n[y * size + x] += 1;
+        }
+    }
+    sum.iter()
+        .zip(&n)
+        .map(|(s, &k)| if k > 0 { s / f64::from(k) } else { f64::NAN })
+        .collect()
+}
+
 fn read_sky(path: &PathBuf) -> Result<SkyFile> {
     let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
     ron::from_str(&text).map_err(|e| anyhow::anyhow!("{}:{}: {}", path.display(), e.span.start, e.code))
@@ -149,7 +180,12 @@ fn read_sky(path: &PathBuf) -> Result<SkyFile> {
 
 pub fn run(cmd: SkyCommand) -> Result<()> {
     match cmd {
-        SkyCommand::Fit { samples, sun, out } => {
+        SkyCommand::Fit {
+            samples,
+            sun,
+            out,
+            residual_map,
+        } => {
             let (zs, az) = sun.resolve()?;
             let file = File::open(&samples).with_context(|| format!("{}: cannot open", samples.display()))?;
             let table = read_samples(BufReader::new(file)).with_context(|| format!("{}", samples.display()))?;
@@ -175,6 +211,23 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
                 sun_azimuth_deg: az.to_degrees(),
                 channels,
             };
+            if let Some(png) = residual_map {
+                let model = &sky.channels[0].model;
+                let pts: Vec<([f64; 3], f64)> = table
+                    .directions
+                    .iter()
+                    .zip(&table.values[0])
+                    .map(|(&(z, a), &v)| {
+                        let d = direction(z, a);
+                        (d, v / model.radiance(z, angle_between(d, sun_dir)) - 1.0)
+                    })
+                    .collect();
+                let size = 256;
+                let map = fisheye(&pts, size);
+                let bytes =
+                    campanile_process::report::false_colour_png("sky residuals", size, size, &map, (-0.1, 0.1))?;
+                std::fs::write(&png, bytes).with_context(|| format!("{}: cannot write", png.display()))?;
+            }
             super::ron_output::write_ron(&sky, out.as_deref())
         }
         SkyCommand::Predict { skies, sun, out } => {

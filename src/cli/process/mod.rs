@@ -37,7 +37,8 @@ pub use session_frames::SessionInputs;
 /// Outputs, in OUT (default SESSION/processed):
 ///   response.csv, response.svg     the curve with its uncertainty
 ///   radiance/<group>.exr           HDR views (RGB, variance, mask)
-///   light/<occurrence>.ron         sun irradiance and sky per channel
+///   light/<occurrence>.ron         the sky per channel (eq. 5.9 parameters, model and why)
+///   light/<occurrence>-environment.exr   the environment's lat-long region map
 ///   summary.json                   every figure and diagnostic, with stage times
 ///   report.html                    the same as a page with plots (self-contained)
 ///
@@ -438,6 +439,38 @@ pub fn write_outputs(p: &Processed, out: &Path) -> Result<()> {
     for g in p.merged.iter().filter(|g| matches!(g.purpose, Purpose::View { .. })) {
         let path = out.join("radiance").join(format!("{}.exr", file_name(&g.key)));
         campanile_process::exr_io::write_radiance_exr(&g.map, &path)
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    for l in &p.light {
+        let Some(env) = &l.environment else { continue };
+        // Lat-long, elevation +90° on the top row, azimuth 0° (north) at the
+        // left, east next; regions nothing fell in are zero with mask bits set.
+        let (w, h) = (env.cols, env.rows);
+        let mut map = campanile_process::hdr::merge::RadianceMap {
+            width: w,
+            height: h,
+            rgb: vec![0.0; w * h * 3],
+            variance: vec![0.0; w * h * 3],
+            mask: vec![0; w * h],
+        };
+        for y in 0..h {
+            for x in 0..w {
+                let r = &env.regions[(h - 1 - y) * w + x];
+                let i = y * w + x;
+                if r.count == 0 {
+                    map.mask[i] = 0b111_111;
+                    continue;
+                }
+                for (c, (m, v)) in r.mean.iter().zip(r.variance()).enumerate() {
+                    map.rgb[3 * i + c] = *m as f32;
+                    map.variance[3 * i + c] = v as f32;
+                }
+            }
+        }
+        let path = out
+            .join("light")
+            .join(format!("{}-environment.exr", file_name(&l.occurrence)));
+        campanile_process::exr_io::write_radiance_exr(&map, &path)
             .with_context(|| format!("{}: cannot write", path.display()))?;
     }
     for o in &p.summary.occurrences {
