@@ -26,6 +26,7 @@ fn the_quick_demo_runs_end_to_end_and_its_figures_match_the_simulator() {
         "Pseudo-albedos",
         "Held-out time",
         "Sunrise to sunset",
+        "Overcast",
         "Camera response",
         "Sun and extinction",
         "Sky",

@@ -55,7 +55,7 @@ proptest! {
         which in 0usize..6,
         edits in proptest::collection::vec((any::<prop::sample::Index>(), 0usize..4, "[ -~]{0,3}"), 1..4),
     ) {
-        let names = ["sim-station.ron", "real-station.ron", "campanile-day.ron", "room-lights.ron", "campanile-scene.ron", "room-scene.ron"];
+        let names = ["sim-station.ron", "real-station.ron", "campanile-day.ron", "campanile-quick.ron", "room-lights.ron", "campanile-scene.ron", "room-scene.ron"];
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples").join(names[which]);
         let mut text = std::fs::read_to_string(&path).expect("example exists");
         for (at, del, ins) in edits {

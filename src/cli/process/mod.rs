@@ -389,7 +389,8 @@ pub fn outdoor_sections(
     });
     let held = outdoor_report::held_out_section(&o.products)?;
     let strip = outdoor_report::day_strip(p, scene, &o.products, &rig, strip_frames)?;
-    Ok((vec![albedo, held, strip], figures))
+    let overcast = outdoor_report::overcast_strip(p, scene, &o.products, &rig)?;
+    Ok((vec![albedo, held, strip, overcast], figures))
 }
 
 /// Writes a report page (through a temporary file).

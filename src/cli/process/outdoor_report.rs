@@ -278,3 +278,54 @@ pub fn day_strip(
         figures,
     })
 }
+
+/// A strip of re-renders at the held-out time (or the last time) under a
+/// cloud layer blocking 0%, 25%, 50%, 75% and 100% of the sunlight (§5.6.3).
+pub fn overcast_strip(
+    p: &Processed,
+    scene: &Scene,
+    out: &OutdoorProducts,
+    rig: &CameraRig,
+) -> Result<Section, ReportError> {
+    let mut figures = Vec::new();
+    let mut paragraphs = vec![
+        "The tower at one time under a uniform cloud layer that blocks a fraction of the sunlight (§5.6.3): the sun dimmed by that fraction, the sky blended toward the CIE overcast sky that carries the blocked light as diffuse light. One exposure for the strip.".to_owned(),
+    ];
+    let time = p.light.iter().find(|l| l.held_out).or(p.light.last()).map(|l| l.time);
+    if let Some(t) = time {
+        match sun_position(t, &p.optics.observer, p.optics.delta_t_s)
+            .map_err(|e| e.to_string())
+            .and_then(|sun| predicted_sky(&p.light, &sun).map_err(|e| e.to_string()))
+        {
+            Ok(clear) => {
+                let mut images = Vec::new();
+                for blocked in [0.0, 0.25, 0.5, 0.75, 1.0] {
+                    let sky = clear.overcast(blocked);
+                    let (img, _) = rerender(
+                        scene,
+                        &out.reflectance,
+                        rig,
+                        &Illumination { time: t, sky: &sky },
+                        &RerenderSettings::default(),
+                    );
+                    images.push((blocked, img));
+                }
+                let mut v: Vec<f64> = images[0].1.data.iter().map(|&x| f64::from(x)).collect();
+                let white = quantile(&mut v, 0.97).max(1e-9);
+                for (blocked, img) in images {
+                    figures.push(Figure::Png {
+                        bytes: tonemapped_png("overcast", img.width, img.height, &img.data, 1.0 / white)?,
+                        caption: format!("{:.0}% of the sunlight blocked", 100.0 * blocked),
+                    });
+                }
+            }
+            Err(e) => paragraphs.push(format!("no light to cloud over: {e}")),
+        }
+    }
+    Ok(Section {
+        title: "Overcast".into(),
+        paragraphs,
+        tables: Vec::new(),
+        figures,
+    })
+}
