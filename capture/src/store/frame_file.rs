@@ -14,6 +14,10 @@ use image::{ColorType, DynamicImage, ImageBuffer, ImageDecoder, Rgb};
 use std::io::Cursor;
 use std::path::Path;
 
+use super::checksum::crc32c;
+use super::journal::FrameEntry;
+use super::storage::Storage;
+
 /// Check that `frame` describes itself consistently: a nonzero size that
 /// fits a PNG, 1 to 16 bits, `width · height · 3` codes, none above
 /// `2^bits − 1`.
@@ -99,4 +103,63 @@ pub fn decode_png(path: &Path, bytes: &[u8], bits: u8) -> Result<CodeImage, Stor
         data: buf.into_raw(),
         label: path.display().to_string(),
     })
+}
+
+/// A journaled frame's bytes, read from `storage` at `path` and checked
+/// against the journal's size and CRC-32C.
+pub(crate) fn read_checked_bytes<S: Storage + ?Sized>(
+    storage: &S,
+    path: &Path,
+    entry: &FrameEntry,
+) -> Result<Vec<u8>, StoreError> {
+    let bytes = match storage.read(path) {
+        Ok(b) => b,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(StoreError::MissingFrame {
+                key: entry.key.clone(),
+                path: path.to_path_buf(),
+            });
+        }
+        Err(source) => {
+            return Err(StoreError::Io {
+                action: "reading",
+                path: path.to_path_buf(),
+                source,
+            });
+        }
+    };
+    let actual = crc32c(&bytes);
+    if actual != entry.crc32c || bytes.len() as u64 != entry.bytes {
+        return Err(StoreError::ChecksumMismatch {
+            key: entry.key.clone(),
+            path: path.to_path_buf(),
+            expected: entry.crc32c,
+            actual,
+            expected_len: entry.bytes,
+            actual_len: bytes.len() as u64,
+        });
+    }
+    Ok(bytes)
+}
+
+/// The codes of a journaled frame, exactly as recorded (unscaled,
+/// `entry.bits` significant bits), after checking its checksum and size.
+pub(crate) fn read_checked_frame<S: Storage + ?Sized>(
+    storage: &S,
+    path: &Path,
+    entry: &FrameEntry,
+) -> Result<CodeImage, StoreError> {
+    let bytes = read_checked_bytes(storage, path, entry)?;
+    let mut image = decode_png(path, &bytes, entry.bits)?;
+    if (image.width, image.height) != (entry.width as usize, entry.height as usize) {
+        return Err(StoreError::BadFrameFile {
+            path: path.to_path_buf(),
+            reason: format!(
+                "image is {}×{}, the journal says {}×{}",
+                image.width, image.height, entry.width, entry.height
+            ),
+        });
+    }
+    image.label = entry.key.clone();
+    Ok(image)
 }

@@ -9,12 +9,11 @@
 use std::path::{Path, PathBuf};
 
 use super::error::StoreError;
-use super::frame_file::decode_png;
+use super::frame_file::read_checked_frame;
 use super::journal::{FrameEntry, JournalEntry, parse_journal};
 use super::session::{FRAMES_DIR, JOURNAL_FILE};
 use super::snapshot::Snapshot;
 use super::storage::{FsStorage, Storage};
-use crate::store::crc32c;
 use campanile_process::camera::image::CodeImage;
 
 /// A session directory opened for reading.
@@ -95,45 +94,6 @@ impl SessionReader {
                 ),
             });
         }
-        let bytes = match FsStorage.read(&path) {
-            Ok(b) => b,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                return Err(StoreError::MissingFrame {
-                    key: entry.key.clone(),
-                    path,
-                });
-            }
-            Err(source) => {
-                return Err(StoreError::Io {
-                    action: "reading",
-                    path,
-                    source,
-                });
-            }
-        };
-        let crc = crc32c(&bytes);
-        if bytes.len() as u64 != entry.bytes || crc != entry.crc32c {
-            return Err(StoreError::BadFrameFile {
-                path,
-                reason: format!(
-                    "{} bytes with CRC-32C {crc:08x}; the journal says {} bytes with {:08x}",
-                    bytes.len(),
-                    entry.bytes,
-                    entry.crc32c
-                ),
-            });
-        }
-        let mut image = decode_png(&path, &bytes, entry.bits)?;
-        if (image.width, image.height) != (entry.width as usize, entry.height as usize) {
-            return Err(StoreError::BadFrameFile {
-                path,
-                reason: format!(
-                    "image is {}×{}, the journal says {}×{}",
-                    image.width, image.height, entry.width, entry.height
-                ),
-            });
-        }
-        image.label = entry.key.clone();
-        Ok(image)
+        read_checked_frame(&FsStorage, &path, entry)
     }
 }

@@ -3,7 +3,7 @@
 
 use super::checksum::crc32c;
 use super::error::{DiskFull, StoreError, is_disk_full};
-use super::frame_file::{check_frame, decode_png, encode_png};
+use super::frame_file::{check_frame, encode_png, read_checked_bytes, read_checked_frame};
 use super::journal::{FrameEntry, FrameMeta, JournalEntry, MissedEntry, parse_journal};
 use super::key::{check_key, frame_file_name};
 use super::report::{ResumeReport, TornLine, VerifyReport};
@@ -414,53 +414,12 @@ impl<S: Storage> SessionStore<S> {
     /// The codes of a journaled frame, exactly as recorded (unscaled,
     /// `entry.bits` significant bits), after checking its checksum.
     pub fn read_frame(&self, entry: &FrameEntry) -> Result<CodeImage, StoreError> {
-        let bytes = self.frame_bytes(entry)?;
-        let path = self.frame_path(entry);
-        let mut image = decode_png(&path, &bytes, entry.bits)?;
-        if (image.width, image.height) != (entry.width as usize, entry.height as usize) {
-            return Err(StoreError::BadFrameFile {
-                path,
-                reason: format!(
-                    "image is {}×{}, the journal says {}×{}",
-                    image.width, image.height, entry.width, entry.height
-                ),
-            });
-        }
-        image.label = entry.key.clone();
-        Ok(image)
+        read_checked_frame(&self.storage, &self.frame_path(entry), entry)
     }
 
     /// A journaled frame's bytes, checked against its size and CRC-32C.
     fn frame_bytes(&self, entry: &FrameEntry) -> Result<Vec<u8>, StoreError> {
-        let path = self.frame_path(entry);
-        let bytes = match self.storage.read(&path) {
-            Ok(b) => b,
-            Err(e) if e.kind() == io::ErrorKind::NotFound => {
-                return Err(StoreError::MissingFrame {
-                    key: entry.key.clone(),
-                    path,
-                });
-            }
-            Err(source) => {
-                return Err(StoreError::Io {
-                    action: "reading",
-                    path,
-                    source,
-                });
-            }
-        };
-        let actual = crc32c(&bytes);
-        if actual != entry.crc32c || bytes.len() as u64 != entry.bytes {
-            return Err(StoreError::ChecksumMismatch {
-                key: entry.key.clone(),
-                path,
-                expected: entry.crc32c,
-                actual,
-                expected_len: entry.bytes,
-                actual_len: bytes.len() as u64,
-            });
-        }
-        Ok(bytes)
+        read_checked_bytes(&self.storage, &self.frame_path(entry), entry)
     }
 
     fn check_writable(&self) -> Result<(), StoreError> {
