@@ -515,7 +515,8 @@ mod tests {
     /// expansion rules: sun 1 centering + 3; sky tiles × 3 plus one frame
     /// per aureole tile (rings around that occurrence's sun); environment
     /// tiles × 3; 4 views × 5 (the held-out time: 3 × 5 and a 4-exposure
-    /// bracket). Every frame is promised (no auto-brackets).
+    /// bracket); the morning's 12-exposure calibration bracket. Every frame
+    /// is promised (no auto-brackets).
     #[test]
     fn the_example_days_frame_counts_follow_the_rules() {
         let station = station();
@@ -537,7 +538,8 @@ mod tests {
             let want = if o.name == "held-out" {
                 (1 + 3) + sky * 3 + 3 * 5 + 4
             } else {
-                (1 + 3) + sky * 3 + bands + env * 3 + 4 * 5
+                let calibration = if o.name == "morning" { 12 } else { 0 };
+                (1 + 3) + sky * 3 + bands + env * 3 + 4 * 5 + calibration
             };
             assert_eq!(o.frames_promised(), want, "{}", o.key);
             assert_eq!(o.frames_at_most(), want, "{}", o.key);
