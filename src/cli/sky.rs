@@ -148,31 +148,6 @@ impl SunArgs {
     }
 }
 
-/// Values toward unit directions averaged on a `size`² fisheye: zenith at
-/// the centre, the horizon on the inscribed circle (equidistant in zenith
-/// angle), north up, east right; NaN where nothing fell.
-fn fisheye(points: &[([f64; 3], f64)], size: usize) -> Vec<f64> {
-    let mut sum = vec![0.0; size * size];
-    let mut n = vec![0u32; size * size];
-    let half = size as f64 / 2.0;
-    for &(d, v) in points {
-        if d[2] < 0.0 || !v.is_finite() {
-            continue;
-        }
-        let r = d[2].clamp(-1.0, 1.0).acos() / std::f64::consts::FRAC_PI_2 * half;
-        let h = (d[0] * d[0] + d[1] * d[1]).sqrt().max(1e-12);
-        let (x, y) = ((half + r * d[0] / h) as usize, (half - r * d[1] / h) as usize);
-        if x < size && y < size {
-            sum[y * size + x] += v;
-            n[y * size + x] += 1;
-        }
-    }
-    sum.iter()
-        .zip(&n)
-        .map(|(s, &k)| if k > 0 { s / f64::from(k) } else { f64::NAN })
-        .collect()
-}
-
 fn read_sky(path: &PathBuf) -> Result<SkyFile> {
     let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
     ron::from_str(&text).map_err(|e| anyhow::anyhow!("{}:{}: {}", path.display(), e.span.start, e.code))
@@ -223,7 +198,7 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
                     })
                     .collect();
                 let size = 256;
-                let map = fisheye(&pts, size);
+                let map = campanile_process::pipeline::fisheye_average(pts, size);
                 let bytes =
                     campanile_process::report::false_colour_png("sky residuals", size, size, &map, (-0.1, 0.1))?;
                 std::fs::write(&png, bytes).with_context(|| format!("{}: cannot write", png.display()))?;

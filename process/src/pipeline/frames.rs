@@ -73,18 +73,15 @@ impl FrameGroup {
     pub fn occurrence(&self) -> &str {
         &self.frames[0].occurrence
     }
+}
 
-    /// Mean capture time.
-    pub fn time(&self) -> DateTime<Utc> {
-        let t0 = self.frames[0].time;
-        let mean_ms = self
-            .frames
-            .iter()
-            .map(|f| (f.time - t0).num_milliseconds() as f64)
-            .sum::<f64>()
-            / self.frames.len() as f64;
-        t0 + chrono::Duration::milliseconds(mean_ms.round() as i64)
-    }
+/// The mean of `times` (to the millisecond); the Unix epoch for none.
+pub fn mean_time(times: &[DateTime<Utc>]) -> DateTime<Utc> {
+    let Some(&t0) = times.first() else {
+        return DateTime::UNIX_EPOCH;
+    };
+    let ms = times.iter().map(|t| (*t - t0).num_milliseconds() as f64).sum::<f64>() / times.len() as f64;
+    t0 + chrono::Duration::milliseconds(ms.round() as i64)
 }
 
 /// Groups frames by key prefix (everything before the last `/`), keeping

@@ -91,11 +91,7 @@ pub fn illumination(
         let groups: Vec<&MergedGroup> = merged.iter().filter(|g| g.occurrence == name).collect();
         let of = |p: &Purpose| groups.iter().copied().filter(|g| g.purpose == *p).collect::<Vec<_>>();
         let (sun_groups, sky_groups, env_groups) = (of(&Purpose::Sun), of(&Purpose::Sky), of(&Purpose::Environment));
-        let mean_time = |gs: &[&MergedGroup]| {
-            let t0 = gs[0].time;
-            let ms = gs.iter().map(|g| (g.time - t0).num_milliseconds() as f64).sum::<f64>() / gs.len() as f64;
-            t0 + chrono::Duration::milliseconds(ms.round() as i64)
-        };
+        let mean_time = |gs: &[&MergedGroup]| super::mean_time(&gs.iter().map(|g| g.time).collect::<Vec<_>>());
         let time = if sky_groups.is_empty() {
             groups[0].time
         } else {
@@ -243,11 +239,35 @@ pub fn illumination(
     Ok(out)
 }
 
-/// A fisheye map of the sky, `size` × `size` pixels, zenith at the centre
-/// and the horizon on the inscribed circle (equidistant in zenith angle),
-/// north up and east to the right (as seen from above), of `value(d,
-/// measured)` averaged over the sky pixels of an occurrence's sky scan
-/// looking toward unit direction `d`. Pixels nothing fell in are NaN.
+/// Values toward unit directions averaged on a `size` × `size` fisheye:
+/// zenith at the centre, the horizon on the inscribed circle (equidistant
+/// in zenith angle), north up and east to the right (as seen from above).
+/// Directions below the horizon and non-finite values are skipped; pixels
+/// nothing fell in are NaN.
+pub fn fisheye_average(points: impl IntoIterator<Item = ([f64; 3], f64)>, size: usize) -> Vec<f64> {
+    let mut sum = vec![0.0; size * size];
+    let mut count = vec![0u32; size * size];
+    let half = size as f64 / 2.0;
+    for (d, v) in points {
+        if d[2] < 0.0 || !v.is_finite() {
+            continue;
+        }
+        let r = d[2].clamp(-1.0, 1.0).acos() / std::f64::consts::FRAC_PI_2 * half;
+        let h = (d[0] * d[0] + d[1] * d[1]).sqrt().max(1e-12);
+        let (u, w) = ((half + r * d[0] / h) as usize, (half - r * d[1] / h) as usize);
+        if u < size && w < size {
+            sum[w * size + u] += v;
+            count[w * size + u] += 1;
+        }
+    }
+    sum.iter()
+        .zip(&count)
+        .map(|(s, &n)| if n > 0 { s / f64::from(n) } else { f64::NAN })
+        .collect()
+}
+
+/// [`fisheye_average`] of `value(d, measured)` over the valid sky pixels of
+/// an occurrence's sky scan, `d` the unit direction a pixel looks toward.
 pub fn sky_fisheye(
     merged: &[MergedGroup],
     optics: &StationOptics,
@@ -256,9 +276,7 @@ pub fn sky_fisheye(
     size: usize,
     value: impl Fn([f64; 3], f64) -> f64,
 ) -> Vec<f64> {
-    let mut sum = vec![0.0; size * size];
-    let mut count = vec![0u32; size * size];
-    let half = size as f64 / 2.0;
+    let mut points = Vec::new();
     for g in merged
         .iter()
         .filter(|g| g.occurrence == occurrence && g.purpose == Purpose::Sky)
@@ -273,26 +291,11 @@ pub fn sky_fisheye(
                     continue;
                 };
                 let d = optics.mount.to_world(g.head, d);
-                if d[2] <= 0.0 {
-                    continue;
-                }
-                let v = value(d, f64::from(g.map.rgb[3 * p + channel]));
-                if !v.is_finite() {
-                    continue;
-                }
-                let r = d[2].clamp(-1.0, 1.0).acos() / std::f64::consts::FRAC_PI_2 * half;
-                let h = (d[0] * d[0] + d[1] * d[1]).sqrt().max(1e-12);
-                let (u, w) = (half + r * d[0] / h, half - r * d[1] / h);
-                let (u, w) = (u as usize, w as usize);
-                if u < size && w < size {
-                    sum[w * size + u] += v;
-                    count[w * size + u] += 1;
+                if d[2] > 0.0 {
+                    points.push((d, value(d, f64::from(g.map.rgb[3 * p + channel]))));
                 }
             }
         }
     }
-    sum.iter()
-        .zip(&count)
-        .map(|(s, &n)| if n > 0 { s / f64::from(n) } else { f64::NAN })
-        .collect()
+    fisheye_average(points, size)
 }

@@ -26,8 +26,8 @@ mod measured_sky;
 mod radiance;
 mod response;
 
-pub use frames::{CapturedFrame, FrameGroup, Purpose, group_frames};
-pub use illumination::{OccurrenceLight, SunMeasurement, illumination, sky_fisheye};
+pub use frames::{CapturedFrame, FrameGroup, Purpose, group_frames, mean_time};
+pub use illumination::{OccurrenceLight, SunMeasurement, fisheye_average, illumination, sky_fisheye};
 pub use measured_sky::{LightError, MeasuredSky, extinction, measured_sky, predicted_sky};
 pub use radiance::{MergedGroup, merge_groups};
 pub use response::{ResponseChoice, calibrate_response};

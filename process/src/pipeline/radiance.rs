@@ -71,18 +71,12 @@ pub fn merge_groups(
                 pan_rad: frames.iter().map(|f| f.head.pan_rad).sum::<f64>() / n,
                 tilt_rad: frames.iter().map(|f| f.head.tilt_rad).sum::<f64>() / n,
             };
-            let t0 = first.time;
-            let mean_ms = frames
-                .iter()
-                .map(|f| (f.time - t0).num_milliseconds() as f64)
-                .sum::<f64>()
-                / n;
             Ok(MergedGroup {
                 key: key.clone(),
                 occurrence: first.occurrence.clone(),
                 held_out: first.held_out,
                 purpose: first.purpose.clone(),
-                time: t0 + chrono::Duration::milliseconds(mean_ms.round() as i64),
+                time: super::mean_time(&frames.iter().map(|f| f.time).collect::<Vec<_>>()),
                 head,
                 position_m: first.position_m,
                 pinhole: optics.pinhole_at(map.width, map.height),

@@ -13,7 +13,7 @@ use campanile_process::outdoor::rerender::{relative_rmse, target_mask};
 use campanile_process::outdoor::{
     Illumination, Photo, Reflectance, ReflectanceSettings, RerenderSettings, recover_reflectance, rerender,
 };
-use campanile_process::pipeline::{MeasuredSky, MergedGroup, Purpose, measured_sky, predicted_sky};
+use campanile_process::pipeline::{MeasuredSky, MergedGroup, Purpose, mean_time, measured_sky, predicted_sky};
 use campanile_process::render::{CameraRig, Scene};
 use campanile_process::sun::sun_position;
 use chrono::{DateTime, Utc};
@@ -98,16 +98,6 @@ fn photo_of(p: &Processed, g: &MergedGroup, time: DateTime<Utc>) -> Photo {
     }
 }
 
-fn mean_time(groups: &[&MergedGroup]) -> DateTime<Utc> {
-    let t0 = groups[0].time;
-    let ms = groups
-        .iter()
-        .map(|g| (g.time - t0).num_milliseconds() as f64)
-        .sum::<f64>()
-        / groups.len() as f64;
-    t0 + chrono::Duration::milliseconds(ms.round() as i64)
-}
-
 /// 4×4-block relative RMSE over blocks with at least half their pixels in the mask.
 fn block_rmse(a: &RadianceImage, b: &RadianceImage, mask: &[bool], k: usize) -> Option<f64> {
     let (mut num, mut den) = (0.0, 0.0);
@@ -155,7 +145,7 @@ pub fn outdoor(p: &Processed, scene: &Scene, settings: &ReflectanceSettings) -> 
         if light.held_out {
             continue;
         }
-        let time = mean_time(groups);
+        let time = mean_time(&groups.iter().map(|g| g.time).collect::<Vec<_>>());
         let sun = sun_position(time, &p.optics.observer, p.optics.delta_t_s)
             .map_err(|e| anyhow!("sun position at {time}: {e}"))?;
         let mut sky = measured_sky(light).with_context(|| format!("the light of {occurrence}"))?;
