@@ -57,6 +57,7 @@ pub mod fault;
 mod frame_file;
 mod journal;
 mod key;
+mod products;
 mod reader;
 mod report;
 mod session;
@@ -70,6 +71,7 @@ pub use journal::{
     FrameEntry, FrameMeta, JournalEntry, LightLevel, MissedEntry, ParsedJournal, PoseDeg, ShotKind, parse_journal,
 };
 pub use key::{MAX_KEY_BYTES, check_key, frame_file_name};
+pub use products::{PROCESSED_DIR, PRODUCTS_FILE, ProcessedProducts, ProductsError, products_path};
 pub use reader::SessionReader;
 pub use report::{ResumeReport, TornLine, VerifyReport};
 pub use session::{FRAMES_DIR, JOURNAL_FILE, SessionStore};
