@@ -23,3 +23,4 @@ pub mod render;
 pub mod report;
 pub mod sky;
 pub mod sun;
+pub mod visibility;

@@ -125,3 +125,35 @@ pub fn from_description(description: campanile_config::Scene, obj: &Path) -> Res
 pub fn examples_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples")
 }
+
+impl LoadedScene {
+    /// An undistorted pinhole view from each of the scene's named poses
+    /// (azimuth from north through east, elevation above the horizon, the
+    /// image upright), with vertical field of view `vfov_rad` and
+    /// `width × height` pixels: the views visibility processing (thesis
+    /// §3.5) is checked on.
+    pub fn pinhole_views(
+        &self,
+        vfov_rad: f64,
+        width: usize,
+        height: usize,
+    ) -> Result<Vec<campanile_process::visibility::PinholeView>, campanile_process::visibility::VisibilityError> {
+        self.description
+            .poses
+            .iter()
+            .map(|p| {
+                let (az, el) = (p.azimuth_deg.to_radians(), p.elevation_deg.to_radians());
+                let look = Vector3::new(az.sin() * el.cos(), az.cos() * el.cos(), el.sin());
+                campanile_process::visibility::PinholeView::look_at(
+                    &p.name,
+                    Vector3::new(p.position_m.0, p.position_m.1, p.position_m.2),
+                    look,
+                    Vector3::z(),
+                    vfov_rad,
+                    width,
+                    height,
+                )
+            })
+            .collect()
+    }
+}
