@@ -8,13 +8,16 @@
 //!   (Appendix B), with occluders by shadow rays.
 //! - [`region`]: environment regions of uniform radiance, no subdivision.
 //! - [`sun`]: the solar disc, with penumbra.
+//! - [`occluder_projection`]: the scene's triangles projected onto the
+//!   sphere of directions and cut out of each sky patch exactly (App. B);
+//!   [`sky::Occlusion`] chooses it or shadow rays.
 //! - [`reference`]: an independent quadrature the tests and benchmark check against.
 //!
-//! Not yet: the thesis's projection of occluding polygons onto the sphere
-//! (occluders are found by shadow rays at the subdivision's samples), and
-//! light reflected by the occluders themselves (§5.4, [83]).
+//! Not yet: light reflected by the occluders themselves (§5.4, [83]) is
+//! gathered by the outdoor solver's bounce, not here.
 
 pub mod clip;
+pub mod occluder_projection;
 pub mod reference;
 pub mod region;
 pub mod sky;
@@ -27,7 +30,7 @@ use thiserror::Error;
 pub use clip::clip_to_hemisphere;
 pub use reference::{ReferenceGrid, reference_sky_irradiance};
 pub use region::{environment_irradiance, region_irradiance};
-pub use sky::{SkyIrradiance, SkySubdivision, sky_irradiance};
+pub use sky::{Occlusion, SkyIrradiance, SkySubdivision, sky_irradiance, sky_irradiance_with};
 pub use spherical_polygon::{SphericalPolygon, SphericalPolygonError};
 pub use sun::{SunIrradiance, sun_irradiance};
 
