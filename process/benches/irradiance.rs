@@ -8,7 +8,10 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use campanile_process::irradiance::{ReferenceGrid, SkySubdivision, reference_sky_irradiance, sky_irradiance};
+use campanile_process::irradiance::{
+    Occlusion, ReferenceGrid, SkySubdivision, reference_sky_irradiance, sky_irradiance, sky_irradiance_with,
+};
+use campanile_process::render::{Material, Ray, Scene, Triangle};
 use campanile_process::sky::{Atmosphere, COS_XI_FLOOR, Daylight, direction};
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
@@ -45,6 +48,108 @@ fn monte_carlo(sky: &impl Fn([f64; 3]) -> [f64; 3], n: &Vector3<f64>, samples: u
         }
     }
     std::f64::consts::PI * sum / samples as f64
+}
+
+/// Monte Carlo as [`monte_carlo`], with a shadow ray per sample into `scene`.
+fn monte_carlo_occluded(
+    sky: &impl Fn([f64; 3]) -> [f64; 3],
+    n: &Vector3<f64>,
+    scene: &Scene,
+    samples: u64,
+    seed: u64,
+) -> f64 {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let helper = if n.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+    let a = n.cross(&helper).normalize();
+    let b = n.cross(&a);
+    let origin = n * 1e-6;
+    let mut sum = 0.0;
+    for _ in 0..samples {
+        let (u1, u2): (f64, f64) = (rng.random(), rng.random());
+        let r = u1.sqrt();
+        let phi = std::f64::consts::TAU * u2;
+        let d = a * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt();
+        if d.z > 0.0 && !scene.occluded(&Ray { origin, direction: d }, f64::INFINITY) {
+            sum += sky([d.x, d.y, d.z])[1];
+        }
+    }
+    std::f64::consts::PI * sum / samples as f64
+}
+
+/// The 10 m × 3 m wall 2 m south of the point, standing on its horizon.
+fn wall() -> Scene {
+    let c = [
+        Vector3::new(-5.0, -2.0, 0.0),
+        Vector3::new(5.0, -2.0, 0.0),
+        Vector3::new(5.0, -2.0, 3.0),
+        Vector3::new(-5.0, -2.0, 3.0),
+    ];
+    Scene::new(
+        vec![
+            Triangle::new([c[0], c[1], c[2]], 0, 0).expect("wall"),
+            Triangle::new([c[0], c[2], c[3]], 0, 0).expect("wall"),
+        ],
+        vec![Material::diffuse("wall", [0.5; 3])],
+        vec!["wall".into()],
+    )
+    .expect("wall scene")
+}
+
+/// With an occluder: the projection (App. B) against shadow rays and Monte
+/// Carlo with shadow rays, against the projection at tolerance 1e-6.
+fn occluded(sky: &impl Fn([f64; 3]) -> [f64; 3], n: &Vector3<f64>) {
+    let scene = wall();
+    let run = |occlusion: Occlusion<'_>, tolerance: f64, max_depth: u32| {
+        let s = SkySubdivision {
+            tolerance,
+            min_depth: 2,
+            max_depth,
+        };
+        sky_irradiance_with(&Vector3::zeros(), n, sky, occlusion, &s).expect("irradiance")
+    };
+    let reference = run(Occlusion::Projected(&scene), 1e-6, 14).rgb[1];
+    println!();
+    println!(
+        "With the wall (10 m × 3 m, 2 m south, on the horizon); reference: projection at tolerance 1e-6, {reference:.12} W/m²"
+    );
+    println!();
+    println!("| method | knob | patches / samples | time per evaluation | relative error |");
+    println!("| --- | --- | --- | --- | --- |");
+    for tolerance in [1e-2, 1e-3, 1e-4, 1e-5] {
+        let e = run(Occlusion::Projected(&scene), tolerance, 14);
+        let t = time_per_call(1.0, || run(Occlusion::Projected(&scene), tolerance, 14));
+        println!(
+            "| projected occluders (App. B) | tolerance {tolerance:.0e} | {} | {:.1} µs | {:.2e} |",
+            e.patches,
+            t * 1e6,
+            ((e.rgb[1] - reference) / reference).abs()
+        );
+    }
+    for depth in [8, 10, 12, 14] {
+        let e = run(Occlusion::ShadowRays(&scene), 1e-4, depth);
+        let t = time_per_call(1.0, || run(Occlusion::ShadowRays(&scene), 1e-4, depth));
+        println!(
+            "| shadow rays | tolerance 1e-4, depth {depth} | {} | {:.1} µs | {:.2e} |",
+            e.patches,
+            t * 1e6,
+            ((e.rgb[1] - reference) / reference).abs()
+        );
+    }
+    for samples in [10_000u64, 100_000, 1_000_000, 10_000_000] {
+        let seeds = (20_000_000 / samples).clamp(4, 32);
+        let start = Instant::now();
+        let mut sq = 0.0;
+        for seed in 0..seeds {
+            let e = monte_carlo_occluded(sky, n, &scene, samples, seed);
+            sq += ((e - reference) / reference).powi(2);
+        }
+        let t = start.elapsed().as_secs_f64() / seeds as f64;
+        println!(
+            "| Monte Carlo + shadow rays | {samples} samples (RMS of {seeds} seeds) | {samples} | {:.1} µs | {:.2e} |",
+            t * 1e6,
+            (sq / seeds as f64).sqrt()
+        );
+    }
 }
 
 fn main() {
@@ -116,4 +221,5 @@ fn main() {
             mc_time / t
         );
     }
+    occluded(&sky, &n);
 }

@@ -11,12 +11,15 @@
 //! - [`occluder_projection`]: the scene's triangles projected onto the
 //!   sphere of directions and cut out of each sky patch exactly (App. B);
 //!   [`sky::Occlusion`] chooses it or shadow rays.
+//! - [`form_factor`]: point-to-patch form factors (Lambert's formula, eq. B.1
+//!   over π) and hierarchical links under a solid-angle threshold (§4.5).
 //! - [`reference`]: an independent quadrature the tests and benchmark check against.
 //!
 //! Not yet: light reflected by the occluders themselves (§5.4, [83]) is
 //! gathered by the outdoor solver's bounce, not here.
 
 pub mod clip;
+pub mod form_factor;
 pub mod occluder_projection;
 pub mod reference;
 pub mod region;

@@ -44,7 +44,7 @@ pub struct ProjectedOccluders {
 }
 
 /// Keeps the part of polygon `poly` (points relative to `P`) where `d · m ≥ 0`.
-fn clip(poly: &[Vector3<f64>], m: &Vector3<f64>) -> Vec<Vector3<f64>> {
+pub(crate) fn clip(poly: &[Vector3<f64>], m: &Vector3<f64>) -> Vec<Vector3<f64>> {
     let mut out = Vec::with_capacity(poly.len() + 1);
     for i in 0..poly.len() {
         let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
