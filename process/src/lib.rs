@@ -21,6 +21,7 @@ pub mod pipeline;
 pub mod pose;
 pub mod render;
 pub mod report;
+pub mod scene_geometry;
 pub mod sky;
 pub mod sun;
 pub mod visibility;

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use campanile_process::render::{Material, Scene, Triangle};
+use campanile_process::render::{Material, Scene};
 use nalgebra::Vector3;
 
 use super::WorldError;
@@ -35,62 +35,20 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, WorldError> {
 
 /// Builds the scene of `description` with geometry from `obj`.
 pub fn from_description(description: campanile_config::Scene, obj: &Path) -> Result<LoadedScene, WorldError> {
-    let opts = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ..Default::default()
-    };
-    let (models, _) = tobj::load_obj(obj, &opts).map_err(|e| WorldError::Geometry {
-        path: obj.to_path_buf(),
-        message: e.to_string(),
-    })?;
-    let mut material_names: Vec<String> = description.materials.iter().map(|m| m.name.clone()).collect();
-    let mut surface_names: Vec<String> = description.surfaces.iter().map(|s| s.name.clone()).collect();
-    let mut triangles = Vec::new();
-    let mut degenerate = 0usize;
-    for model in &models {
-        let (surface, material) = match description.surfaces.iter().position(|s| s.groups.contains(&model.name)) {
-            Some(i) => {
-                let m = &description.surfaces[i].material;
-                let mi = material_names.iter().position(|n| n == m).unwrap_or_else(|| {
-                    material_names.push(m.clone());
-                    material_names.len() - 1
-                });
-                (i, mi)
-            }
-            None => {
-                surface_names.push(model.name.clone());
-                material_names.push(format!("{} (no material)", model.name));
-                (surface_names.len() - 1, material_names.len() - 1)
-            }
-        };
-        let p = &model.mesh.positions;
-        let vertex = |i: u32| -> Result<Vector3<f64>, WorldError> {
-            let i = i as usize * 3;
-            p.get(i..i + 3)
-                .map(|v| Vector3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2])))
-                .ok_or_else(|| WorldError::Geometry {
-                    path: obj.to_path_buf(),
-                    message: format!("group {:?}: a face refers to missing vertex {}", model.name, i / 3 + 1),
-                })
-        };
-        for f in model.mesh.indices.chunks_exact(3) {
-            let corners = [vertex(f[0])?, vertex(f[1])?, vertex(f[2])?];
-            match Triangle::new(corners, material as u32, surface as u32) {
-                Some(t) => triangles.push(t),
-                None => degenerate += 1,
-            }
-        }
-    }
-    if degenerate > 0 {
-        tracing::warn!(path = %obj.display(), degenerate, "skipped degenerate triangles");
-    }
-    if triangles.is_empty() {
-        return Err(WorldError::Geometry {
+    let geometry =
+        campanile_process::scene_geometry::load_obj(&description, obj).map_err(|e| WorldError::Geometry {
             path: obj.to_path_buf(),
-            message: "no triangles".into(),
-        });
+            message: e.to_string(),
+        })?;
+    if geometry.degenerate > 0 {
+        tracing::warn!(path = %obj.display(), degenerate = geometry.degenerate, "skipped degenerate triangles");
     }
+    let campanile_process::scene_geometry::SceneGeometry {
+        triangles,
+        surface_names,
+        material_names,
+        ..
+    } = geometry;
     let appearances: Vec<Appearance> = material_names
         .iter()
         .map(|m| appearance(&description.name, m))
