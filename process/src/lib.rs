@@ -22,4 +22,5 @@ pub mod pose;
 pub mod render;
 pub mod report;
 pub mod sky;
+pub mod sky_series;
 pub mod sun;
