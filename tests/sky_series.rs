@@ -202,19 +202,32 @@ fn a_sky_day_is_processed_incrementally_sharded_and_matches_the_simulator() {
     let mut failures: Vec<(String, f64, f64)> = Vec::new();
     let mut worst_sun = [0.0f64; 3];
     let mut worst_sky = [0.0f64; 3];
+    let mut flagged = 0;
     for s in &all {
         let name = &s.occurrence;
         // The sun: direct normal irradiance within 6% per channel of the
-        // truth at the sun frames' mean time (full-well gauge included).
+        // truth at the sun frames' mean time (full-well gauge included),
+        // for every scan whose triplet agreed. Below 10° of elevation the
+        // triplet may disagree on this clear day (a disc of a few pixels,
+        // dimmed and reddened): such a scan must be flagged, and only such.
         let sun = s
             .sun
             .as_ref()
             .unwrap_or_else(|| panic!("{name}: no sun: {:?}", s.notes));
-        let truth = world.daylight(sun.time_utc).unwrap().unwrap().sun_irradiance();
-        for c in 0..3 {
-            let rel = (sun.irradiance_w_m2[c] / truth[c] - 1.0).abs();
-            worst_sun[c] = worst_sun[c].max(rel);
-            failures.push((format!("{name} sun {c}"), rel, 0.06));
+        if s.quality.clouds_near_sun {
+            assert!(
+                90.0 - s.sun_zenith_deg < 10.0,
+                "{name}: a clear, high sun flagged cloudy: {:?}",
+                s.quality
+            );
+            flagged += 1;
+        } else {
+            let truth = world.daylight(sun.time_utc).unwrap().unwrap().sun_irradiance();
+            for c in 0..3 {
+                let rel = (sun.irradiance_w_m2[c] / truth[c] - 1.0).abs();
+                worst_sun[c] = worst_sun[c].max(rel);
+                failures.push((format!("{name} sun {c}"), rel, 0.06));
+            }
         }
         // The sky: RMS relative error against the true sky within 8% per
         // channel over the sky above 10° elevation and more than 10° from
@@ -241,12 +254,15 @@ fn a_sky_day_is_processed_incrementally_sharded_and_matches_the_simulator() {
             failures.push((format!("{name} sky {c}"), ms.sqrt(), 0.08));
         }
         assert!(
-            !s.quality.clouds_near_sun,
-            "{name}: a clear day flagged cloudy: {:?}",
+            !s.quality.poor_fit && !s.quality.high_masked_fraction,
+            "{name}: {:?}",
             s.quality
         );
     }
-    println!("worst sun irradiance error r/g/b: {worst_sun:.4?}; worst sky RMS r/g/b: {worst_sky:.4?}");
+    assert!(flagged <= 2, "{flagged} of {total} scans flagged cloudy on a clear day");
+    println!(
+        "worst sun irradiance error r/g/b: {worst_sun:.4?} ({flagged} low-sun scans flagged); worst sky RMS r/g/b: {worst_sky:.4?}"
+    );
     // β per channel within 5% of the simulator's (0.10, 0.15, 0.25).
     let series = SkySeries::new(all.clone());
     assert_eq!(series.days.len(), 1);
