@@ -7,6 +7,9 @@ use crate::report::{ReportError, Series, line_plot_svg};
 const COLOURS: [(u8, u8, u8); 3] = [(200, 40, 40), (40, 150, 40), (40, 70, 200)];
 const NAMES: [&str; 3] = ["r", "g", "b"];
 
+/// A plotted sky parameter: its name, how to read it, its colour.
+type Parameter = (&'static str, fn(&crate::sky::SkyModel) -> f64, (u8, u8, u8));
+
 /// Hours since 00:00 UTC of the first scan's date (may pass 24).
 fn hours(series: &SkySeries) -> Vec<f64> {
     let Some(first) = series.scans.first() else {
@@ -42,7 +45,7 @@ pub fn zenith_scale_svg(series: &SkySeries) -> Result<String, ReportError> {
 /// The shape parameters a, b, c, d, e of the green channel against time.
 pub fn shape_parameters_svg(series: &SkySeries) -> Result<String, ReportError> {
     let t = hours(series);
-    let params: [(&str, fn(&crate::sky::SkyModel) -> f64, (u8, u8, u8)); 5] = [
+    let params: [Parameter; 5] = [
         ("a", |m| m.a, (200, 40, 40)),
         ("b", |m| m.b, (230, 140, 0)),
         ("c", |m| m.c, (40, 150, 40)),

@@ -48,11 +48,11 @@ impl QualityFlags {
         let worst_rms_relative = worst(|c| c.0);
         let masked_fraction = worst(|c| c.1);
         QualityFlags {
-            clouds_near_sun: triplet_spread.is_none_or(|s| !(s <= TRIPLET_AGREEMENT)),
+            clouds_near_sun: triplet_spread.is_none_or(|s| s.is_nan() || s > TRIPLET_AGREEMENT),
             triplet_spread,
-            poor_fit: worst_rms_relative.is_none_or(|r| !(r <= POOR_FIT_RMS)),
+            poor_fit: worst_rms_relative.is_none_or(|r| r.is_nan() || r > POOR_FIT_RMS),
             worst_rms_relative,
-            high_masked_fraction: masked_fraction.is_some_and(|m| !(m <= HIGH_MASKED_FRACTION)),
+            high_masked_fraction: masked_fraction.is_some_and(|m| m.is_nan() || m > HIGH_MASKED_FRACTION),
             masked_fraction,
         }
     }
