@@ -122,24 +122,47 @@ fn scan_occurrences(inputs: &SessionInputs) -> BTreeSet<String> {
         .collect()
 }
 
-/// The occurrences whose promised data shots are all journaled (taken or
-/// missed). `None` when the plan's timeline cannot be rebuilt (then every
-/// occurrence but the journal's last is taken as complete).
-fn complete_occurrences(inputs: &SessionInputs) -> Option<HashSet<String>> {
-    let t = timeline(&inputs.plan, &inputs.station, None, &TimelineOptions::default()).ok()?;
-    let journaled: HashSet<&str> = inputs.reader.entries().iter().map(JournalEntry::key).collect();
-    Some(
-        t.occurrences
-            .iter()
-            .filter(|o| {
-                o.shots
+/// Which occurrences are finished: those of the plan's timeline whose
+/// promised data shots are all journaled (taken or missed); an occurrence
+/// the timeline does not know (or every one, when the timeline cannot be
+/// rebuilt) is finished once a later occurrence has journaled something.
+struct Finished {
+    /// Occurrences of the timeline, and whether each is finished.
+    planned: std::collections::HashMap<String, bool>,
+    /// The occurrence of the journal's last line.
+    last: Option<String>,
+}
+
+impl Finished {
+    fn of(inputs: &SessionInputs) -> Finished {
+        let journaled: HashSet<&str> = inputs.reader.entries().iter().map(JournalEntry::key).collect();
+        let planned = timeline(&inputs.plan, &inputs.station, None, &TimelineOptions::default())
+            .map(|t| {
+                t.occurrences
                     .iter()
-                    .filter(|s| s.promised && s.kind == PlannedKind::Data)
-                    .all(|s| journaled.contains(s.key.as_str()))
+                    .map(|o| {
+                        let done = o
+                            .shots
+                            .iter()
+                            .filter(|s| s.promised && s.kind == PlannedKind::Data)
+                            .all(|s| journaled.contains(s.key.as_str()));
+                        (o.key.clone(), done)
+                    })
+                    .collect()
             })
-            .map(|o| o.key.clone())
-            .collect(),
-    )
+            .unwrap_or_default();
+        Finished {
+            planned,
+            last: last_occurrence(inputs),
+        }
+    }
+
+    fn contains(&self, occurrence: &str) -> bool {
+        match self.planned.get(occurrence) {
+            Some(&done) => done,
+            None => self.last.as_deref() != Some(occurrence),
+        }
+    }
 }
 
 fn last_occurrence(inputs: &SessionInputs) -> Option<String> {
@@ -254,18 +277,14 @@ pub fn process_new_scans(session: &Path, opts: &SkySeriesOptions) -> Result<Scan
     let optics = StationOptics::of_station(&inputs.station);
     let listed = ProcessedProducts::read(session)?;
     let lists = opts.lists_products(session);
-    let complete = complete_occurrences(&inputs);
-    let last = last_occurrence(&inputs);
+    let finished = Finished::of(&inputs);
     let (mut todo, mut already_done, mut other_shards, mut incomplete) = (Vec::new(), 0, 0, Vec::new());
     for occ in scan_occurrences(&inputs) {
         if scan_path(&opts.out, &occ).is_file() || (lists && listed.contains(&occ)) {
             already_done += 1;
         } else if opts.shard.is_some_and(|s| !s.contains(&occ)) {
             other_shards += 1;
-        } else if complete
-            .as_ref()
-            .map_or(last.as_deref() == Some(occ.as_str()), |c| !c.contains(&occ))
-        {
+        } else if !finished.contains(&occ) {
             incomplete.push(occ);
         } else {
             todo.push(occ);
