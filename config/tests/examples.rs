@@ -18,14 +18,19 @@ fn every_example_file_is_valid() {
             n += 1;
         }
     }
-    assert_eq!(n, 7, "sim station, real station, three plans, two scenes");
+    assert_eq!(n, 8, "sim station, real station, four plans, two scenes");
 }
 
 #[test]
 fn plans_run_on_both_stations() {
     for station in ["sim-station.ron", "real-station.ron"] {
         let station = load_station(&example(station)).expect("valid station");
-        for plan in ["campanile-day.ron", "campanile-quick.ron", "room-lights.ron"] {
+        for plan in [
+            "campanile-day.ron",
+            "campanile-quick.ron",
+            "room-lights.ron",
+            "sky-day.ron",
+        ] {
             let Ok(Document::Plan(plan)) = load(&example(plan)) else {
                 panic!("{plan} is a plan")
             };

@@ -23,5 +23,6 @@ pub mod render;
 pub mod report;
 pub mod scene_geometry;
 pub mod sky;
+pub mod sky_series;
 pub mod sun;
 pub mod visibility;

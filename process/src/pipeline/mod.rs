@@ -27,7 +27,9 @@ mod radiance;
 mod response;
 
 pub use frames::{CapturedFrame, FrameGroup, Purpose, group_frames, mean_time};
-pub use illumination::{OccurrenceLight, SunMeasurement, fisheye_average, illumination, sky_fisheye};
+pub use illumination::{
+    OccurrenceLight, SUN_MARGIN_RAD, SunMeasurement, TRIPLET_AGREEMENT, fisheye_average, illumination, sky_fisheye,
+};
 pub use measured_sky::{LightError, MeasuredSky, extinction, measured_sky, predicted_sky};
 pub use radiance::{MergedGroup, merge_groups};
 pub use response::{ResponseChoice, calibrate_response};
@@ -108,6 +110,12 @@ pub enum PipelineError {
         group: String,
         /// Why.
         source: crate::hdr::HdrError,
+    },
+    /// An occurrence has no sun or sky frames to process.
+    #[error("occurrence {occurrence:?} has no sun shot and no sky scan")]
+    NoScan {
+        /// The occurrence.
+        occurrence: String,
     },
     /// The sun's position could not be computed.
     #[error("sun position at {time}: {message}")]

@@ -5,6 +5,7 @@ pub mod outdoor_report;
 pub mod outdoor_stage;
 pub mod report_sections;
 mod session_frames;
+pub mod sky_series;
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -42,8 +43,26 @@ pub use session_frames::SessionInputs;
 ///   summary.json                   every figure and diagnostic, with stage times
 ///   report.html                    the same as a page with plots (self-contained)
 ///
-/// Example:
+/// A sky-only session (only sun shots, sky scans and brackets aimed at head
+/// angles) is processed as a sky time series instead: per scan the sun's
+/// irradiance, the sky per channel (model and why, residuals), a profile
+/// and quality flags; per day the extinction β per channel, a CSV, plots
+/// and a keogram. It is incremental (scans with products are skipped;
+/// scans still being captured wait) and shardable:
+///   scans/<occurrence>.ron         one scan's products (the source of every per-day product)
+///   sky-series.csv                 one row per scan, every column documented in its header
+///   extinction.csv                 β and E₀ per day and channel (Langley)
+///   plots/*.svg, keogram.png, keogram-residual.png, report.html
+///   response.csv                   the response used (given, or from the calibration bracket)
+/// and, when OUT is SESSION/processed and no --shard is given, each scan's
+/// occurrence is added to SESSION/processed/products.ron once its file is
+/// on disk (the station may then delete its raw frames).
+///
+/// Examples:
 ///   campanile process campanile-day-session --scene examples/campanile-scene.ron
+///   campanile process sky-day --response other-day/processed/response.csv
+///   campanile process sky-day --shard 2/8 --out shard-2     (one of 8 array jobs)
+///   campanile process sky-day --merge-shards shard-1 shard-2 … shard-8
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct ProcessArgs {
@@ -68,6 +87,28 @@ pub struct ProcessArgs {
     /// Environment map azimuth sectors.
     #[arg(long, value_name = "N", default_value_t = 36)]
     env_cols: usize,
+    /// Sky-only sessions: the response curve (CSV from `campanile hdr
+    /// calibrate` or a session's processed/response.csv), for a day without
+    /// a calibration bracket. Default: OUT/response.csv of an earlier run,
+    /// else the session's own calibration bracket.
+    #[arg(long, value_name = "FILE.csv")]
+    response: Option<PathBuf>,
+    /// Sky-only sessions: process only share K of N of the scans, chosen by
+    /// a stable hash of the occurrence id (1 ≤ K ≤ N). Shards do not write
+    /// the products list; merge them with --merge-shards.
+    #[arg(long, value_name = "K/N")]
+    shard: Option<campanile_process::sky_series::Shard>,
+    /// Sky-only sessions: copy the per-scan files of these shard output
+    /// directories into OUT (none: use what OUT holds), list them in the
+    /// products list (if OUT is SESSION/processed) and recompute the day.
+    /// No scan is processed.
+    #[arg(long, value_name = "DIR", num_args = 0.., conflicts_with = "shard")]
+    merge_shards: Option<Vec<PathBuf>>,
+    /// Sky-only sessions: process this one occurrence (e.g. sky@2026-08-28#3)
+    /// again or for the first time, whether or not it has products, then
+    /// recompute the day (what the station does after each scan).
+    #[arg(long, value_name = "ID", conflicts_with_all = ["shard", "merge_shards"])]
+    occurrence: Option<String>,
 }
 
 /// What `process` measured, for `summary.json` and the report.
@@ -120,6 +161,18 @@ pub fn run(args: ProcessArgs) -> Result<()> {
         ..DebevecOptions::default()
     };
     debevec.sampling.samples = args.samples;
+    let inputs = SessionInputs::open(&args.session, args.scene.as_deref())?;
+    if sky_series::is_sky_only(&inputs.plan) {
+        drop(inputs);
+        return run_sky_series(&args, out, debevec);
+    }
+    if args.response.is_some() || args.shard.is_some() || args.merge_shards.is_some() || args.occurrence.is_some() {
+        anyhow::bail!(
+            "{}: --response, --shard, --merge-shards and --occurrence are for sky-only sessions (sun shots, sky scans and brackets at head angles); this session's plan has views of a scene",
+            args.session.display()
+        );
+    }
+    drop(inputs);
     let processed = process_session(
         &args.session,
         args.scene.as_deref(),
@@ -177,6 +230,94 @@ pub fn run(args: ProcessArgs) -> Result<()> {
         for n in &o.notes {
             println!("    note: {n}");
         }
+    }
+    Ok(())
+}
+
+fn run_sky_series(args: &ProcessArgs, out: PathBuf, debevec: DebevecOptions) -> Result<()> {
+    let opts = sky_series::SkySeriesOptions {
+        out: out.clone(),
+        response: args.response.clone(),
+        shard: args.shard,
+        debevec,
+    };
+    std::fs::create_dir_all(&out).with_context(|| format!("{}: cannot create", out.display()))?;
+    if let Some(occurrence) = &args.occurrence {
+        let scan = sky_series::process_scan(&args.session, occurrence, &opts)?;
+        println!(
+            "processed {occurrence} → {}: flags [{}]",
+            campanile_process::sky_series::scan_path(&out, occurrence).display(),
+            scan.quality.names()
+        );
+    }
+    let (series, run) = match &args.merge_shards {
+        _ if args.occurrence.is_some() => (sky_series::recompute_day(&out)?, None),
+        Some(dirs) => {
+            let (copied, series) = sky_series::merge_shards(&args.session, dirs, &opts)?;
+            println!(
+                "merged {} shard directories ({copied} scan files copied): {} scans in {}",
+                dirs.len(),
+                series.scans.len(),
+                out.display()
+            );
+            (series, None)
+        }
+        None => {
+            let run = sky_series::process_new_scans(&args.session, &opts)?;
+            let rate = if run.scan_seconds > 0.0 {
+                run.processed.len() as f64 / run.scan_seconds
+            } else {
+                0.0
+            };
+            println!(
+                "sky series {} → {}{}",
+                args.session.display(),
+                out.display(),
+                args.shard.map_or(String::new(), |s| format!(" (shard {s})"))
+            );
+            println!(
+                "  processed {} scans in {:.2} s ({rate:.2} scans/s); {} already done, {} in other shards, {} still being captured",
+                run.processed.len(),
+                run.scan_seconds,
+                run.already_done,
+                run.other_shards,
+                run.incomplete.len()
+            );
+            println!("  response: {}", run.response);
+            (run.series.clone(), Some(run))
+        }
+    };
+    for d in &series.days {
+        let beta: Vec<String> = d
+            .fit
+            .iter()
+            .map(|f| {
+                f.as_ref()
+                    .map_or_else(|e| format!("none ({e})"), |e| format!("{:.4}", e.beta))
+            })
+            .collect();
+        println!(
+            "  {}: β r/g/b {} from {} scans ({} left out)",
+            d.date,
+            beta.join(" / "),
+            d.points.len(),
+            d.left_out
+        );
+    }
+    let flagged = series.scans.iter().filter(|s| !s.quality.names().is_empty()).count();
+    println!("  {} scans in the series, {flagged} flagged", series.scans.len());
+    let report = sky_series::report(&args.session, &series, run.as_ref())?;
+    write_report(&report, &out.join("report.html"))?;
+    if let Some(run) = &run
+        && !run.failed.is_empty()
+    {
+        for (occ, why) in &run.failed {
+            eprintln!("  failed {occ}: {why}");
+        }
+        anyhow::bail!(
+            "{} scans failed (listed above); they were not marked processed",
+            run.failed.len()
+        );
     }
     Ok(())
 }

@@ -83,10 +83,16 @@ impl SessionInputs {
     /// Every data frame of the session with its purpose, read and checked
     /// (in parallel), in journal order.
     pub fn frames(&self, bar: &ProgressBar) -> Result<Vec<CapturedFrame>> {
+        self.frames_where(bar, |_| true)
+    }
+
+    /// The data frames whose journal entry `keep` accepts, read and checked
+    /// (in parallel), in journal order.
+    pub fn frames_where(&self, bar: &ProgressBar, keep: impl Fn(&FrameEntry) -> bool) -> Result<Vec<CapturedFrame>> {
         let entries: Vec<&FrameEntry> = self
             .reader
             .frames()
-            .filter(|f| f.meta.kind != ShotKind::Metering)
+            .filter(|f| f.meta.kind != ShotKind::Metering && keep(f))
             .collect();
         bar.set_length(entries.len() as u64);
         // Where the head stood: the last pose a view aimed from, starting at
@@ -154,7 +160,8 @@ impl SessionInputs {
         frames
     }
 
-    fn session_of(&self, occurrence: &str) -> Option<&campanile_config::plan::Session> {
+    /// The plan session of an occurrence id (`{session}@…`).
+    pub fn session_of(&self, occurrence: &str) -> Option<&campanile_config::plan::Session> {
         let name = occurrence.split('@').next()?;
         self.plan.sessions.iter().find(|s| s.name == name)
     }
