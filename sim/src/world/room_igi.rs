@@ -1,0 +1,255 @@
+//! The simulated room (thesis §4.7.2) as inverse global illumination sees
+//! it: the room's geometry grouped by material (the groups that share
+//! specular parameters), the station's lamps, cameras at the scene's poses,
+//! and photographs by [`photograph`] (exact direct light, path-traced
+//! interreflection).
+
+use std::path::Path;
+
+use campanile_process::brdf::WardMaterial;
+use campanile_process::camera::image::RadianceImage;
+use campanile_process::igi::{IgiInput, IgiLight, View, ViewCamera};
+use campanile_process::render::{PointLight, Scene, SphereLight, Triangle};
+use nalgebra::Vector3;
+
+use super::igi_photograph::{PhotoSettings, photograph};
+use super::scene_file::{LoadedScene, load_scene};
+use super::{MIN_BULB_RADIUS_M, WorldError};
+
+/// The room, its lamps and its true materials.
+#[derive(Debug, Clone)]
+pub struct RoomIgi {
+    /// The scene with its true materials (surfaces are the OBJ groups'
+    /// scene surfaces; materials the shared-specular groups).
+    pub loaded: LoadedScene,
+    /// The station's lamps (name, bulb at full level).
+    pub lamps: Vec<(String, SphereLight)>,
+}
+
+/// The camera at a scene pose: azimuth from north through east, elevation
+/// above the horizon, z up.
+pub fn pose_camera(
+    pose: &campanile_config::scene::CameraPose,
+    vfov_deg: f64,
+    width: usize,
+    height: usize,
+) -> ViewCamera {
+    let (az, el) = (pose.azimuth_deg.to_radians(), pose.elevation_deg.to_radians());
+    let (x, y, z) = pose.position_m;
+    ViewCamera {
+        position: Vector3::new(x, y, z),
+        look: Vector3::new(az.sin() * el.cos(), az.cos() * el.cos(), el.sin()),
+        up: Vector3::z(),
+        vfov_rad: vfov_deg.to_radians(),
+        width,
+        height,
+    }
+}
+
+impl RoomIgi {
+    /// The room of scene file `scene` lit by the lamps of `station`.
+    pub fn load(scene: &Path, station: &campanile_config::Station) -> Result<RoomIgi, WorldError> {
+        let loaded = load_scene(scene)?;
+        let lamps = station
+            .lights
+            .iter()
+            .flat_map(|l| l.channels.iter())
+            .map(|ch| {
+                let (x, y, z) = ch.position_m;
+                let (r, g, b) = ch.intensity.radiant_intensity_w_sr;
+                (
+                    ch.name.clone(),
+                    SphereLight::with_intensity(Vector3::new(x, y, z), ch.radius_m.max(MIN_BULB_RADIUS_M), [r, g, b]),
+                )
+            })
+            .collect();
+        Ok(RoomIgi { loaded, lamps })
+    }
+
+    /// The render scene with the true materials.
+    pub fn scene(&self) -> &Scene {
+        &self.loaded.scene
+    }
+
+    /// Names of the groups that share specular parameters (the scene's
+    /// materials), which are the solver's surfaces.
+    pub fn material_names(&self) -> Vec<String> {
+        self.loaded.scene.materials().iter().map(|m| m.name.clone()).collect()
+    }
+
+    /// The true BRDF of each material, its texture's mean albedo as ρd.
+    pub fn true_materials(&self) -> Result<Vec<WardMaterial>, WorldError> {
+        self.loaded
+            .appearances
+            .iter()
+            .map(|a| {
+                Ok(WardMaterial {
+                    rho_d: a.albedo.mean_albedo(),
+                    lobe: a.lobe().map_err(|e| WorldError::Config {
+                        path: "room truth".into(),
+                        message: e.to_string(),
+                    })?,
+                })
+            })
+            .collect()
+    }
+
+    /// The triangles as the solver takes them: `surface` is the material
+    /// index (the group sharing one BRDF).
+    pub fn igi_triangles(&self) -> Vec<Triangle> {
+        self.loaded
+            .scene
+            .triangles()
+            .iter()
+            .map(|t| Triangle {
+                surface: t.material,
+                ..*t
+            })
+            .collect()
+    }
+
+    /// The named cameras at the scene's poses, `width` × `height`, vertical
+    /// field of view `vfov_deg`.
+    pub fn cameras(&self, vfov_deg: f64, width: usize, height: usize) -> Vec<(String, ViewCamera)> {
+        self.loaded
+            .description
+            .poses
+            .iter()
+            .map(|p| (p.name.clone(), pose_camera(p, vfov_deg, width, height)))
+            .collect()
+    }
+
+    /// The lamps as the solver takes them (true positions, radii, intensities).
+    pub fn igi_lights(&self) -> Vec<IgiLight> {
+        self.lamps
+            .iter()
+            .map(|(_, b)| IgiLight {
+                position: b.center,
+                radius: b.radius,
+                intensity: b.radiance.map(|l| l * std::f64::consts::PI * b.radius * b.radius),
+            })
+            .collect()
+    }
+
+    /// One photograph of the room lit by `bulbs` (visible in view) and
+    /// `points` (invisible), with the true materials.
+    pub fn photograph(
+        &self,
+        bulbs: &[SphereLight],
+        points: &[PointLight],
+        camera: &ViewCamera,
+        settings: &PhotoSettings,
+    ) -> RadianceImage {
+        photograph(&self.loaded.scene, points, bulbs, camera, settings)
+    }
+
+    /// The solver's input: every lamp on, the views `cameras` (for
+    /// example [`RoomIgi::cameras`] and [`RoomIgi::highlight_cameras`]).
+    pub fn igi_input(&self, cameras: Vec<(String, ViewCamera)>, settings: &PhotoSettings) -> IgiInput {
+        let bulbs: Vec<SphereLight> = self.lamps.iter().map(|(_, b)| *b).collect();
+        let views = cameras
+            .into_iter()
+            .enumerate()
+            .map(|(k, (name, camera))| View {
+                name,
+                camera,
+                image: self.photograph(
+                    &bulbs,
+                    &[],
+                    &camera,
+                    &PhotoSettings {
+                        seed: settings.seed.wrapping_add(k as u64 * 1000),
+                        ..*settings
+                    },
+                ),
+                mask: None,
+            })
+            .collect();
+        IgiInput {
+            triangles: self.igi_triangles(),
+            surfaces: self.material_names(),
+            lights: self.igi_lights(),
+            views,
+        }
+    }
+}
+
+impl RoomIgi {
+    /// Highlight views (as §4.7.1's zoomed views): for each lamp and each
+    /// scene surface whose true material has a specular lobe, the first
+    /// scene pose position (in file order) from which the lamp's mirror
+    /// reflection on one of the surface's triangles is visible and lit;
+    /// a camera there aimed at that point, `px` square, `vfov_deg` wide.
+    pub fn highlight_cameras(&self, vfov_deg: f64, px: usize) -> Vec<(String, ViewCamera)> {
+        use campanile_process::render::Ray;
+        let scene = &self.loaded.scene;
+        let positions: Vec<Vector3<f64>> = self
+            .loaded
+            .description
+            .poses
+            .iter()
+            .map(|p| Vector3::new(p.position_m.0, p.position_m.1, p.position_m.2))
+            .collect();
+        let visible = |a: &Vector3<f64>, b: &Vector3<f64>| {
+            let d = b - a;
+            let len = d.norm();
+            !scene.occluded(
+                &Ray {
+                    origin: *a,
+                    direction: d / len,
+                },
+                len * (1.0 - 1e-6),
+            )
+        };
+        let mut out = Vec::new();
+        for (lamp, bulb) in &self.lamps {
+            for (s, surface) in scene.surfaces().iter().enumerate() {
+                let found = positions.iter().find_map(|p| {
+                    scene
+                        .triangles()
+                        .iter()
+                        .filter(|t| t.surface as usize == s)
+                        .find_map(|t| {
+                            scene.materials()[t.material as usize].specular?;
+                            let n = t.normal;
+                            let (dp, dl) = ((p - t.vertices[0]).dot(&n), (bulb.center - t.vertices[0]).dot(&n));
+                            if dp * dl <= 0.0 || dp.abs() < 1e-6 {
+                                return None;
+                            }
+                            // The lamp mirrored in the plane, joined to the camera.
+                            let mirrored = bulb.center - n * (2.0 * dl);
+                            let k = dp / (dp - (mirrored - t.vertices[0]).dot(&n));
+                            let m = p + (mirrored - p) * k;
+                            let (e1, e2, q) = (
+                                t.vertices[1] - t.vertices[0],
+                                t.vertices[2] - t.vertices[0],
+                                m - t.vertices[0],
+                            );
+                            let (d11, d12, d22) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
+                            let (q1, q2) = (q.dot(&e1), q.dot(&e2));
+                            let det = d11 * d22 - d12 * d12;
+                            let u = (d22 * q1 - d12 * q2) / det;
+                            let v = (d11 * q2 - d12 * q1) / det;
+                            let inside = u > 0.02 && v > 0.02 && u + v < 0.98;
+                            let lift = m + n * dp.signum() * 1e-4;
+                            (inside && visible(p, &lift) && visible(&bulb.center, &lift)).then_some((*p, m))
+                        })
+                });
+                if let Some((p, m)) = found {
+                    out.push((
+                        format!("highlight-{surface}-{lamp}"),
+                        ViewCamera {
+                            position: p,
+                            look: m - p,
+                            up: Vector3::z(),
+                            vfov_rad: vfov_deg.to_radians(),
+                            width: px,
+                            height: px,
+                        },
+                    ));
+                }
+            }
+        }
+        out
+    }
+}
