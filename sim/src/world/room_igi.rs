@@ -253,3 +253,72 @@ impl RoomIgi {
         out
     }
 }
+
+/// `image` averaged over `k × k` pixel blocks (a partial block at the edge
+/// is dropped): comparisons of path-traced images at the scale where
+/// their Monte Carlo noise has averaged out.
+pub fn block_average(image: &RadianceImage, k: usize) -> RadianceImage {
+    let k = k.max(1);
+    let (w, h) = (image.width / k, image.height / k);
+    let mut data = vec![0f32; w * h * 3];
+    for y in 0..h {
+        for x in 0..w {
+            for c in 0..3 {
+                let mut s = 0.0f64;
+                for dy in 0..k {
+                    for dx in 0..k {
+                        s += f64::from(image.radiance(x * k + dx, y * k + dy, c));
+                    }
+                }
+                data[(y * w + x) * 3 + c] = (s / (k * k) as f64) as f32;
+            }
+        }
+    }
+    RadianceImage {
+        width: w,
+        height: h,
+        data,
+    }
+}
+
+impl RoomIgi {
+    /// The albedo map of solver surface `surface` (a material index)
+    /// against the true texture: the median over seen texels of the
+    /// relative error of the mean over channels, and the texel count.
+    pub fn albedo_map_error(
+        &self,
+        map: &campanile_process::igi::albedo_map::AlbedoMap,
+        surface: usize,
+    ) -> (f64, usize) {
+        let Some(appearance) = self.loaded.appearances.get(surface) else {
+            return (f64::NAN, 0);
+        };
+        let mut errs = Vec::new();
+        for (tri, texels) in self.loaded.scene.triangles().iter().zip(&map.triangles) {
+            if tri.material as usize != surface {
+                continue;
+            }
+            for j in 0..texels.size[1] {
+                for i in 0..texels.size[0] {
+                    let k = j * texels.size[0] + i;
+                    if texels.weight[k] <= 0.0 {
+                        continue;
+                    }
+                    let st = [
+                        texels.origin[0] + (i as f64 + 0.5) * map.texel_m,
+                        texels.origin[1] + (j as f64 + 0.5) * map.texel_m,
+                    ];
+                    let t = appearance.albedo.albedo(st);
+                    let got: f64 = texels.albedo[k].iter().map(|v| f64::from(*v)).sum::<f64>();
+                    let want: f64 = t.iter().sum();
+                    errs.push((got / want - 1.0).abs());
+                }
+            }
+        }
+        if errs.is_empty() {
+            return (f64::NAN, 0);
+        }
+        errs.sort_by(f64::total_cmp);
+        (errs[errs.len() / 2], errs.len())
+    }
+}
