@@ -34,6 +34,7 @@ mod radiosity;
 mod recover;
 pub mod relight;
 pub mod relit_scene;
+pub mod scene_file;
 mod specular_albedo;
 pub mod table;
 mod ward_fit;

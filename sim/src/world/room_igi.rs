@@ -322,3 +322,162 @@ impl RoomIgi {
         (errs[errs.len() / 2], errs.len())
     }
 }
+
+/// What [`RoomIgi::write_scene_file`] photographs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SceneFileShot {
+    /// Vertical field of view of the wide views, degrees.
+    pub wide_vfov_deg: f64,
+    /// Wide views' width and height, pixels.
+    pub wide_px: (usize, usize),
+    /// Highlight views' field of view (degrees) and side (pixels).
+    pub highlight: (f64, usize),
+    /// Bulb views' field of view (degrees) and side (pixels).
+    pub bulb: (f64, usize),
+    /// Noise against time of every photograph.
+    pub photo: PhotoSettings,
+}
+
+impl Default for SceneFileShot {
+    fn default() -> Self {
+        SceneFileShot {
+            wide_vfov_deg: 60.0,
+            wide_px: (96, 72),
+            highlight: (20.0, 40),
+            bulb: (8.0, 64),
+            photo: PhotoSettings {
+                indirect_samples: 16,
+                max_bounces: 4,
+                seed: 7,
+            },
+        }
+    }
+}
+
+fn write_exr(image: &RadianceImage, path: &Path) -> Result<(), WorldError> {
+    let map = campanile_process::hdr::merge::RadianceMap {
+        width: image.width,
+        height: image.height,
+        rgb: image.data.clone(),
+        variance: vec![0.0; image.data.len()],
+        mask: vec![0; image.width * image.height],
+    };
+    campanile_process::exr_io::write_radiance_exr(&map, path).map_err(|e| WorldError::Config {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
+}
+
+impl RoomIgi {
+    /// Photographs the room and writes a `campanile igi` scene file
+    /// (`dir/scene.ron`, the OBJ beside it, EXR images under `dir/images`):
+    /// every lamp on, seen from the scene's poses and from the highlight
+    /// views; each lamp given by three HDR images of its bulb (lit alone),
+    /// from the first three pose positions, to be triangulated. Returns the
+    /// scene file's path.
+    pub fn write_scene_file(&self, dir: &Path, shot: &SceneFileShot) -> Result<std::path::PathBuf, WorldError> {
+        use std::fmt::Write as _;
+        let io = |p: &Path, e: std::io::Error| WorldError::Config {
+            path: p.to_path_buf(),
+            message: e.to_string(),
+        };
+        let images = dir.join("images");
+        std::fs::create_dir_all(&images).map_err(|e| io(&images, e))?;
+        let obj_src = super::scene_file::examples_dir().join(&self.loaded.description.geometry);
+        let obj = dir.join("room.obj");
+        std::fs::copy(&obj_src, &obj).map_err(|e| io(&obj_src, e))?;
+        let mut cams = self.cameras(shot.wide_vfov_deg, shot.wide_px.0, shot.wide_px.1);
+        cams.extend(self.highlight_cameras(shot.highlight.0, shot.highlight.1));
+        let mut text = String::from(
+            "// Written by the simulator: the room with every lamp on.\nIgiScene(\n    geometry: \"room.obj\",\n    surfaces: [\n",
+        );
+        for m in self.material_names() {
+            let groups: Vec<String> = self
+                .loaded
+                .description
+                .surfaces
+                .iter()
+                .filter(|s| s.material == m)
+                .flat_map(|s| s.groups.iter().map(|g| format!("{g:?}")))
+                .collect();
+            let _ = writeln!(text, "        (name: {m:?}, groups: [{}]),", groups.join(", "));
+        }
+        text.push_str("    ],\n    cameras: [\n");
+        let cam_line = |text: &mut String, name: &str, c: &ViewCamera| {
+            let _ = writeln!(
+                text,
+                "        (name: {name:?}, position_m: ({:?}, {:?}, {:?}), look: ({:?}, {:?}, {:?}), up: (0.0, 0.0, 1.0), vfov_deg: {:?}, width: {}, height: {}),",
+                c.position.x,
+                c.position.y,
+                c.position.z,
+                c.look.x,
+                c.look.y,
+                c.look.z,
+                c.vfov_rad.to_degrees(),
+                c.width,
+                c.height
+            );
+        };
+        for (n, c) in &cams {
+            cam_line(&mut text, n, c);
+        }
+        // Bulb views.
+        let positions: Vec<Vector3<f64>> = cams.iter().take(3).map(|(_, c)| c.position).collect();
+        let mut bulb_entries = String::new();
+        for (lamp, bulb) in &self.lamps {
+            let mut entries = Vec::new();
+            for (k, p) in positions.iter().enumerate() {
+                let name = format!("bulb-{lamp}-{k}");
+                let cam = ViewCamera {
+                    position: *p,
+                    look: bulb.center - p,
+                    up: Vector3::z(),
+                    vfov_rad: shot.bulb.0.to_radians(),
+                    width: shot.bulb.1,
+                    height: shot.bulb.1,
+                };
+                cam_line(&mut text, &name, &cam);
+                let img = self.photograph(
+                    std::slice::from_ref(bulb),
+                    &[],
+                    &cam,
+                    &PhotoSettings {
+                        indirect_samples: 0,
+                        max_bounces: 1,
+                        ..shot.photo
+                    },
+                );
+                let file = format!("images/{name}.exr");
+                write_exr(&img, &dir.join(&file))?;
+                entries.push(format!("(camera: {name:?}, image: {file:?})"));
+            }
+            let _ = writeln!(
+                bulb_entries,
+                "        Bulb(name: {lamp:?}, images: [{}]),",
+                entries.join(", ")
+            );
+        }
+        text.push_str("    ],\n    lights: [\n");
+        text.push_str(&bulb_entries);
+        text.push_str("    ],\n    images: [\n");
+        let bulbs: Vec<SphereLight> = self.lamps.iter().map(|(_, b)| *b).collect();
+        for (k, (n, c)) in cams.iter().enumerate() {
+            let img = self.photograph(
+                &bulbs,
+                &[],
+                c,
+                &PhotoSettings {
+                    seed: shot.photo.seed.wrapping_add(k as u64 * 1000),
+                    ..shot.photo
+                },
+            );
+            let file = format!("images/{n}.exr");
+            write_exr(&img, &dir.join(&file))?;
+            let _ = writeln!(text, "        (camera: {n:?}, image: {file:?}),");
+        }
+        text.push_str("    ],\n)\n");
+        let path = dir.join("scene.ron");
+        std::fs::write(&path, text).map_err(|e| io(&path, e))?;
+        Ok(path)
+    }
+}
