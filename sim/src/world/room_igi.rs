@@ -119,6 +119,30 @@ impl RoomIgi {
             .collect()
     }
 
+    /// Views of the ceiling (which the scene's poses, looking down, barely
+    /// see, yet which reflects most of the lamps' light into the room): from
+    /// each pose position, the pose's azimuth at `elevation_deg` above the horizon.
+    pub fn ceiling_cameras(
+        &self,
+        elevation_deg: f64,
+        vfov_deg: f64,
+        width: usize,
+        height: usize,
+    ) -> Vec<(String, ViewCamera)> {
+        self.loaded
+            .description
+            .poses
+            .iter()
+            .map(|p| {
+                let up = campanile_config::scene::CameraPose {
+                    elevation_deg,
+                    ..p.clone()
+                };
+                (format!("{}-up", p.name), pose_camera(&up, vfov_deg, width, height))
+            })
+            .collect()
+    }
+
     /// The lamps as the solver takes them (true positions, radii, intensities).
     pub fn igi_lights(&self) -> Vec<IgiLight> {
         self.lamps
@@ -323,6 +347,9 @@ impl RoomIgi {
     }
 }
 
+/// Elevation of the ceiling views, degrees.
+pub const CEILING_ELEVATION_DEG: f64 = 35.0;
+
 /// What [`RoomIgi::write_scene_file`] photographs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SceneFileShot {
@@ -371,8 +398,8 @@ fn write_exr(image: &RadianceImage, path: &Path) -> Result<(), WorldError> {
 impl RoomIgi {
     /// Photographs the room and writes a `campanile igi` scene file
     /// (`dir/scene.ron`, the OBJ beside it, EXR images under `dir/images`):
-    /// every lamp on, seen from the scene's poses and from the highlight
-    /// views; each lamp given by three HDR images of its bulb (lit alone),
+    /// every lamp on, seen from the scene's poses, the highlight views and
+    /// the ceiling views; each lamp given by three HDR images of its bulb (lit alone),
     /// from the first three pose positions, to be triangulated. Returns the
     /// scene file's path.
     pub fn write_scene_file(&self, dir: &Path, shot: &SceneFileShot) -> Result<std::path::PathBuf, WorldError> {
@@ -388,6 +415,12 @@ impl RoomIgi {
         std::fs::copy(&obj_src, &obj).map_err(|e| io(&obj_src, e))?;
         let mut cams = self.cameras(shot.wide_vfov_deg, shot.wide_px.0, shot.wide_px.1);
         cams.extend(self.highlight_cameras(shot.highlight.0, shot.highlight.1));
+        cams.extend(self.ceiling_cameras(
+            CEILING_ELEVATION_DEG,
+            shot.wide_vfov_deg,
+            shot.wide_px.0,
+            shot.wide_px.1,
+        ));
         let mut text = String::from(
             "// Written by the simulator: the room with every lamp on.\nIgiScene(\n    geometry: \"room.obj\",\n    surfaces: [\n",
         );
