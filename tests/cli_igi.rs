@@ -110,8 +110,8 @@ fn igi_recovers_the_simulated_room_from_its_scene_file_and_relights_it() {
     let (a, b) = (block_average(&relit, 4), block_average(&sim, 4));
     let rmse = relative_rmse(&a, &b, |i| b.data[i * 3] < 20.0).unwrap();
     eprintln!("relit against the simulator: {:.2} % (4x4 blocks)", 100.0 * rmse);
-    // Measured 11.9 %; the goal of 3 % is not met yet (README).
-    assert!(rmse < 0.2, "{rmse}");
+    // Measured 7.1 %; the goal of 3 % is not met yet (README).
+    assert!(rmse < 0.12, "{rmse}");
 
     // `campanile render --igi` writes the same relit image.
     let rendered = dir.path().join("render");
