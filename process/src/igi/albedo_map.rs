@@ -49,6 +49,12 @@ pub struct AlbedoMapOptions {
     pub border_px: f64,
     /// Seed of the gathering.
     pub seed: u64,
+    /// Divide by the indirect irradiance too (false: the lamps' light only,
+    /// which leaves the colour bleeding in; a baseline for comparison).
+    pub indirect: bool,
+    /// Remove the recovered specular reflection, weight by diffuse share
+    /// and drop the brightest sample (false: leaves highlights in; a baseline).
+    pub remove_specular: bool,
 }
 
 impl Default for AlbedoMapOptions {
@@ -60,6 +66,8 @@ impl Default for AlbedoMapOptions {
             max_bounces: 4,
             border_px: 8.0,
             seed: 3,
+            indirect: true,
+            remove_specular: true,
         }
     }
 }
@@ -197,7 +205,9 @@ impl AlbedoMap {
         let points = point_lights(&input.lights);
         let cameras: Vec<Vector3<f64>> = input.views.iter().map(|v| v.camera.position).collect();
         let sides = seen_sides(&scene, &cameras);
-        let indirect = IndirectField::gather(&scene, &points, &sides, options);
+        let indirect = options
+            .indirect
+            .then(|| IndirectField::gather(&scene, &points, &sides, options));
         let fallback: Vec<[f64; 3]> = (0..input.surfaces.len())
             .map(|s| scene.materials()[s].albedo.mean_albedo())
             .collect();
@@ -247,8 +257,14 @@ impl AlbedoMap {
                             continue;
                         }
                         let radiance = [0, 1, 2].map(|c| f64::from(view.image.radiance(x, y, c)));
-                        let (e_direct, specular) = direct(&scene, &points, tri, &hit.point, normal, &wo);
-                        let e_ind = indirect.at(hit.triangle, tri, &hit.point, sides[hit.triangle].dot(&normal) > 0.0);
+                        let (e_direct, mut specular) = direct(&scene, &points, tri, &hit.point, normal, &wo);
+                        if !options.remove_specular {
+                            specular = [0.0; 3];
+                        }
+                        let e_ind = match &indirect {
+                            Some(f) => f.at(hit.triangle, tri, &hit.point, sides[hit.triangle].dot(&normal) > 0.0),
+                            None => [0.0; 3],
+                        };
                         let e: [f64; 3] = [0, 1, 2].map(|c| e_direct[c] + e_ind[c]);
                         if e.iter().any(|v| *v <= 1e-12) {
                             continue;
@@ -300,7 +316,7 @@ impl AlbedoMap {
                 let texel = samples[k].texel;
                 let end = k + samples[k..].iter().take_while(|s| s.texel == texel).count();
                 // Sorted brightest first: drop it when three or more remain.
-                let start = if end - k >= 3 {
+                let start = if end - k >= 3 && options.remove_specular {
                     dropped += 1;
                     k + 1
                 } else {
