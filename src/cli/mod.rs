@@ -6,6 +6,7 @@ mod demo;
 mod devices;
 mod env;
 mod hdr;
+mod igi;
 mod logging;
 mod plan;
 mod process;
@@ -74,6 +75,8 @@ pub enum Command {
         #[command(subcommand)]
         action: sky::SkyCommand,
     },
+    /// Inverse global illumination indoors: Ward BRDFs and albedo maps from a scene file (SCENE.ron).
+    Igi(igi::IgiArgs),
     /// Run a plan on a station into a session directory, or resume one.
     Capture(capture::CaptureArgs),
     /// Process a captured session: response, HDR, sun, sky and environment, with a summary.
@@ -126,6 +129,7 @@ pub fn run() -> ExitCode {
         Command::Process(args) => report(process::run(args)),
         Command::Devices(args) => devices::run(args),
         Command::Render(args) => report(render::run(args)),
+        Command::Igi(args) => report(igi::run(args)),
     };
     ExitCode::from(code)
 }

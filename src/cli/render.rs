@@ -44,21 +44,40 @@ const OVERCAST_ZENITH: [f64; 3] = [30.0, 32.0, 36.0];
 ///            --station examples/sim-station.ron --materials out/materials.ron \
 ///            --pose view-se --time 2026-08-29T20:30:00Z --out renders/
 ///          campanile render ... --sequence 2026-08-29 --step-min 60 --out day/
+///
+/// Indoors (room mode): --igi SCENE.ron --lights LIGHTS.ron recovers the
+/// scene file's materials and albedo maps (as `campanile igi`) and renders
+/// the room under the new lights from each camera with an image (or
+/// --camera NAME), writing relit-CAMERA.exr.
+///
+/// Example: campanile render --igi room/scene.ron --lights new-lights.ron --out relit/
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct RenderArgs {
     /// Scene description (RON) with its geometry.
-    #[arg(long)]
-    scene: PathBuf,
+    #[arg(long, required_unless_present = "igi")]
+    scene: Option<PathBuf>,
     /// Station description (RON): the site and the camera.
-    #[arg(long)]
-    station: PathBuf,
+    #[arg(long, required_unless_present = "igi")]
+    station: Option<PathBuf>,
     /// Materials file (RON) from the reflectance recovery.
-    #[arg(long)]
-    materials: PathBuf,
+    #[arg(long, required_unless_present = "igi")]
+    materials: Option<PathBuf>,
     /// Camera pose named in the scene.
-    #[arg(long)]
-    pose: String,
+    #[arg(long, required_unless_present = "igi")]
+    pose: Option<String>,
+    /// Room mode: an indoor scene file (RON, see `campanile igi`) whose recovered materials are relit.
+    #[arg(long, requires = "lights", conflicts_with_all = ["scene", "station", "materials", "pose", "time", "sequence"])]
+    igi: Option<PathBuf>,
+    /// Room mode: the new lights (a RON list of Known(...) lights).
+    #[arg(long, requires = "igi")]
+    lights: Option<PathBuf>,
+    /// Room mode: render only this camera of the scene file.
+    #[arg(long, requires = "igi")]
+    camera: Option<String>,
+    /// Room mode: the faster, coarser recovery.
+    #[arg(long, requires = "igi")]
+    quick: bool,
     /// UTC time to render (RFC 3339).
     #[arg(long, conflicts_with = "sequence")]
     time: Option<DateTime<Utc>>,
@@ -103,7 +122,37 @@ fn write_exr(image: &RadianceImage, path: &Path) -> Result<()> {
     write_radiance_exr(&map, path).with_context(|| format!("writing {}", path.display()))
 }
 
+/// Room mode: the scene file's recovered materials under new lights.
+fn run_room(args: &RenderArgs, scene: &Path, lights: &Path) -> Result<()> {
+    let lights: Vec<campanile_process::igi::IgiLight> = campanile_process::igi::scene_file::load_lights(lights)
+        .map_err(|e| anyhow::anyhow!("{e}"))?
+        .into_iter()
+        .map(|(_, l)| l)
+        .collect();
+    let r = super::igi::recover_scene(scene, args.quick).with_context(|| format!("reading {}", scene.display()))?;
+    let cameras = match &args.camera {
+        Some(c) => vec![c.clone()],
+        None => r.image_cameras(),
+    };
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    for cam in cameras {
+        let img = r.relight(&lights, &cam, args.quick)?;
+        let path = args.out.join(format!("relit-{cam}.exr"));
+        write_exr(&img, &path)?;
+        println!("relit {}", path.display());
+    }
+    Ok(())
+}
+
 pub fn run(args: RenderArgs) -> Result<()> {
+    if let (Some(scene), Some(lights)) = (&args.igi, &args.lights) {
+        return run_room(&args, scene, lights);
+    }
+    let (Some(station_path), Some(scene_path), Some(materials_path), Some(pose_name)) =
+        (&args.station, &args.scene, &args.materials, &args.pose)
+    else {
+        bail!("give --scene, --station, --materials and --pose (or --igi and --lights for the room)");
+    };
     if !(0.0..=1.0).contains(&args.overcast) {
         bail!("--overcast {} must be a fraction in [0, 1]", args.overcast);
     }
@@ -117,20 +166,20 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if !(args.step_min.is_finite() && args.step_min >= 1.0) {
         bail!("--step-min {} must be at least 1 minute", args.step_min);
     }
-    let station = campanile_config::document::load_station(&args.station)
+    let station = campanile_config::document::load_station(station_path)
         .map_err(|e| anyhow::anyhow!("{e}"))
-        .with_context(|| format!("reading {}", args.station.display()))?
+        .with_context(|| format!("reading {}", station_path.display()))?
         .value;
-    let loaded = load_scene(&args.scene).with_context(|| format!("reading {}", args.scene.display()))?;
+    let loaded = load_scene(scene_path).with_context(|| format!("reading {}", scene_path.display()))?;
     let scene = &loaded.scene;
     let refl =
-        read_materials(scene, &args.materials).with_context(|| format!("reading {}", args.materials.display()))?;
-    let pose = loaded.description.pose(&args.pose).with_context(|| {
+        read_materials(scene, materials_path).with_context(|| format!("reading {}", materials_path.display()))?;
+    let pose = loaded.description.pose(pose_name).with_context(|| {
         let names: Vec<&str> = loaded.description.poses.iter().map(|p| p.name.as_str()).collect();
         format!(
             "--pose {:?} is not in {}: it has {names:?}",
-            args.pose,
-            args.scene.display()
+            pose_name,
+            scene_path.display()
         )
     })?;
     let (pan, tilt) = station

@@ -21,15 +21,20 @@
 // Colour channels are indexed 0..3 alike across several arrays at once.
 #![allow(clippy::needless_range_loop)]
 
+pub mod albedo_map;
 pub mod camera;
 mod delta_s;
 mod error;
 mod geometry;
 pub mod highlight;
 pub mod input;
+pub mod light_triangulation;
 mod observation;
 mod radiosity;
 mod recover;
+pub mod relight;
+pub mod relit_scene;
+pub mod scene_file;
 mod specular_albedo;
 pub mod table;
 mod ward_fit;

@@ -9,6 +9,7 @@
 pub mod cube_room;
 pub mod igi_photograph;
 pub mod rig;
+pub mod room_igi;
 pub mod scene_file;
 pub mod truth;
 

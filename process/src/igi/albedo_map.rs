@@ -1,0 +1,575 @@
+//! Diffuse albedo maps (thesis §4.6): each surface point's ρd from every
+//! view that sees it, once the recovered specular light is removed and the
+//! light it receives (direct from the lamps, and indirect, gathered
+//! through the recovered scene) is divided out:
+//!
+//! ρd(x) = π (L(x) − S(x)) / (E_direct(x) + E_indirect(x)),
+//!
+//! where S is the recovered lobe's reflection of the lamps. Dividing by the
+//! full irradiance removes colour bleeding (the indirect light's colour);
+//! removing S and down-weighting samples whose radiance is mostly specular
+//! removes highlights. Views are combined per texel with the weight
+//!
+//! w = cos θ_view · (diffuse share)² · border weight,
+//!
+//! and where a texel has three or more samples the brightest is dropped
+//! (§4.6: "the brightest sample ... is likely to contain a highlight").
+//!
+//! The map is a grid of square texels per triangle over its planar texture
+//! coordinates (metres); a texel no view saw takes the mean of its seen
+//! neighbours within [`FILL_RADIUS`] texels, else its surface's recovered ρd.
+
+use nalgebra::Vector3;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+
+use super::error::IgiError;
+use super::input::IgiInput;
+use super::recover::IgiResult;
+use super::relit_scene::{point_lights, recovered_scene, seen_sides};
+use crate::render::surface_bsdf::SurfaceBsdf;
+use crate::render::{Lighting, Material, PointLight, Ray, Scene, Texture, Triangle, trace};
+
+/// Texels searched around an unseen texel for seen ones.
+pub const FILL_RADIUS: i64 = 3;
+
+/// The albedo map's knobs (speed against error).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AlbedoMapOptions {
+    /// Texel side, metres.
+    pub texel_m: f64,
+    /// Side of the cells over which the indirect irradiance is gathered, metres.
+    pub irradiance_cell_m: f64,
+    /// Cosine-distributed rays per irradiance cell.
+    pub irradiance_rays: u32,
+    /// Scattering events per gathered path.
+    pub max_bounces: u32,
+    /// Pixels from the image border over which the border weight rises from 0 to 1.
+    pub border_px: f64,
+    /// Seed of the gathering.
+    pub seed: u64,
+    /// Divide by the indirect irradiance too (false: the lamps' light only,
+    /// which leaves the colour bleeding in; a baseline for comparison).
+    pub indirect: bool,
+    /// Remove the recovered specular reflection, weight by diffuse share
+    /// and drop the brightest sample (false: leaves highlights in; a baseline).
+    pub remove_specular: bool,
+}
+
+impl Default for AlbedoMapOptions {
+    fn default() -> Self {
+        AlbedoMapOptions {
+            texel_m: 0.02,
+            irradiance_cell_m: 0.25,
+            irradiance_rays: 128,
+            max_bounces: 4,
+            border_px: 8.0,
+            seed: 3,
+            indirect: true,
+            remove_specular: true,
+        }
+    }
+}
+
+impl AlbedoMapOptions {
+    fn validate(&self) -> Result<(), IgiError> {
+        let err = |name, value: f64, expected| {
+            Err(IgiError::Option {
+                name,
+                value: value.to_string(),
+                expected,
+            })
+        };
+        if !(self.texel_m > 0.0 && self.texel_m.is_finite()) {
+            return err("texel_m", self.texel_m, "a finite size > 0 m");
+        }
+        if !(self.irradiance_cell_m > 0.0 && self.irradiance_cell_m.is_finite()) {
+            return err("irradiance_cell_m", self.irradiance_cell_m, "a finite size > 0 m");
+        }
+        if self.irradiance_rays == 0 {
+            return err("irradiance_rays", 0.0, "at least 1");
+        }
+        if !(self.border_px >= 0.0 && self.border_px.is_finite()) {
+            return err("border_px", self.border_px, "a finite width >= 0 px");
+        }
+        Ok(())
+    }
+}
+
+/// One triangle's texels.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TriangleTexels {
+    /// Texture coordinates of the grid's corner, metres.
+    pub origin: [f64; 2],
+    /// Texels along s and t.
+    pub size: [usize; 2],
+    /// Albedo per texel (row-major, t rows), only meaningful where `weight > 0`.
+    pub albedo: Vec<[f32; 3]>,
+    /// Sum of sample weights per texel (0: unseen).
+    pub weight: Vec<f32>,
+}
+
+/// The albedo map of every triangle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AlbedoMap {
+    /// Texel side, metres.
+    pub texel_m: f64,
+    /// Per triangle, in the input's order.
+    pub triangles: Vec<TriangleTexels>,
+    /// Per surface, the recovered ρd (for texels nobody saw).
+    pub fallback: Vec<[f64; 3]>,
+    /// Samples used, and samples dropped as the brightest of their texel.
+    pub samples: (usize, usize),
+}
+
+/// One view's sample on a texel.
+#[derive(Debug, Clone, Copy)]
+struct Sample {
+    texel: usize,
+    albedo: [f64; 3],
+    brightness: f64,
+    weight: f64,
+}
+
+impl TriangleTexels {
+    fn new(tri: &Triangle, texel_m: f64) -> TriangleTexels {
+        let st: Vec<[f64; 2]> = tri.vertices.iter().map(|v| tri.texture_coordinates(v)).collect();
+        let lo = [0, 1].map(|k| st.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min));
+        let hi = [0, 1].map(|k| st.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max));
+        let size = [0, 1].map(|k| (((hi[k] - lo[k]) / texel_m).ceil() as usize).clamp(1, 4096));
+        TriangleTexels {
+            origin: lo,
+            size,
+            albedo: vec![[0.0; 3]; size[0] * size[1]],
+            weight: vec![0.0; size[0] * size[1]],
+        }
+    }
+
+    fn texel(&self, st: [f64; 2], texel_m: f64) -> (i64, i64) {
+        (
+            ((st[0] - self.origin[0]) / texel_m).floor() as i64,
+            ((st[1] - self.origin[1]) / texel_m).floor() as i64,
+        )
+    }
+
+    fn index(&self, i: i64, j: i64) -> Option<usize> {
+        let (i, j) = (i.clamp(0, self.size[0] as i64 - 1), j.clamp(0, self.size[1] as i64 - 1));
+        Some(j as usize * self.size[0] + i as usize)
+    }
+}
+
+impl AlbedoMap {
+    /// The albedo at point `p` of triangle `triangle` (module doc: unseen
+    /// texels are filled from neighbours, then from the surface's ρd).
+    pub fn albedo_at(&self, triangle: usize, surface: usize, tri: &Triangle, p: &Vector3<f64>) -> [f64; 3] {
+        let fallback = self.fallback.get(surface).copied().unwrap_or([0.5; 3]);
+        let Some(t) = self.triangles.get(triangle) else {
+            return fallback;
+        };
+        let (i, j) = t.texel(tri.texture_coordinates(p), self.texel_m);
+        for r in 0..=FILL_RADIUS {
+            let (mut sum, mut w) = ([0.0; 3], 0.0);
+            for dj in -r..=r {
+                for di in -r..=r {
+                    if di.abs().max(dj.abs()) != r {
+                        continue;
+                    }
+                    let (a, b) = (i + di, j + dj);
+                    if a < 0 || b < 0 || a >= t.size[0] as i64 || b >= t.size[1] as i64 {
+                        continue;
+                    }
+                    if let Some(k) = t.index(a, b)
+                        && t.weight[k] > 0.0
+                    {
+                        for c in 0..3 {
+                            sum[c] += f64::from(t.albedo[k][c]);
+                        }
+                        w += 1.0;
+                    }
+                }
+            }
+            if w > 0.0 {
+                return sum.map(|v| v / w);
+            }
+        }
+        fallback
+    }
+
+    /// Builds the map from `input`'s views and `result`'s materials
+    /// (module doc).
+    pub fn build(input: &IgiInput, result: &IgiResult, options: &AlbedoMapOptions) -> Result<AlbedoMap, IgiError> {
+        options.validate()?;
+        input.validate()?;
+        let scene = recovered_scene(input, result)?;
+        let points = point_lights(&input.lights);
+        let cameras: Vec<Vector3<f64>> = input.views.iter().map(|v| v.camera.position).collect();
+        let sides = seen_sides(&scene, &cameras);
+        let indirect = options
+            .indirect
+            .then(|| IndirectField::gather(&scene, &points, &sides, options));
+        let fallback: Vec<[f64; 3]> = (0..input.surfaces.len())
+            .map(|s| scene.materials()[s].albedo.mean_albedo())
+            .collect();
+        let mut triangles: Vec<TriangleTexels> = scene
+            .triangles()
+            .iter()
+            .map(|t| TriangleTexels::new(t, options.texel_m))
+            .collect();
+        // Samples per triangle.
+        let mut per_triangle: Vec<Vec<Sample>> = vec![Vec::new(); triangles.len()];
+        let grids = &triangles;
+        for view in &input.views {
+            let cam = &view.camera;
+            let (w, h) = (cam.width, cam.height);
+            let rows: Vec<Vec<(usize, Sample)>> = (0..h)
+                .into_par_iter()
+                .map(|y| {
+                    let mut out = Vec::new();
+                    for x in 0..w {
+                        if view.mask.as_ref().is_some_and(|m| !m[y * w + x]) {
+                            continue;
+                        }
+                        let d = cam.direction(x as f64 + 0.5, y as f64 + 0.5);
+                        let ray = Ray {
+                            origin: cam.position,
+                            direction: d,
+                        };
+                        let Some(hit) = scene.intersect(&ray, f64::INFINITY) else {
+                            continue;
+                        };
+                        if input
+                            .lights
+                            .iter()
+                            .any(|l| l.radius > 0.0 && sphere_hit(&l.position, l.radius, &ray, hit.t))
+                        {
+                            continue;
+                        }
+                        let tri = &scene.triangles()[hit.triangle];
+                        let wo = -d;
+                        let normal = if tri.normal.dot(&wo) >= 0.0 {
+                            tri.normal
+                        } else {
+                            -tri.normal
+                        };
+                        let cos_view = normal.dot(&wo);
+                        if cos_view <= 0.05 {
+                            continue;
+                        }
+                        let radiance = [0, 1, 2].map(|c| f64::from(view.image.radiance(x, y, c)));
+                        let (e_direct, mut specular) = direct(&scene, &points, tri, &hit.point, normal, &wo);
+                        if !options.remove_specular {
+                            specular = [0.0; 3];
+                        }
+                        let e_ind = match &indirect {
+                            Some(f) => f.at(hit.triangle, tri, &hit.point, sides[hit.triangle].dot(&normal) > 0.0),
+                            None => [0.0; 3],
+                        };
+                        let e: [f64; 3] = [0, 1, 2].map(|c| e_direct[c] + e_ind[c]);
+                        if e.iter().any(|v| *v <= 1e-12) {
+                            continue;
+                        }
+                        let diffuse: [f64; 3] = [0, 1, 2].map(|c| (radiance[c] - specular[c]).max(0.0));
+                        let (lm, dm) = (radiance.iter().sum::<f64>(), diffuse.iter().sum::<f64>());
+                        let share = if lm > 0.0 { (dm / lm).clamp(0.0, 1.0) } else { 1.0 };
+                        let edge = (x as f64 + 0.5)
+                            .min(w as f64 - x as f64 - 0.5)
+                            .min(y as f64 + 0.5)
+                            .min(h as f64 - y as f64 - 0.5);
+                        let border = if options.border_px > 0.0 {
+                            (edge / options.border_px).clamp(0.0, 1.0)
+                        } else {
+                            1.0
+                        };
+                        let weight = cos_view * share * share * border;
+                        if weight <= 0.0 {
+                            continue;
+                        }
+                        let grid = &grids[hit.triangle];
+                        let (i, j) = grid.texel(tri.texture_coordinates(&hit.point), options.texel_m);
+                        let Some(texel) = grid.index(i, j) else {
+                            continue;
+                        };
+                        out.push((
+                            hit.triangle,
+                            Sample {
+                                texel,
+                                albedo: [0, 1, 2].map(|c| std::f64::consts::PI * diffuse[c] / e[c]),
+                                brightness: lm,
+                                weight,
+                            },
+                        ));
+                    }
+                    out
+                })
+                .collect();
+            for (t, s) in rows.into_iter().flatten() {
+                per_triangle[t].push(s);
+            }
+        }
+        let mut used = 0usize;
+        let mut dropped = 0usize;
+        for (grid, samples) in triangles.iter_mut().zip(per_triangle.iter_mut()) {
+            samples.sort_by(|a, b| a.texel.cmp(&b.texel).then(b.brightness.total_cmp(&a.brightness)));
+            let mut k = 0;
+            while k < samples.len() {
+                let texel = samples[k].texel;
+                let end = k + samples[k..].iter().take_while(|s| s.texel == texel).count();
+                // Sorted brightest first: drop it when three or more remain.
+                let start = if end - k >= 3 && options.remove_specular {
+                    dropped += 1;
+                    k + 1
+                } else {
+                    k
+                };
+                let (mut sum, mut w) = ([0.0; 3], 0.0);
+                for s in &samples[start..end] {
+                    for c in 0..3 {
+                        sum[c] += s.weight * s.albedo[c];
+                    }
+                    w += s.weight;
+                }
+                used += end - start;
+                if w > 0.0 {
+                    grid.albedo[texel] = sum.map(|v| (v / w) as f32);
+                    grid.weight[texel] = w as f32;
+                }
+                k = end;
+            }
+        }
+        Ok(AlbedoMap {
+            texel_m: options.texel_m,
+            triangles,
+            fallback,
+            samples: (used, dropped),
+        })
+    }
+}
+
+/// Whether `ray` meets the sphere before distance `limit`.
+pub(crate) fn sphere_hit(centre: &Vector3<f64>, radius: f64, ray: &Ray, limit: f64) -> bool {
+    let oc = ray.origin - centre;
+    let b = oc.dot(&ray.direction);
+    let c = oc.norm_squared() - radius * radius;
+    let disc = b * b - c;
+    if disc < 0.0 {
+        return false;
+    }
+    let t = -b - disc.sqrt();
+    t > 0.0 && t < limit
+}
+
+/// The lamps' irradiance at `p` (shadow-tested) and the recovered lobe's
+/// reflection of them toward `wo`.
+fn direct(
+    scene: &Scene,
+    points: &[PointLight],
+    tri: &Triangle,
+    p: &Vector3<f64>,
+    normal: Vector3<f64>,
+    wo: &Vector3<f64>,
+) -> ([f64; 3], [f64; 3]) {
+    let material = &scene.materials()[tri.material as usize];
+    let lobe_only = Material {
+        name: String::new(),
+        albedo: Texture::Constant([0.0; 3]),
+        specular: material.specular,
+        emission: [0.0; 3],
+    };
+    let bsdf = SurfaceBsdf::at(&lobe_only, tri, p, normal);
+    let origin = p + normal * 1e-6 * (1.0 + p.norm());
+    let (mut e, mut s) = ([0.0; 3], [0.0; 3]);
+    for l in points {
+        let to = l.position - origin;
+        let d2 = to.norm_squared();
+        let wi = to / d2.sqrt();
+        let cos = wi.dot(&normal);
+        if cos <= 0.0 || scene.occluded(&Ray { origin, direction: wi }, d2.sqrt()) {
+            continue;
+        }
+        let f = if material.specular.is_some() {
+            bsdf.eval(&wi, wo)
+        } else {
+            [0.0; 3]
+        };
+        for c in 0..3 {
+            let ei = l.intensity[c] * cos / d2;
+            e[c] += ei;
+            s[c] += f[c] * ei;
+        }
+    }
+    (e, s)
+}
+
+/// Indirect irradiance gathered on a coarse grid of cells per triangle
+/// (barycentric `n × n` over the triangle, `n` from the cell size), on the
+/// side the cameras see.
+struct IndirectField {
+    /// Per triangle: cells per edge and the cells' irradiance.
+    cells: Vec<(usize, Vec<[f64; 3]>)>,
+}
+
+impl IndirectField {
+    fn gather(
+        scene: &Scene,
+        points: &[PointLight],
+        sides: &[Vector3<f64>],
+        options: &AlbedoMapOptions,
+    ) -> IndirectField {
+        let lighting = Lighting {
+            sky: None,
+            points,
+            spheres: &[],
+        };
+        let cells = scene
+            .triangles()
+            .par_iter()
+            .zip(sides.par_iter())
+            .enumerate()
+            .map(|(ti, (tri, side))| {
+                let longest = (0..3)
+                    .map(|k| (tri.vertices[(k + 1) % 3] - tri.vertices[k]).norm())
+                    .fold(0.0, f64::max);
+                let n = ((longest / options.irradiance_cell_m).ceil() as usize).clamp(1, 64);
+                let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+                rng.set_stream(ti as u64);
+                let values = (0..n * n)
+                    .map(|k| {
+                        let (i, j) = (k % n, k / n);
+                        let (mut u, mut v) = ((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
+                        if u + v > 1.0 {
+                            let s = 0.999 / (u + v);
+                            u *= s;
+                            v *= s;
+                        }
+                        let p = tri.point(u, v);
+                        irradiance(scene, &lighting, &p, side, options, &mut rng)
+                    })
+                    .collect();
+                (n, values)
+            })
+            .collect();
+        IndirectField { cells }
+    }
+
+    /// The indirect irradiance at `p` on triangle `t` (zero on the side no camera sees).
+    fn at(&self, t: usize, tri: &Triangle, p: &Vector3<f64>, seen_side: bool) -> [f64; 3] {
+        if !seen_side {
+            return [0.0; 3];
+        }
+        let (n, values) = &self.cells[t];
+        let (e1, e2, q) = (
+            tri.vertices[1] - tri.vertices[0],
+            tri.vertices[2] - tri.vertices[0],
+            p - tri.vertices[0],
+        );
+        let (d11, d12, d22) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
+        let (q1, q2) = (q.dot(&e1), q.dot(&e2));
+        let det = d11 * d22 - d12 * d12;
+        let u = (d22 * q1 - d12 * q2) / det;
+        let v = (d11 * q2 - d12 * q1) / det;
+        let cell = |x: f64| ((x * *n as f64).floor() as i64).clamp(0, *n as i64 - 1) as usize;
+        values[cell(v) * n + cell(u)]
+    }
+}
+
+/// Indirect irradiance at `p` facing `normal`: π times the mean radiance
+/// of cosine-distributed paths (direct light at their first hit counts,
+/// the lamps themselves do not).
+fn irradiance(
+    scene: &Scene,
+    lighting: &Lighting,
+    p: &Vector3<f64>,
+    normal: &Vector3<f64>,
+    options: &AlbedoMapOptions,
+    rng: &mut ChaCha8Rng,
+) -> [f64; 3] {
+    let (a, b) = tangents(normal);
+    let origin = p + normal * 1e-6 * (1.0 + p.norm());
+    let mut sum = [0.0; 3];
+    for _ in 0..options.irradiance_rays {
+        let (u1, u2): (f64, f64) = (rng.random(), rng.random());
+        let r = u1.sqrt();
+        let phi = std::f64::consts::TAU * u2;
+        let d = (a * (r * phi.cos()) + b * (r * phi.sin()) + normal * (1.0 - u1).max(0.0).sqrt()).normalize();
+        let l = trace(scene, lighting, Ray { origin, direction: d }, options.max_bounces, rng);
+        for c in 0..3 {
+            sum[c] += l[c];
+        }
+    }
+    sum.map(|v| std::f64::consts::PI * v / f64::from(options.irradiance_rays))
+}
+
+fn tangents(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let helper = if n.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+    let a = n.cross(&helper).normalize();
+    (a, n.cross(&a))
+}
+
+impl AlbedoMap {
+    /// The map of triangles `members` (of `triangles`, the solver's input)
+    /// as one image over their shared planar texture coordinates, when they
+    /// are coplanar (row 0 at the largest `t`; unseen texels filled as in
+    /// [`AlbedoMap::albedo_at`]); `None` when they are not coplanar, are
+    /// empty, or the image would exceed 4096 texels a side.
+    pub fn chart(&self, triangles: &[Triangle], members: &[usize]) -> Option<crate::camera::image::RadianceImage> {
+        let first = triangles.get(*members.first()?)?;
+        let (n, d) = (first.normal, first.normal.dot(&first.vertices[0]));
+        let coplanar = members.iter().all(|&i| {
+            triangles.get(i).is_some_and(|t| {
+                t.normal.dot(&n) > 1.0 - 1e-9 && t.vertices.iter().all(|v| (v.dot(&n) - d).abs() < 1e-6)
+            })
+        });
+        if !coplanar {
+            return None;
+        }
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for &i in members {
+            let t = &triangles[i];
+            for v in &t.vertices {
+                let st = t.texture_coordinates(v);
+                for k in 0..2 {
+                    lo[k] = lo[k].min(st[k]);
+                    hi[k] = hi[k].max(st[k]);
+                }
+            }
+        }
+        let w = ((hi[0] - lo[0]) / self.texel_m).ceil() as usize;
+        let h = ((hi[1] - lo[1]) / self.texel_m).ceil() as usize;
+        if w == 0 || h == 0 || w > 4096 || h > 4096 {
+            return None;
+        }
+        let mut data = vec![0f32; w * h * 3];
+        for y in 0..h {
+            for x in 0..w {
+                let st = [
+                    lo[0] + (x as f64 + 0.5) * self.texel_m,
+                    hi[1] - (y as f64 + 0.5) * self.texel_m,
+                ];
+                // The point in the plane with these coordinates: s and t
+                // axes are orthonormal in the face.
+                let t0 = &triangles[members[0]];
+                let p = t0.texture_axes[0] * st[0] + t0.texture_axes[1] * st[1] + n * d;
+                let inside = members.iter().find(|&&i| {
+                    let t = &triangles[i];
+                    let (a, b, c) = (t.vertices[0], t.vertices[1], t.vertices[2]);
+                    let s1 = (b - a).cross(&(p - a)).dot(&t.normal);
+                    let s2 = (c - b).cross(&(p - b)).dot(&t.normal);
+                    let s3 = (a - c).cross(&(p - c)).dot(&t.normal);
+                    s1 >= -1e-9 && s2 >= -1e-9 && s3 >= -1e-9
+                });
+                if let Some(&i) = inside {
+                    let a = self.albedo_at(i, triangles[i].surface as usize, &triangles[i], &p);
+                    for c in 0..3 {
+                        data[(y * w + x) * 3 + c] = a[c] as f32;
+                    }
+                }
+            }
+        }
+        Some(crate::camera::image::RadianceImage {
+            width: w,
+            height: h,
+            data,
+        })
+    }
+}

@@ -1,0 +1,276 @@
+//! The demo's room (thesis §4.7.2): the simulated room photographed with
+//! every lamp on (the scene's poses plus highlight views) and each lamp's
+//! bulb alone, written as a `campanile igi` scene file, recovered (lamps
+//! triangulated, Ward BRDFs, albedo maps), and relit under two lamps the
+//! capture never used, beside the simulator's render of the same lamps.
+//!
+//! Not yet from the capture controller: the frames are the simulator's
+//! radiance photographs, not a `campanile capture` session merged to HDR
+//! (README: status).
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{Result, anyhow};
+use campanile_process::igi::relight::relative_rmse;
+use campanile_process::igi::table::errors;
+use campanile_process::igi::{IgiLight, format_table};
+use campanile_process::render::SphereLight;
+use campanile_process::report::{Figure, Section, Table, false_colour_png, tonemapped_png};
+use campanile_sim::world::examples_dir;
+use campanile_sim::world::igi_photograph::PhotoSettings;
+use campanile_sim::world::room_igi::{RoomIgi, SceneFileShot, block_average};
+use nalgebra::Vector3;
+
+use crate::cli::igi::{recover_scene, write_albedo_maps, write_exr};
+
+/// The camera the room is relit from.
+pub const RELIT_CAMERA: &str = "wide-sw";
+
+/// What the room run measured.
+pub struct RoomRun {
+    /// The report section.
+    pub section: Section,
+    /// Relative RMSE of the relit image against the simulator's, over 4×4-pixel blocks.
+    pub relit_rmse: f64,
+    /// The same for the true materials through the same renderer (Monte Carlo noise floor).
+    pub noise_floor_rmse: f64,
+    /// Worst lamp position error from triangulation, millimetres.
+    pub triangulation_mm: f64,
+    /// Worst lamp intensity error from triangulation, relative.
+    pub intensity_relative: f64,
+    /// Seconds to photograph, to recover (lamps, BRDFs, albedo maps) and to relight.
+    pub photograph_s: f64,
+    /// See `photograph_s`.
+    pub recover_s: f64,
+    /// See `photograph_s`.
+    pub relight_s: f64,
+}
+
+/// The lamps of the relit image (not in the capture).
+pub fn new_lamps() -> [SphereLight; 2] {
+    [
+        SphereLight::with_intensity(Vector3::new(2.0, 2.2, 2.4), 0.05, [2.5, 2.4, 2.0]),
+        SphereLight::with_intensity(Vector3::new(3.6, 2.8, 2.0), 0.05, [1.4, 1.7, 2.3]),
+    ]
+}
+
+fn rel(got: f64, truth: f64) -> f64 {
+    if truth.abs() > 0.0 {
+        (got / truth - 1.0).abs()
+    } else {
+        got.abs()
+    }
+}
+
+/// Runs the room into `dir/room` (`quick`: smaller images, fewer rays).
+pub fn room(dir: &Path, quick: bool) -> Result<RoomRun> {
+    let out = dir.join("room");
+    let station = campanile_config::document::load_station(&examples_dir().join("sim-station.ron"))
+        .map_err(|e| anyhow!("{e}"))?
+        .value;
+    let world = RoomIgi::load(&examples_dir().join("room-scene.ron"), &station).map_err(|e| anyhow!("{e}"))?;
+    let shot = if quick {
+        SceneFileShot {
+            wide_px: (64, 48),
+            highlight: (20.0, 32),
+            bulb: (8.0, 48),
+            ..SceneFileShot::default()
+        }
+    } else {
+        SceneFileShot {
+            wide_px: (128, 96),
+            highlight: (20.0, 48),
+            ..SceneFileShot::default()
+        }
+    };
+    let t = Instant::now();
+    let scene_file = world.write_scene_file(&out, &shot).map_err(|e| anyhow!("{e}"))?;
+    let photograph_s = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let r = recover_scene(&scene_file, quick)?;
+    let recover_s = t.elapsed().as_secs_f64();
+    let truth = world.true_materials().map_err(|e| anyhow!("{e}"))?;
+    let truth_opt: Vec<_> = truth.iter().copied().map(Some).collect();
+    std::fs::write(out.join("materials.txt"), format_table(&r.result, &truth_opt, None))?;
+    write_albedo_maps(&r, &out.join("albedo"))?;
+
+    // Lamps.
+    let (mut worst_mm, mut worst_i) = (0.0f64, 0.0f64);
+    let mut lamp_rows = Vec::new();
+    for (name, t) in &r.loaded.triangulated {
+        if let Some((_, b)) = world.lamps.iter().find(|(n, _)| n == name) {
+            let mm = (t.light.position - b.center).norm() * 1e3;
+            let ti = b.radiance.map(|l| l * std::f64::consts::PI * b.radius * b.radius);
+            let di = (0..3).map(|c| rel(t.light.intensity[c], ti[c])).fold(0.0, f64::max);
+            worst_mm = worst_mm.max(mm);
+            worst_i = worst_i.max(di);
+            lamp_rows.push(vec![
+                name.clone(),
+                format!("{mm:.2} mm"),
+                format!("{:.4} / {:.4} m", b.radius, t.light.radius),
+                format!("{:.2} %", 100.0 * di),
+            ]);
+        }
+    }
+
+    // Materials beside the truth.
+    let mut table = Table {
+        caption: "The room's materials (thesis Table 4.1 format): true / recovered (error); channel R for ρd and ρs, as in the thesis's table".into(),
+        header: ["surface", "model (why)", "ρd", "ρs", "αx", "αy", "γ"].map(String::from).to_vec(),
+        rows: Vec::new(),
+    };
+    for (s, t) in r.result.surfaces.iter().zip(&truth) {
+        let Some(m) = s.material else { continue };
+        let e = errors(&m, t);
+        let lobe = m
+            .lobe
+            .map(|l| campanile_process::igi::table::nearest_representation(&l, t.lobe.map_or(0.0, |l| l.gamma_rad)));
+        let cell = |tv: Option<f64>, g: Option<f64>, e: Option<f64>, unit: &str| match (tv, g) {
+            (Some(tv), Some(g)) => format!("{tv:.3} / {g:.3} ({:.1}{unit})", e.unwrap_or(f64::NAN)),
+            (Some(tv), None) => format!("{tv:.3} / —"),
+            (None, Some(g)) => format!("— / {g:.3}"),
+            (None, None) => "—".into(),
+        };
+        table.rows.push(vec![
+            s.name.clone(),
+            format!("{:?} ({})", s.model, s.reason),
+            cell(Some(t.rho_d[0]), Some(m.rho_d[0]), e[0], "%"),
+            cell(
+                Some(t.lobe.map_or(0.0, |l| l.rho_s[0])),
+                Some(lobe.map_or(0.0, |l| l.rho_s[0])),
+                e[1],
+                "%",
+            ),
+            cell(t.lobe.map(|l| l.alpha_x), lobe.map(|l| l.alpha_x), e[2], "%"),
+            cell(t.lobe.map(|l| l.alpha_y), lobe.map(|l| l.alpha_y), e[3], "%"),
+            cell(
+                t.lobe.map(|l| l.gamma_rad.to_degrees()),
+                lobe.map(|l| l.gamma_rad.to_degrees()),
+                e[4],
+                "°",
+            ),
+        ]);
+    }
+
+    // Relit under new lamps, beside the simulator.
+    let bulbs = new_lamps();
+    let lights: Vec<IgiLight> = bulbs
+        .iter()
+        .map(|b| IgiLight {
+            position: b.center,
+            radius: b.radius,
+            intensity: b.radiance.map(|l| l * std::f64::consts::PI * b.radius * b.radius),
+        })
+        .collect();
+    let t = Instant::now();
+    let relit = r.relight(&lights, RELIT_CAMERA, quick)?;
+    let relight_s = t.elapsed().as_secs_f64();
+    let (_, camera) = r
+        .loaded
+        .cameras
+        .iter()
+        .find(|(n, _)| n == RELIT_CAMERA)
+        .ok_or_else(|| anyhow!("no camera {RELIT_CAMERA}"))?;
+    let samples = if quick { 16 } else { 32 };
+    let sim = world.photograph(
+        &bulbs,
+        &[],
+        camera,
+        &PhotoSettings {
+            indirect_samples: samples,
+            max_bounces: 4,
+            seed: 99,
+        },
+    );
+    let scene_true = world.scene();
+    let same = campanile_process::igi::relight::relight(
+        scene_true,
+        None,
+        &lights,
+        camera,
+        &campanile_process::igi::relight::RelightSettings {
+            indirect_samples: samples,
+            max_bounces: 4,
+            seed: 5,
+        },
+    );
+    write_exr(&relit, &out.join("relit.exr"))?;
+    write_exr(&sim, &out.join("simulator.exr"))?;
+    let (rb, sb, fb) = (
+        block_average(&relit, 4),
+        block_average(&sim, 4),
+        block_average(&same, 4),
+    );
+    let keep = |i: usize| sb.data[i * 3] < 20.0;
+    let relit_rmse = relative_rmse(&rb, &sb, keep).ok_or_else(|| anyhow!("the simulator's render is black"))?;
+    let noise_floor_rmse = relative_rmse(&fb, &sb, keep).ok_or_else(|| anyhow!("the simulator's render is black"))?;
+    let (w, h) = (sim.width, sim.height);
+    let mut sorted: Vec<f32> = sim.data.iter().copied().filter(|v| *v < 20.0).collect();
+    sorted.sort_by(f32::total_cmp);
+    let white = f64::from(sorted.get(sorted.len() * 99 / 100).copied().unwrap_or(1.0)).max(1e-6);
+    let err: Vec<f64> = (0..w * h)
+        .map(|i| {
+            let a: f64 = (0..3).map(|c| f64::from(relit.data[i * 3 + c])).sum();
+            let b: f64 = (0..3).map(|c| f64::from(sim.data[i * 3 + c])).sum();
+            if b > 0.0 && b < 60.0 { a / b - 1.0 } else { f64::NAN }
+        })
+        .collect();
+    let figures = vec![
+        Figure::Png {
+            bytes: tonemapped_png("relit", w, h, &relit.data, 1.0 / white)?,
+            caption: format!("Relit with the recovered materials ({RELIT_CAMERA}, two new lamps)"),
+        },
+        Figure::Png {
+            bytes: tonemapped_png("simulator", w, h, &sim.data, 1.0 / white)?,
+            caption: "The simulator's render of the same lamps (true materials)".into(),
+        },
+        Figure::Png {
+            bytes: false_colour_png("relit error", w, h, &err, (-0.3, 0.3))?,
+            caption: "Relit / simulator − 1 per pixel (blue −30 %, red +30 %)".into(),
+        },
+    ];
+    let section = Section {
+        title: "Indoor: the room relit (inverse global illumination, §4.7.2)".into(),
+        paragraphs: vec![
+            format!(
+                "The simulated room ({} surfaces sharing specular parameters) photographed with its three lamps on from {} views ({} wide at {}×{} px and highlight views), each lamp's bulb from three views. Lamps triangulated from their bulbs (§4.7.2): worst position error {worst_mm:.2} mm, intensity {:.2} %.",
+                r.loaded.input.surfaces.len(),
+                r.loaded.input.views.len(),
+                world.loaded.description.poses.len(),
+                shot.wide_px.0,
+                shot.wide_px.1,
+                100.0 * worst_i
+            ),
+            format!(
+                "Relit under two lamps the capture never used: relative RMSE {:.1} % over 4×4-pixel blocks (the issue's goal: 3 %); the true materials through the same renderer give {:.1} % (Monte Carlo noise floor). The metal sphere's faceted highlight falls in no view, so it is recovered as diffuse only, as the model choice says.",
+                100.0 * relit_rmse,
+                100.0 * noise_floor_rmse
+            ),
+            format!(
+                "Photographs {photograph_s:.1} s, recovery (lamps, BRDFs, albedo maps) {recover_s:.1} s, relighting {relight_s:.1} s. Not yet: the frames come from the simulator's radiance photographs, not from a captured session merged to HDR."
+            ),
+        ],
+        tables: vec![
+            table,
+            Table {
+                caption: "Lamps triangulated from HDR images of their bulbs: error against the simulator".into(),
+                header: ["lamp", "position error", "radius true / found", "intensity error"]
+                    .map(String::from)
+                    .to_vec(),
+                rows: lamp_rows,
+            },
+        ],
+        figures,
+    };
+    Ok(RoomRun {
+        section,
+        relit_rmse,
+        noise_floor_rmse,
+        triangulation_mm: worst_mm,
+        intensity_relative: worst_i,
+        photograph_s,
+        recover_s,
+        relight_s,
+    })
+}

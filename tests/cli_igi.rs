@@ -1,0 +1,165 @@
+//! `campanile igi SCENE.ron` and `campanile render --igi` on a scene file
+//! the simulator writes for its room: lamps triangulated from bulb images,
+//! the boards' lobes recovered, albedo maps written, the room relit under
+//! new lamps against the simulator's render; bad input refused by name.
+
+mod common;
+
+use campanile_process::exr_io::read_rgb_exr;
+use campanile_process::igi::relight::relative_rmse;
+use campanile_process::render::SphereLight;
+use campanile_sim::world::examples_dir;
+use campanile_sim::world::igi_photograph::PhotoSettings;
+use campanile_sim::world::room_igi::{RoomIgi, SceneFileShot, block_average};
+use common::campanile;
+use nalgebra::Vector3;
+
+#[test]
+fn igi_recovers_the_simulated_room_from_its_scene_file_and_relights_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let station = campanile_config::document::load_station(&examples_dir().join("sim-station.ron")).unwrap();
+    let room = RoomIgi::load(&examples_dir().join("room-scene.ron"), &station.value).unwrap();
+    let shot = SceneFileShot {
+        wide_px: (64, 48),
+        highlight: (20.0, 32),
+        bulb: (8.0, 48),
+        ..SceneFileShot::default()
+    };
+    let scene = room.write_scene_file(dir.path(), &shot).unwrap();
+    let lights = dir.path().join("new-lights.ron");
+    std::fs::write(
+        &lights,
+        "[\n  Known(name: \"a\", position_m: (2.0, 2.2, 2.4), radius_m: 0.05, intensity_w_sr: (2.5, 2.4, 2.0)),\n  Known(name: \"b\", position_m: (3.6, 2.8, 2.0), radius_m: 0.05, intensity_w_sr: (1.4, 1.7, 2.3)),\n]\n",
+    )
+    .unwrap();
+    let out = dir.path().join("igi");
+    let o = campanile(&[
+        "igi",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quick",
+        "--relight",
+        lights.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&o.stderr));
+    assert!(stdout.contains("rho_d") && stdout.contains("Anisotropic"), "{stdout}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    // The lamps, triangulated from their bulbs' images: within 2 mm and 5 %.
+    for (name, bulb) in &room.lamps {
+        let l = summary["lights"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|l| l["name"] == name.as_str())
+            .unwrap();
+        assert_eq!(l["triangulated"], true);
+        let p: Vec<f64> = l["position_m"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let mm = (Vector3::new(p[0], p[1], p[2]) - bulb.center).norm() * 1e3;
+        assert!(mm < 2.0, "{name}: {mm} mm");
+        let i = l["intensity_w_sr"][1].as_f64().unwrap();
+        let truth = bulb.radiance[1] * std::f64::consts::PI * bulb.radius * bulb.radius;
+        assert!((i / truth - 1.0).abs() < 0.05, "{name}: {i} vs {truth}");
+    }
+    // The brushed board: anisotropic, αx, αy and γ near (0.05, 0.30, 45°).
+    let brushed = summary["surfaces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["name"] == "brushed")
+        .unwrap();
+    assert_eq!(brushed["model"], "Anisotropic", "{brushed}");
+    let (ax, ay) = (
+        brushed["alpha_x"].as_f64().unwrap(),
+        brushed["alpha_y"].as_f64().unwrap(),
+    );
+    let (lo, hi) = (ax.min(ay), ax.max(ay));
+    assert!(
+        (lo / 0.05 - 1.0).abs() < 0.15 && (hi / 0.30 - 1.0).abs() < 0.1,
+        "{ax} {ay}"
+    );
+    // Albedo maps of the planar groups.
+    for g in ["floor", "wall-north", "poster-1", "board-1"] {
+        let img = read_rgb_exr(&out.join("albedo").join(format!("{g}.exr"))).unwrap();
+        assert!(img.width > 10 && img.height > 10, "{g}");
+    }
+    // Relit from the first wide view against the simulator's render of the same lamps.
+    let relit = read_rgb_exr(&out.join("relit-wide-sw.exr")).unwrap();
+    let camera = room.cameras(shot.wide_vfov_deg, 64, 48).swap_remove(0).1;
+    let bulbs = [
+        SphereLight::with_intensity(Vector3::new(2.0, 2.2, 2.4), 0.05, [2.5, 2.4, 2.0]),
+        SphereLight::with_intensity(Vector3::new(3.6, 2.8, 2.0), 0.05, [1.4, 1.7, 2.3]),
+    ];
+    let sim = room.photograph(
+        &bulbs,
+        &[],
+        &camera,
+        &PhotoSettings {
+            indirect_samples: 32,
+            max_bounces: 4,
+            seed: 99,
+        },
+    );
+    let (a, b) = (block_average(&relit, 4), block_average(&sim, 4));
+    let rmse = relative_rmse(&a, &b, |i| b.data[i * 3] < 20.0).unwrap();
+    eprintln!("relit against the simulator: {:.2} % (4x4 blocks)", 100.0 * rmse);
+    // Measured 7.1 %; the goal of 3 % is not met yet (README).
+    assert!(rmse < 0.12, "{rmse}");
+
+    // `campanile render --igi` writes the same relit image.
+    let rendered = dir.path().join("render");
+    let o = campanile(&[
+        "render",
+        "--igi",
+        scene.to_str().unwrap(),
+        "--lights",
+        lights.to_str().unwrap(),
+        "--camera",
+        "wide-sw",
+        "--quick",
+        "--out",
+        rendered.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let again = read_rgb_exr(&rendered.join("relit-wide-sw.exr")).unwrap();
+    assert_eq!(again.data, relit.data, "the same seeds give the same image");
+}
+
+#[test]
+fn igi_refuses_bad_scene_files_by_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("s.ron");
+    std::fs::write(
+        &scene,
+        "IgiScene(geometry: \"missing.obj\", cameras: [], lights: [], images: [])",
+    )
+    .unwrap();
+    let o = campanile(&[
+        "igi",
+        scene.to_str().unwrap(),
+        "--out",
+        dir.path().join("o").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("missing.obj") && e.contains("expected a Wavefront OBJ"),
+        "{e}"
+    );
+    std::fs::write(&scene, "IgiScene(\n geometry: 1,\n)").unwrap();
+    let o = campanile(&[
+        "igi",
+        scene.to_str().unwrap(),
+        "--out",
+        dir.path().join("o").to_str().unwrap(),
+    ]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && e.contains("s.ron: line 2"), "{e}");
+}
