@@ -501,6 +501,7 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
             }
             JournalEntry::Missed(_) if !store.completed(e.key()) => missed += 1,
             JournalEntry::Missed(_) => {}
+            JournalEntry::Pruned(_) | JournalEntry::Outage(_) => {}
             _ => extra += 1,
         }
     }
@@ -541,10 +542,7 @@ fn run_simulated<S: Storage>(
     let first = &inputs.timeline.occurrences[0];
     // The simulated calendar begins a minute before the first occurrence,
     // or, on resume, a second after the last journaled shot.
-    let last = store.entries().iter().map(|e| match e {
-        JournalEntry::Done(f) | JournalEntry::Late(f) => f.meta.time,
-        JournalEntry::Missed(m) => m.time,
-    });
+    let last = store.entries().iter().map(JournalEntry::time);
     let origin = match (resumed, last.max()) {
         (true, Some(t)) => t + TimeDelta::seconds(1),
         _ => first.start - TimeDelta::seconds(60),
