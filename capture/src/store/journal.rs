@@ -204,8 +204,13 @@ pub struct OutageEntry {
     pub device: String,
     /// Its first failed call, UTC.
     pub start: DateTime<Utc>,
-    /// Its first answer after coming back, UTC.
+    /// Its first answer after coming back, UTC; or, when `open`, when the
+    /// run stopped with the device still down.
     pub end: DateTime<Utc>,
+    /// The run stopped (or ended) while the device was still down: `end`
+    /// is the stop, not the device's return.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub open: bool,
 }
 
 /// One journal line.

@@ -510,19 +510,22 @@ impl<S: Storage> SessionStore<S> {
         Ok(entry)
     }
 
-    /// Record that `device` was down from `start` to `end`: one journal
-    /// line with status `outage`.
+    /// Record that `device` was down from `start` to `end` (`open`: still
+    /// down when the run stopped at `end`): one journal line with status
+    /// `outage`.
     pub fn record_outage(
         &mut self,
         device: &str,
         start: DateTime<Utc>,
         end: DateTime<Utc>,
+        open: bool,
     ) -> Result<JournalEntry, StoreError> {
         self.check_writable()?;
         let entry = JournalEntry::Outage(OutageEntry {
             device: device.to_string(),
             start,
             end,
+            open,
         });
         self.append(&entry, None)?;
         self.entries.push(entry.clone());
