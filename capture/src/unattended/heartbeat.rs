@@ -165,14 +165,16 @@ pub fn free_disk_bytes(path: &Path) -> Option<u64> {
 #[derive(Debug, Clone)]
 pub struct Beat {
     store: PathBuf,
+    devices: Vec<crate::controller::DeviceKind>,
     shared: Arc<Mutex<(Heartbeat, DeviceHealth)>>,
 }
 
 impl Beat {
-    /// Start beating into `store`.
-    pub fn new(store: &Path, first: Heartbeat) -> Self {
+    /// Start beating into `store`, listing `devices` (those the station has).
+    pub fn new(store: &Path, devices: &[crate::controller::DeviceKind], first: Heartbeat) -> Self {
         Self {
             store: store.to_path_buf(),
+            devices: devices.to_vec(),
             shared: Arc::new(Mutex::new((first, DeviceHealth::default()))),
         }
     }
@@ -187,6 +189,7 @@ impl Beat {
         beat.wall_utc = Utc::now();
         beat.devices = health
             .states()
+            .filter(|(k, _)| self.devices.contains(k))
             .map(|(k, s)| DeviceLine {
                 device: k.to_string(),
                 state: s.clone(),
@@ -257,7 +260,11 @@ mod tests {
     fn a_beat_round_trips_with_devices_and_free_disk() {
         let dir = tempfile::tempdir().unwrap();
         let t = Utc.with_ymd_and_hms(2026, 6, 22, 18, 0, 0).unwrap();
-        let beat = Beat::new(dir.path(), Heartbeat::starting(t, Some(2_000_000)));
+        let beat = Beat::new(
+            dir.path(),
+            &crate::unattended::outage::WATCHED,
+            Heartbeat::starting(t, Some(2_000_000)),
+        );
         beat.update(t, |b, h| {
             b.state = StationState::Waiting;
             b.frames_today = 12;

@@ -185,8 +185,11 @@ pub async fn run<R: Rig, C: Clock>(
     stop: &StopHandle,
     progress: &mut dyn Progress,
 ) -> Result<StationReport, StationFailure> {
+    let mut devices = vec![DeviceKind::Camera];
+    devices.extend(probed(inputs.station));
     let beat = Beat::new(
         root,
+        &devices,
         Heartbeat::starting(clock.now(), options.budget.map(|b| b.max_bytes)),
     );
     let mut station = Unattended {
