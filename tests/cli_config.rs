@@ -36,9 +36,9 @@ fn config_check_passes_on_every_example_and_summarizes_them() {
         "stdout:\n{stdout}\nstderr:\n{}",
         text(&out.stderr)
     );
-    assert_eq!(stdout.matches(": valid ").count(), 7, "{stdout}");
-    // The three plans were checked against both stations.
-    assert_eq!(stdout.matches("  runs on station").count(), 6, "{stdout}");
+    assert_eq!(stdout.matches(": valid ").count(), 10, "{stdout}");
+    // The four plans were checked against the three stations.
+    assert_eq!(stdout.matches("  runs on station").count(), 12, "{stdout}");
     assert!(stdout.contains("37.8721°N, 122.2578°W"), "{stdout}");
     assert!(stdout.contains("session \"held-out\" (held out)"), "{stdout}");
 }

@@ -382,8 +382,14 @@ async fn three_simulated_days_survive_a_stop_an_outage_and_a_budget() {
     assert!(beat.store_bytes <= BUDGET_BYTES);
     assert!(beat.free_disk_bytes.is_some_and(|b| b > 0));
     let devices: Vec<&str> = beat.devices.iter().map(|d| d.device.as_str()).collect();
-    assert_eq!(devices, ["camera", "head", "filter wheel"]);
-    assert!(beat.devices.iter().all(|d| matches!(d.state, DeviceState::Up { .. })));
+    assert_eq!(devices, ["camera", "head", "filter wheel", "lights"]);
+    assert!(
+        beat.devices[..3]
+            .iter()
+            .all(|d| matches!(d.state, DeviceState::Up { .. }))
+    );
+    // Sky scans never use the lamps, and lights have no harmless query.
+    assert_eq!(beat.devices[3].state, DeviceState::Unknown);
 
     exposures_do_not_flap(&i.timeline, &sessions);
 }

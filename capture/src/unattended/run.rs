@@ -466,6 +466,13 @@ impl<R: Rig, C: Clock> Unattended<'_, R, C> {
             if self.probe_due_at(kind) > now {
                 continue;
             }
+            // Lights have no harmless query: they are probed only when
+            // down (by reconnecting), else judged by their calls in scans.
+            if kind == DeviceKind::Lights && self.beat.health(|h| h.down_since(kind).is_none()) {
+                self.last_probe.retain(|(k, _)| *k != kind);
+                self.last_probe.push((kind, now));
+                continue;
+            }
             let result = self.probe(kind).await;
             let t = self.clock.now();
             self.last_probe.retain(|(k, _)| *k != kind);
