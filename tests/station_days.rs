@@ -394,6 +394,9 @@ async fn three_simulated_days_survive_a_stop_an_outage_and_a_budget() {
     exposures_do_not_flap(&i.timeline, &sessions);
 }
 
+/// A tile's scan: (scan number, log2 exposure, the model's log2 radiance).
+type ScanExposure = (u32, f64, f64);
+
 /// Per sky tile and day, the 0-stop frame's exposure from scan to scan:
 /// - steps of at most [`MAX_STEP_STOPS`];
 /// - no flapping: no three consecutive steps of more than 0.01 stop whose
@@ -404,8 +407,7 @@ async fn three_simulated_days_survive_a_stop_an_outage_and_a_budget() {
 ///   are the tile's median departing from the model at its centre (the sun
 ///   and aureole inside the zenith tile at noon), not flapping.
 fn exposures_do_not_flap(timeline: &Timeline, sessions: &BTreeMap<NaiveDate, SessionStore>) {
-    // target → [(scan number, log2 exposure, model log2 radiance)]
-    let mut series: HashMap<(NaiveDate, String), Vec<(u32, f64, f64)>> = HashMap::new();
+    let mut series: HashMap<(NaiveDate, String), Vec<ScanExposure>> = HashMap::new();
     for occ in timeline.occurrences.iter() {
         let d = unattended::day_rollover::plan_day(occ).unwrap();
         let n: u32 = occ.key.rsplit_once('#').unwrap().1.parse().unwrap();
