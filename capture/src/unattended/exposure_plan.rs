@@ -291,7 +291,7 @@ mod tests {
         // The measurement jumps 3 stops brighter (shorter) and stays there.
         let mut x = x0;
         let mut steps = Vec::new();
-        for n in 2..10 {
+        for n in 2..14 {
             let o = scan(n, 30.0);
             let t = format!("{}/s1/t0", o.key);
             let start = plan.metering_start(&o, &t).expect("a recent scan");
@@ -303,7 +303,8 @@ mod tests {
             steps.push((next / x).log2());
             x = next;
         }
-        // Bounded steps of at most 0.5 stop, all in one direction, converging on −3 stops.
+        // Bounded steps of at most 0.5 stop, all in one direction, halving the
+        // rest of the way once within a stop: −0.5 × 5, then −0.25, −0.125, … to −3 stops.
         for s in &steps {
             assert!(*s <= 1e-12 && *s >= -0.5 - 1e-12, "{steps:?}");
         }
