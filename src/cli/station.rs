@@ -23,15 +23,15 @@ use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
 
 #[derive(Debug, Subcommand)]
 pub enum StationCommand {
-    /// Run a plan unattended, day after day, into a store of day sessions.
+    // The variants take their help from their arguments' doc comments.
     Run(RunArgs),
-    /// Print a station's heartbeat (exit 1 when it is stale).
     Status(StatusArgs),
 }
 
-/// Run a plan unattended: its daily-repeating triggers (e.g. a sun triplet
-/// and a sky scan every 10 minutes while the sun is above 5°) for all its
-/// days, or until stopped.
+/// Run a plan unattended, day after day, until its days end or it is stopped.
+///
+/// The plan's daily-repeating triggers (e.g. a sun triplet and a sky scan
+/// every 10 minutes while the sun is above 5°) run for all its days.
 ///
 /// Each plan day (the site's mean solar day, centred on local mean noon)
 /// is one session directory, STORE/YYYY-MM-DD/. SIGTERM or SIGINT stops at
@@ -140,7 +140,7 @@ impl std::str::FromStr for StationOutageArg {
     }
 }
 
-/// Print the heartbeat of a station's store readably.
+/// Print a station's heartbeat (exit 1 when it is stale).
 ///
 /// Exit status: 0 when the heartbeat was written less than --max-age
 /// seconds ago (wall clock); 1 when it is older (stale: the station is not
