@@ -694,7 +694,7 @@ fn pruned_frames_are_gone_on_purpose_and_outages_are_journaled() {
 
     // A crash between the pruned line and the deletions: resume removes
     // the files as unjournaled frames.
-    let mut store = SessionStore::resume(&dir).unwrap().0;
+    let store = SessionStore::resume(&dir).unwrap().0;
     let kept = store.frame_path(store.frame_entry(&key(2)).unwrap());
     let line = JournalEntry::Pruned(PrunedEntry {
         time: t,
