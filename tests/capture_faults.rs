@@ -156,6 +156,9 @@ fn a_session_completes_through_link_faults_a_disconnect_and_camera_timeouts() {
             }
             JournalEntry::Done(f) => panic!("{} is not journaled late", f.key),
             JournalEntry::Missed(m) => missed.push((m.key.clone(), m.reason.clone())),
+            JournalEntry::Pruned(_) | JournalEntry::Outage(_) => {
+                panic!("nothing is pruned, no outage is journaled: {e:?}")
+            }
         }
     }
     println!("late frames {late}, missed {missed:?}");

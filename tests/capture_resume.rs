@@ -151,6 +151,9 @@ fn journal(dir: &Path) -> (Vec<(String, u32, u64)>, Vec<String>) {
         match e {
             JournalEntry::Done(f) | JournalEntry::Late(f) => frames.push((f.key.clone(), f.crc32c, f.sequence)),
             JournalEntry::Missed(m) => missed.push(m.key.clone()),
+            JournalEntry::Pruned(_) | JournalEntry::Outage(_) => {
+                panic!("a capture journals no pruning or outage: {e:?}")
+            }
         }
     }
     assert!(store.verify().unwrap().is_ok(), "{}", dir.display());

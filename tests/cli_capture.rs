@@ -55,7 +55,7 @@ fn frames(dir: &Path) -> Vec<(String, u32)> {
         .iter()
         .filter_map(|e| match e {
             JournalEntry::Done(f) | JournalEntry::Late(f) => Some((f.key.clone(), f.crc32c)),
-            JournalEntry::Missed(_) => None,
+            JournalEntry::Missed(_) | JournalEntry::Pruned(_) | JournalEntry::Outage(_) => None,
         })
         .collect()
 }

@@ -8,6 +8,7 @@
 //! - [`schedule`]: when sessions run and what shots they take, as a pure function of plan, site and time.
 //! - [`station`]: a real station's devices, built from its configuration, reconnecting with backoff.
 //! - [`store`]: the session directory: frames written atomically and an append-only journal.
+//! - [`unattended`]: the unattended station: days of scans, day sessions, storage budget, heartbeat, outages, damped exposure.
 
 pub mod clock;
 pub mod conformance;
@@ -17,3 +18,4 @@ pub mod driver;
 pub mod schedule;
 pub mod station;
 pub mod store;
+pub mod unattended;

@@ -1,4 +1,4 @@
-//! The shipped examples are valid, and each plan runs on the simulated station.
+//! The shipped examples are valid, and each plan runs on every station.
 
 use std::path::Path;
 
@@ -18,18 +18,22 @@ fn every_example_file_is_valid() {
             n += 1;
         }
     }
-    assert_eq!(n, 8, "sim station, real station, four plans, two scenes");
+    assert_eq!(
+        n, 11,
+        "sim station, sky sim station, real station, five plans, three scenes"
+    );
 }
 
 #[test]
-fn plans_run_on_both_stations() {
-    for station in ["sim-station.ron", "real-station.ron"] {
+fn plans_run_on_every_station() {
+    for station in ["sim-station.ron", "real-station.ron", "sky-sim-station.ron"] {
         let station = load_station(&example(station)).expect("valid station");
         for plan in [
             "campanile-day.ron",
             "campanile-quick.ron",
             "room-lights.ron",
             "sky-day.ron",
+            "sky-station.ron",
         ] {
             let Ok(Document::Plan(plan)) = load(&example(plan)) else {
                 panic!("{plan} is a plan")

@@ -185,14 +185,14 @@ pub fn run(args: CaptureArgs) -> u8 {
 }
 
 /// The plan, station and scene, as `plan check` reads them.
-struct Inputs {
-    plan: campanile_config::document::LoadedPlan,
-    station: Station,
-    timeline: Timeline,
-    snapshot: Snapshot,
+pub(super) struct Inputs {
+    pub(super) plan: campanile_config::document::LoadedPlan,
+    pub(super) station: Station,
+    pub(super) timeline: Timeline,
+    pub(super) snapshot: Snapshot,
     /// How to name the plan and station in messages.
     plan_label: String,
-    station_label: String,
+    pub(super) station_label: String,
     /// Whether they were read from a session's snapshot.
     from_session: bool,
 }
@@ -210,7 +210,7 @@ impl Inputs {
     }
 
     /// Read PLAN and STATION (and the plan's scene) from their files.
-    fn from_files(plan_path: &Path, station_path: &Path, days: Option<u32>) -> Result<Self> {
+    pub(super) fn from_files(plan_path: &Path, station_path: &Path, days: Option<u32>) -> Result<Self> {
         let plan = load_plan(plan_path).map_err(|e| anyhow::anyhow!("{e}"))?;
         let loaded = load_station(station_path).map_err(|e| anyhow::anyhow!("{e}"))?;
         let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
@@ -501,6 +501,7 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
             }
             JournalEntry::Missed(_) if !store.completed(e.key()) => missed += 1,
             JournalEntry::Missed(_) => {}
+            JournalEntry::Pruned(_) | JournalEntry::Outage(_) => {}
             _ => extra += 1,
         }
     }
@@ -541,33 +542,12 @@ fn run_simulated<S: Storage>(
     let first = &inputs.timeline.occurrences[0];
     // The simulated calendar begins a minute before the first occurrence,
     // or, on resume, a second after the last journaled shot.
-    let last = store.entries().iter().map(|e| match e {
-        JournalEntry::Done(f) | JournalEntry::Late(f) => f.meta.time,
-        JournalEntry::Missed(m) => m.time,
-    });
+    let last = store.entries().iter().map(JournalEntry::time);
     let origin = match (resumed, last.max()) {
         (true, Some(t)) => t + TimeDelta::seconds(1),
         _ => first.start - TimeDelta::seconds(60),
     };
-    let scene_path = inputs
-        .plan
-        .scene
-        .as_ref()
-        .map(|s| s.source.path.clone())
-        .context("a simulated capture needs the plan's scene to photograph (the plan has no `scene`)")?;
-    let mut world = World::new(
-        &inputs.station,
-        load_scene(&scene_path).with_context(|| format!("loading {}", scene_path.display()))?,
-    );
-    world.quality.samples_per_pixel = args.sim_samples.max(1);
-    world.quality.max_bounces = args.sim_bounces;
-    let home = inputs
-        .plan
-        .scene
-        .as_ref()
-        .and_then(|s| s.value.poses.first())
-        .map_or([0.0; 3], |p| [p.position_m.0, p.position_m.1, p.position_m.2]);
-    let seed = inputs.station.simulation.as_ref().map_or(0, |s| s.seed);
+    let SimulatedWorld { world, home, seed } = simulated_world(inputs, args.sim_samples, args.sim_bounces)?;
     let faults = FaultPlan {
         link: (args.sim_drop_chance.is_some() || args.sim_corrupt_chance.is_some()).then(|| LinkFaults {
             drop_chance: args.sim_drop_chance.unwrap_or(0.0),
@@ -598,7 +578,7 @@ fn run_simulated<S: Storage>(
         .build()
         .context("starting the runtime")?;
     runtime.block_on(async {
-        let mut sim = SimStation::start(&inputs.station, Arc::new(world), options)
+        let mut sim = SimStation::start(&inputs.station, world, options)
             .await
             .context("starting the simulated station")?;
         let clock = sim.clock();
@@ -613,6 +593,43 @@ fn run_simulated<S: Storage>(
             bars,
         )
         .await)
+    })
+}
+
+/// The simulated world a plan's scene makes, where the station stands in
+/// it (the scene's first pose), and the station's simulation seed.
+pub(super) struct SimulatedWorld {
+    pub(super) world: Arc<World>,
+    pub(super) home: [f64; 3],
+    pub(super) seed: u64,
+}
+
+/// Build the simulated world of `inputs` rendered with `samples` per pixel
+/// and `bounces`.
+pub(super) fn simulated_world(inputs: &Inputs, samples: u32, bounces: u32) -> Result<SimulatedWorld> {
+    let scene_path = inputs
+        .plan
+        .scene
+        .as_ref()
+        .map(|s| s.source.path.clone())
+        .context("a simulated station needs the plan's scene to photograph (the plan has no `scene`)")?;
+    let mut world = World::new(
+        &inputs.station,
+        load_scene(&scene_path).with_context(|| format!("loading {}", scene_path.display()))?,
+    );
+    world.quality.samples_per_pixel = samples.max(1);
+    world.quality.max_bounces = bounces;
+    let home = inputs
+        .plan
+        .scene
+        .as_ref()
+        .and_then(|s| s.value.poses.first())
+        .map_or([0.0; 3], |p| [p.position_m.0, p.position_m.1, p.position_m.2]);
+    let seed = inputs.station.simulation.as_ref().map_or(0, |s| s.seed);
+    Ok(SimulatedWorld {
+        world: Arc::new(world),
+        home,
+        seed,
     })
 }
 

@@ -14,6 +14,7 @@ mod render;
 mod ron_output;
 mod site;
 mod sky;
+mod station;
 mod sun;
 
 use std::process::ExitCode;
@@ -79,6 +80,11 @@ pub enum Command {
     Igi(igi::IgiArgs),
     /// Run a plan on a station into a session directory, or resume one.
     Capture(capture::CaptureArgs),
+    /// The unattended station: run a plan day after day (`station run`), read its heartbeat (`station status`).
+    Station {
+        #[command(subcommand)]
+        action: station::StationCommand,
+    },
     /// Process a captured session: response, HDR, sun, sky and environment, with a summary.
     Process(process::ProcessArgs),
     /// List serial ports and cameras, or test a station's devices (`devices test --station FILE`).
@@ -125,6 +131,7 @@ pub fn run() -> ExitCode {
         Command::Env { action } => report(env::run(action)),
         Command::Plan { action } => plan::run(action),
         Command::Capture(args) => capture::run(args),
+        Command::Station { action } => station::run(action),
         Command::Demo(args) => report(demo::run(args)),
         Command::Process(args) => report(process::run(args)),
         Command::Devices(args) => devices::run(args),

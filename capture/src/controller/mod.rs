@@ -11,6 +11,8 @@
 //! - [`sun_shot`]: the disc, the ND filter and exposure, triplet agreement.
 //! - [`aim`]: head angles through the mount's exact kinematics.
 //! - [`options`]: [`RunOptions`], [`RunReport`] and [`Progress`].
+//! - [`supervisor`]: a [`Supervisor`] that may stop a run between shots,
+//!   seed and damp metered exposures, and hears of device failures.
 //!
 //! Frames: every promised shot ends as one journal line, a frame (`done`
 //! or `late`) or `missed` with the reason. Auto-bracket frames after the
@@ -36,8 +38,10 @@ pub mod options;
 pub mod rig;
 pub mod run;
 pub mod sun_shot;
+pub mod supervisor;
 
 pub use error::RunError;
 pub use options::{AutoBracketUse, NoProgress, Progress, RunOptions, RunReport, ShotOutcome};
 pub use rig::{DeviceKind, Rig};
-pub use run::run;
+pub use run::{run, run_supervised};
+pub use supervisor::{Metering, Supervisor, Unsupervised};

@@ -32,6 +32,7 @@ use super::metering::{self, Codes};
 use super::options::{AutoBracketUse, Progress, RunOptions, RunReport, ShotOutcome};
 use super::rig::{DeviceKind, Rig};
 use super::sun_shot::{self, FilterCandidate};
+use super::supervisor::{Metering, Supervisor, Unsupervised};
 use super::{aim, error::RunError};
 use crate::clock::Clock;
 use crate::device::{
@@ -60,9 +61,42 @@ pub async fn run<R: Rig, C: Clock, S: Storage>(
     options: &RunOptions,
     progress: &mut dyn Progress,
 ) -> Result<RunReport, RunError> {
+    run_supervised(
+        timeline,
+        plan,
+        station,
+        store,
+        rig,
+        clock,
+        options,
+        progress,
+        &mut Unsupervised,
+        0,
+    )
+    .await
+}
+
+/// [`run()`] under a [`Supervisor`]: when it asks to stop, the run ends
+/// before the next shot with `report.stopped` set and `Ok`. The frames of
+/// the timeline's shots are numbered (see [`Rig::number_frames_from`]) from
+/// `first_ordinal` on, so that a timeline cut into parts (one occurrence
+/// at a time) numbers them as the whole one would.
+#[allow(clippy::too_many_arguments)]
+pub async fn run_supervised<R: Rig, C: Clock, S: Storage>(
+    timeline: &Timeline,
+    plan: &Plan,
+    station: &Station,
+    store: &mut SessionStore<S>,
+    rig: &mut R,
+    clock: &C,
+    options: &RunOptions,
+    progress: &mut dyn Progress,
+    supervisor: &mut dyn Supervisor,
+    first_ordinal: u64,
+) -> Result<RunReport, RunError> {
     let mut ordinals = HashMap::new();
     for (i, shot) in timeline.occurrences.iter().flat_map(|o| o.shots.iter()).enumerate() {
-        ordinals.insert(shot.key.clone(), i as u64);
+        ordinals.insert(shot.key.clone(), first_ordinal + i as u64);
     }
     let s = &station.site;
     let mut c = Controller {
@@ -73,6 +107,8 @@ pub async fn run<R: Rig, C: Clock, S: Storage>(
         clock,
         options,
         progress,
+        supervisor,
+        stopping: false,
         ordinals,
         observer: Observer::from_degrees(
             s.latitude_deg,
@@ -86,6 +122,11 @@ pub async fn run<R: Rig, C: Clock, S: Storage>(
         last_slot: None,
     };
     for occ in &timeline.occurrences {
+        if c.stopping || c.supervisor.stop_requested() {
+            c.report.stopped = Some(STOPPED_ON_REQUEST.to_owned());
+            tracing::info!("the run stops on request, between shots");
+            return Ok(c.report);
+        }
         let span = tracing::info_span!("occurrence", key = %occ.key);
         if let Err(error) = c.occurrence(occ).instrument(span).await {
             c.report.stopped = Some(error.to_string());
@@ -96,8 +137,15 @@ pub async fn run<R: Rig, C: Clock, S: Storage>(
             });
         }
     }
+    if c.stopping {
+        c.report.stopped = Some(STOPPED_ON_REQUEST.to_owned());
+        tracing::info!("the run stops on request, between shots");
+    }
     Ok(c.report)
 }
+
+/// [`RunReport::stopped`] of a run its supervisor stopped.
+pub const STOPPED_ON_REQUEST: &str = "stopped on request";
 
 /// Why a shot was not taken.
 enum ShotError {
@@ -159,6 +207,9 @@ struct Controller<'a, R, C, S: Storage> {
     clock: &'a C,
     options: &'a RunOptions,
     progress: &'a mut dyn Progress,
+    supervisor: &'a mut dyn Supervisor,
+    /// The supervisor asked to stop: no further shot is taken.
+    stopping: bool,
     ordinals: HashMap<String, u64>,
     observer: Observer,
     report: RunReport,
@@ -266,6 +317,10 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
             if self.store.completed(&shot.key) {
                 self.progress.shot(shot, ShotOutcome::AlreadyDone);
                 continue;
+            }
+            if self.supervisor.stop_requested() {
+                self.stopping = true;
+                return Ok(());
             }
             if !self.open(shot) {
                 continue;
@@ -418,7 +473,7 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
         let exposure_s = match shot.exposure {
             PlannedExposure::Fixed { seconds } => self.clamp_exposure(seconds),
             PlannedExposure::Metered { stops } => {
-                let t = self.metered(shot, state).await?;
+                let t = self.metered(occ, shot, state).await?;
                 self.clamp_exposure(t * 2f64.powf(stops))
             }
             PlannedExposure::Auto => match (shot.kind, &step) {
@@ -428,7 +483,7 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
                 ),
                 _ => match auto_exposure {
                     Some(t) => self.clamp_exposure(t),
-                    None => self.metered(shot, state).await?,
+                    None => self.metered(occ, shot, state).await?,
                 },
             },
         };
@@ -503,7 +558,7 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
         let exposure = ExposureTime::from_seconds(exposure_s)
             .ok_or_else(|| ShotError::Unreachable(format!("exposure {exposure_s} s is not a positive time")))?;
         let limit = self.options.watchdog + exposure.duration();
-        guarded(
+        let r = guarded(
             DeviceKind::Camera,
             limit,
             self.rig.camera().capture(CaptureSettings {
@@ -511,7 +566,18 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
                 gain: Gain::UNITY,
             }),
         )
-        .await
+        .await;
+        self.noted(DeviceKind::Camera, r)
+    }
+
+    /// Tell the supervisor how a device call went; pass the result on.
+    fn noted<T>(&mut self, kind: DeviceKind, r: Result<T, ShotError>) -> Result<T, ShotError> {
+        match &r {
+            Ok(_) => self.supervisor.device_answered(kind, self.clock.now()),
+            Err(ShotError::Device(k, e)) => self.supervisor.device_failed(*k, self.clock.now(), e),
+            Err(_) => {}
+        }
+        r
     }
 
     /// Aim the head (and, for a pose, the tripod); the pose asked for and reached.
@@ -572,9 +638,11 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
         }
         self.last_pose = None;
         let limit = self.options.watchdog;
-        guarded(DeviceKind::Head, limit, self.rig.head().move_to(pose)).await?;
+        let r = guarded(DeviceKind::Head, limit, self.rig.head().move_to(pose)).await;
+        self.noted(DeviceKind::Head, r)?;
         let settle = self.options.settle_limit;
-        let reached = guarded(DeviceKind::Head, limit + settle, self.rig.head().wait_idle(settle)).await?;
+        let r = guarded(DeviceKind::Head, limit + settle, self.rig.head().wait_idle(settle)).await;
+        let reached = self.noted(DeviceKind::Head, r)?;
         self.last_pose = Some((pose, PoseDeg::from(reached)));
         Ok((PoseDeg::from(pose), PoseDeg::from(reached)))
     }
@@ -609,7 +677,8 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
         self.last_slot = None;
         let limit = self.options.watchdog;
         if let Some(w) = self.rig.wheel() {
-            guarded(DeviceKind::Wheel, limit, w.select(slot)).await?;
+            let r = guarded(DeviceKind::Wheel, limit, w.select(slot)).await;
+            self.noted(DeviceKind::Wheel, r)?;
         }
         self.last_slot = Some(slot);
         Ok(())
@@ -659,7 +728,8 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
                 continue;
             };
             if let Some(lights) = self.rig.lights() {
-                guarded(DeviceKind::Lights, limit, lights.set_level(channel, level)).await?;
+                let r = guarded(DeviceKind::Lights, limit, lights.set_level(channel, level)).await;
+                self.noted(DeviceKind::Lights, r)?;
             }
             journaled.push(LightLevel {
                 channel: channel.0,
@@ -671,7 +741,12 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
 
     /// The metered exposure of the shot's target (once per target per
     /// occurrence): unstored test captures until the median is mid-range.
-    async fn metered(&mut self, shot: &PlannedShot, state: &mut OccurrenceState) -> Result<f64, ShotError> {
+    async fn metered(
+        &mut self,
+        occ: &Occurrence,
+        shot: &PlannedShot,
+        state: &mut OccurrenceState,
+    ) -> Result<f64, ShotError> {
         let target = target_of(&shot.key).to_owned();
         if let Some(&t) = state.metered.get(&target) {
             return Ok(t);
@@ -690,12 +765,25 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
             .map(|(_, &o)| o)
             .min()
             .unwrap_or(0);
-        let mut t = self.clamp_exposure(self.options.meter_start_s);
+        let start = self
+            .supervisor
+            .metering_start(occ, &target)
+            .filter(|s| s.is_finite() && *s > 0.0)
+            .unwrap_or(self.options.meter_start_s);
+        let mut t = self.clamp_exposure(start);
+        let mut ideal = t;
+        let mut captures = 0;
         for i in 0..metering::MAX_CAPTURES as u64 {
             self.rig.number_frames_from(first * FRAMES_PER_SHOT + 32 + i);
             let frame = self.capture(t).await?;
             self.report.metering_captures += 1;
+            captures += 1;
             let median = metering::median_fraction(Codes::from(&frame));
+            ideal = if median > 0.01 && median < 0.97 {
+                t * (metering::TARGET_FRACTION / median).powf(metering::ASSUMED_GAMMA)
+            } else {
+                t
+            };
             match metering::next_exposure(t, median) {
                 None => break,
                 Some(next) => {
@@ -707,7 +795,17 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
                 }
             }
         }
-        tracing::debug!(target = %target, exposure_s = t, "metered");
+        let chosen = self.supervisor.metered_exposure(
+            occ,
+            &target,
+            Metering {
+                accepted_s: t,
+                ideal_s: ideal,
+                captures,
+            },
+        );
+        let t = self.clamp_exposure(chosen);
+        tracing::debug!(target = %target, exposure_s = t, ideal_s = ideal, "metered");
         state.metered.insert(target, t);
         Ok(t)
     }

@@ -67,6 +67,15 @@ pub enum StoreError {
         status: &'static str,
     },
 
+    /// A shot's frame cannot be pruned: it has none, or it is pruned already.
+    #[error("the frame of shot {key:?} cannot be pruned: {reason}")]
+    NotPrunable {
+        /// The key.
+        key: String,
+        /// Why.
+        reason: String,
+    },
+
     /// Two different keys map to the same frame file name.
     #[error("shot keys {key:?} and {other:?} both map to the frame file {file}")]
     FileNameClash {

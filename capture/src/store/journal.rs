@@ -6,7 +6,13 @@
 //!   depth, camera sequence number and [`FrameMeta`];
 //! - `late`: the same, for a frame taken late (`meta.late_by_s` says by
 //!   how much);
-//! - `missed`: a shot not taken, with the time and the reason.
+//! - `missed`: a shot not taken, with the time and the reason;
+//! - `pruned`: raw frames deleted on purpose (an unattended station's
+//!   storage budget, once their processed products exist), with the keys,
+//!   the bytes freed and the reason; those frames are intentionally gone,
+//!   not damaged, and their shots stay complete;
+//! - `outage`: a device that was down, from `start` (its first failed
+//!   call) to `end` (its first answer after coming back).
 //!
 //! A line is written whole (one `write_all` of the line and its `\n`) and
 //! fsynced before the next shot; a crash can only leave a torn *last*
@@ -178,6 +184,35 @@ pub struct MissedEntry {
     pub reason: String,
 }
 
+/// Raw frames deleted on purpose (e.g. to stay within a storage budget).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PrunedEntry {
+    /// When they were deleted, UTC.
+    pub time: DateTime<Utc>,
+    /// The shot keys whose frames were deleted (each completed earlier).
+    pub keys: Vec<String>,
+    /// Bytes freed (the journaled sizes of their files).
+    pub bytes: u64,
+    /// Why, e.g. "storage budget 2000000 bytes exceeded; products exist".
+    pub reason: String,
+}
+
+/// A device that was down.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OutageEntry {
+    /// The device: `camera`, `head`, `filter wheel` or `lights`.
+    pub device: String,
+    /// Its first failed call, UTC.
+    pub start: DateTime<Utc>,
+    /// Its first answer after coming back, UTC; or, when `open`, when the
+    /// run stopped with the device still down.
+    pub end: DateTime<Utc>,
+    /// The run stopped (or ended) while the device was still down: `end`
+    /// is the stop, not the device's return.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub open: bool,
+}
+
 /// One journal line.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "status", rename_all = "lowercase")]
@@ -188,22 +223,39 @@ pub enum JournalEntry {
     Late(FrameEntry),
     /// A shot not taken.
     Missed(MissedEntry),
+    /// Frames deleted on purpose.
+    Pruned(PrunedEntry),
+    /// A device outage.
+    Outage(OutageEntry),
 }
 
 impl JournalEntry {
-    /// The shot's key.
+    /// The shot's key; empty for the lines about no single shot
+    /// (`pruned`, `outage`).
     pub fn key(&self) -> &str {
         match self {
             JournalEntry::Done(f) | JournalEntry::Late(f) => &f.key,
             JournalEntry::Missed(m) => &m.key,
+            JournalEntry::Pruned(_) | JournalEntry::Outage(_) => "",
         }
     }
 
-    /// The frame, unless the shot was missed.
+    /// The frame, unless the line is not about a taken frame.
     pub fn frame(&self) -> Option<&FrameEntry> {
         match self {
             JournalEntry::Done(f) | JournalEntry::Late(f) => Some(f),
-            JournalEntry::Missed(_) => None,
+            JournalEntry::Missed(_) | JournalEntry::Pruned(_) | JournalEntry::Outage(_) => None,
+        }
+    }
+
+    /// When the line's event happened (a frame's time, a miss, a
+    /// pruning, an outage's end).
+    pub fn time(&self) -> DateTime<Utc> {
+        match self {
+            JournalEntry::Done(f) | JournalEntry::Late(f) => f.meta.time,
+            JournalEntry::Missed(m) => m.time,
+            JournalEntry::Pruned(p) => p.time,
+            JournalEntry::Outage(o) => o.end,
         }
     }
 
@@ -248,7 +300,7 @@ pub fn parse_journal(path: &Path, bytes: &[u8]) -> Result<ParsedJournal, StoreEr
         let entry = serde_json::from_slice::<JournalEntry>(line).map_err(|e| StoreError::JournalCorrupt {
             path: path.to_path_buf(),
             line: n,
-            reason: format!("expected a JSON journal entry with status done, late or missed: {e}"),
+            reason: format!("expected a JSON journal entry with status done, late, missed, pruned or outage: {e}"),
         })?;
         entries.push(entry);
     }

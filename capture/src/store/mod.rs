@@ -7,9 +7,17 @@
 //! SESSION/
 //!   plan.ron, station.ron, scene.ron   the descriptions the session runs under (scene optional)
 //!   provenance.json                    campanile version, creation time, calibration files and checksums
-//!   journal.jsonl                      one JSON line per shot: done, late or missed
+//!   journal.jsonl                      one JSON line per shot (done, late or missed), per pruning, per outage
 //!   frames/<key>-<crc>.png             raw sensor codes, 16-bit RGB PNG, unscaled
+//!   processed/products.ron             occurrences whose processed products exist (optional)
 //! ```
+//!
+//! A `pruned` journal line ([`PrunedEntry`]) lists completed shots whose
+//! frame files were deleted on purpose: they stay complete (never
+//! retaken), resume and verify do not look for their files, and readers
+//! leave them out of [`SessionReader::frames`]. The line is journaled
+//! before the files are removed, so a crash in between leaves files that
+//! resume removes as unjournaled.
 //!
 //! Journal lines ([`JournalEntry`]) carry the time, head pose asked for
 //! and reached, exposure asked for and applied, gain, filter, lights,
@@ -68,7 +76,8 @@ pub use checksum::crc32c;
 pub use error::{DiskFull, StoreError, is_disk_full};
 pub use frame_file::{check_frame, decode_png, encode_png};
 pub use journal::{
-    FrameEntry, FrameMeta, JournalEntry, LightLevel, MissedEntry, ParsedJournal, PoseDeg, ShotKind, parse_journal,
+    FrameEntry, FrameMeta, JournalEntry, LightLevel, MissedEntry, OutageEntry, ParsedJournal, PoseDeg, PrunedEntry,
+    ShotKind, parse_journal,
 };
 pub use key::{MAX_KEY_BYTES, check_key, frame_file_name};
 pub use products::{PROCESSED_DIR, PRODUCTS_FILE, ProcessedProducts, ProductsError, products_path};

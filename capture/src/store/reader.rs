@@ -72,9 +72,26 @@ impl SessionReader {
         &self.entries
     }
 
-    /// The journaled frames, in order (done and late).
+    /// The journaled frames still on disk, in order (done and late; frames
+    /// deleted on purpose by a `pruned` line are left out).
     pub fn frames(&self) -> impl Iterator<Item = &FrameEntry> {
-        self.entries.iter().filter_map(JournalEntry::frame)
+        let pruned = self.pruned_keys();
+        self.entries
+            .iter()
+            .filter_map(JournalEntry::frame)
+            .filter(move |f| !pruned.contains(f.key.as_str()))
+    }
+
+    /// The keys of completed shots whose frames were deleted on purpose.
+    pub fn pruned_keys(&self) -> std::collections::HashSet<&str> {
+        self.entries
+            .iter()
+            .filter_map(|e| match e {
+                JournalEntry::Pruned(p) => Some(p.keys.iter().map(String::as_str)),
+                _ => None,
+            })
+            .flatten()
+            .collect()
     }
 
     /// Bytes of a torn last journal line (0 if none).

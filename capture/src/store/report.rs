@@ -73,6 +73,9 @@ pub struct VerifyReport {
     pub frames_checked: usize,
     /// Bytes read.
     pub bytes_checked: u64,
+    /// Journaled frames deleted on purpose (a `pruned` line): not checked,
+    /// not problems.
+    pub frames_pruned: usize,
     /// Frames that failed: [`StoreError::MissingFrame`],
     /// [`StoreError::ChecksumMismatch`] or [`StoreError::BadFrameFile`],
     /// each naming the file.

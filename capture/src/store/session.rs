@@ -4,7 +4,7 @@
 use super::checksum::crc32c;
 use super::error::{DiskFull, StoreError, is_disk_full};
 use super::frame_file::{check_frame, encode_png, read_checked_bytes, read_checked_frame};
-use super::journal::{FrameEntry, FrameMeta, JournalEntry, MissedEntry, parse_journal};
+use super::journal::{FrameEntry, FrameMeta, JournalEntry, MissedEntry, OutageEntry, PrunedEntry, parse_journal};
 use super::key::{check_key, frame_file_name};
 use super::report::{ResumeReport, TornLine, VerifyReport};
 use super::snapshot::Snapshot;
@@ -48,6 +48,8 @@ pub struct SessionStore<S: Storage = FsStorage> {
     missed: HashSet<String>,
     /// Keys recorded missed by this run.
     missed_this_run: HashSet<String>,
+    /// Completed keys whose frame files were deleted on purpose.
+    pruned: HashSet<String>,
     /// Journal length in bytes (all complete lines).
     journal_len: u64,
     /// Set when a failure left the directory needing `resume`.
@@ -109,6 +111,7 @@ impl<S: Storage> SessionStore<S> {
             files: HashMap::new(),
             missed: HashSet::new(),
             missed_this_run: HashSet::new(),
+            pruned: HashSet::new(),
             journal_len: 0,
             broken: None,
         })
@@ -153,6 +156,7 @@ impl<S: Storage> SessionStore<S> {
             files: HashMap::new(),
             missed: HashSet::new(),
             missed_this_run: HashSet::new(),
+            pruned: HashSet::new(),
             journal_len: parsed.complete_len,
             broken: None,
         };
@@ -221,9 +225,11 @@ impl<S: Storage> SessionStore<S> {
             s.sync_dir(&frames).map_err(io_err("fsyncing directory", &frames))?;
         }
 
-        // Every journaled frame present and intact.
+        // Every journaled frame present and intact (pruned ones are gone on purpose).
         for entry in store.entries.iter().filter_map(JournalEntry::frame) {
-            store.frame_bytes(entry)?;
+            if !store.pruned.contains(&entry.key) {
+                store.frame_bytes(entry)?;
+            }
         }
         report.frames = store.done.len();
         report.missed = store.missed.len();
@@ -234,6 +240,18 @@ impl<S: Storage> SessionStore<S> {
     /// Take a journal entry read back into the in-memory state; the
     /// problem, if it contradicts earlier lines.
     fn admit(&mut self, entry: JournalEntry) -> Result<(), String> {
+        if let JournalEntry::Pruned(p) = &entry {
+            for key in &p.keys {
+                self.check_prunable(key)?;
+            }
+            for key in &p.keys {
+                self.forget_file(key);
+            }
+        }
+        if matches!(entry, JournalEntry::Pruned(_) | JournalEntry::Outage(_)) {
+            self.entries.push(entry);
+            return Ok(());
+        }
         let key = entry.key().to_string();
         if self.done.contains_key(&key) {
             return Err(format!("shot {key:?} appears again after it was completed"));
@@ -257,9 +275,34 @@ impl<S: Storage> SessionStore<S> {
             JournalEntry::Missed(_) => {
                 self.missed.insert(key);
             }
+            JournalEntry::Pruned(_) | JournalEntry::Outage(_) => {}
         }
         self.entries.push(entry);
         Ok(())
+    }
+
+    /// Why `key`'s frame cannot be pruned, if it cannot: it must be
+    /// completed and not pruned already.
+    fn check_prunable(&self, key: &str) -> Result<(), String> {
+        if !self.done.contains_key(key) {
+            return Err(format!("pruned shot {key:?} has no journaled frame before"));
+        }
+        if self.pruned.contains(key) {
+            return Err(format!("shot {key:?} is pruned twice"));
+        }
+        Ok(())
+    }
+
+    /// Mark `key`'s frame pruned: its file is no longer the session's.
+    fn forget_file(&mut self, key: &str) {
+        if let Some(name) = self
+            .frame_entry(key)
+            .and_then(|f| f.file.strip_prefix(&format!("{FRAMES_DIR}/")))
+            .map(str::to_owned)
+        {
+            self.files.remove(&name);
+        }
+        self.pruned.insert(key.to_string());
     }
 
     /// The session directory.
@@ -294,8 +337,17 @@ impl<S: Storage> SessionStore<S> {
         self.missed_this_run.contains(key)
     }
 
-    /// The journaled frame for `key`, if completed.
+    /// Whether `key`'s frame was deleted on purpose (a `pruned` line);
+    /// the shot stays completed.
+    pub fn pruned(&self, key: &str) -> bool {
+        self.pruned.contains(key)
+    }
+
+    /// The journaled frame for `key`, if completed and not pruned.
     pub fn frame_entry(&self, key: &str) -> Option<&FrameEntry> {
+        if self.pruned.contains(key) {
+            return None;
+        }
         self.done
             .get(key)
             .and_then(|&i| self.entries.get(i))
@@ -394,6 +446,92 @@ impl<S: Storage> SessionStore<S> {
         Ok(entry)
     }
 
+    /// Delete the frame files of the completed shots `keys` on purpose,
+    /// at `time`, for `reason`: one journal line with status `pruned`
+    /// (keys, bytes freed, reason), then the files are removed and the
+    /// frames directory fsynced. The shots stay completed. Refused
+    /// ([`StoreError::NotPrunable`]) for a key without a frame, already
+    /// pruned or listed twice; nothing is journaled then.
+    ///
+    /// The line is journaled first: after a crash before the files are
+    /// gone, [`SessionStore::resume`] removes them as unjournaled frames.
+    /// A file that cannot be removed is logged and left (resume removes
+    /// it); the line stands.
+    pub fn record_pruned(
+        &mut self,
+        keys: &[String],
+        reason: &str,
+        time: DateTime<Utc>,
+    ) -> Result<JournalEntry, StoreError> {
+        self.check_writable()?;
+        let mut bytes = 0;
+        let mut seen = HashSet::new();
+        for key in keys {
+            let listed_twice = !seen.insert(key.as_str());
+            let problem = self
+                .check_prunable(key)
+                .err()
+                .or_else(|| listed_twice.then(|| "it is listed twice".to_owned()));
+            if let Some(reason) = problem {
+                return Err(StoreError::NotPrunable {
+                    key: key.clone(),
+                    reason,
+                });
+            }
+            bytes += self.frame_entry(key).map_or(0, |f| f.bytes);
+        }
+        let files: Vec<PathBuf> = keys
+            .iter()
+            .filter_map(|k| self.frame_entry(k))
+            .map(|f| self.frame_path(f))
+            .collect();
+        let entry = JournalEntry::Pruned(PrunedEntry {
+            time,
+            keys: keys.to_vec(),
+            bytes,
+            reason: reason.to_string(),
+        });
+        self.append(&entry, None)?;
+        for key in keys {
+            self.forget_file(key);
+        }
+        self.entries.push(entry.clone());
+        for f in &files {
+            if let Err(e) = self.storage.remove(f)
+                && e.kind() != io::ErrorKind::NotFound
+            {
+                tracing::warn!(file = %f.display(), error = %e, "could not remove a pruned frame; resume will");
+            }
+        }
+        let frames = self.dir.join(FRAMES_DIR);
+        if let Err(e) = self.storage.sync_dir(&frames) {
+            tracing::warn!(dir = %frames.display(), error = %e, "fsyncing after pruning failed");
+        }
+        Ok(entry)
+    }
+
+    /// Record that `device` was down from `start` to `end` (`open`: still
+    /// down when the run stopped at `end`): one journal line with status
+    /// `outage`.
+    pub fn record_outage(
+        &mut self,
+        device: &str,
+        start: DateTime<Utc>,
+        end: DateTime<Utc>,
+        open: bool,
+    ) -> Result<JournalEntry, StoreError> {
+        self.check_writable()?;
+        let entry = JournalEntry::Outage(OutageEntry {
+            device: device.to_string(),
+            start,
+            end,
+            open,
+        });
+        self.append(&entry, None)?;
+        self.entries.push(entry.clone());
+        Ok(entry)
+    }
+
     /// Re-read every journaled frame: its size, CRC-32C, and that it
     /// decodes as a 16-bit RGB PNG of the journaled size. Damaged or
     /// missing frames are listed in the report; only a failure to read
@@ -401,6 +539,10 @@ impl<S: Storage> SessionStore<S> {
     pub fn verify(&self) -> Result<VerifyReport, StoreError> {
         let mut report = VerifyReport::default();
         for entry in self.entries.iter().filter_map(JournalEntry::frame) {
+            if self.pruned.contains(&entry.key) {
+                report.frames_pruned += 1;
+                continue;
+            }
             report.frames_checked += 1;
             match self.read_frame(entry) {
                 Ok(_) => report.bytes_checked += entry.bytes,

@@ -4,7 +4,7 @@
 use super::*;
 use crate::device::{ExposureTime, Gain};
 use crate::store::fault::{CrashingStorage, Operation, QuotaStorage};
-use crate::store::{CalibrationRef, LightLevel, PoseDeg, Provenance, ShotKind, SourcePaths};
+use crate::store::{CalibrationRef, LightLevel, PoseDeg, Provenance, SessionReader, ShotKind, SourcePaths};
 use chrono::TimeZone;
 use std::collections::BTreeSet;
 
@@ -641,4 +641,71 @@ fn duplicate_invalid_and_misplaced_requests_are_refused() {
     assert!(err.to_string().contains("journal.jsonl is missing"), "{err}");
     // An existing empty directory is fine for create.
     SessionStore::create(&empty, snapshot()).unwrap();
+}
+
+#[test]
+fn pruned_frames_are_gone_on_purpose_and_outages_are_journaled() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("s");
+    let mut store = SessionStore::create(&dir, snapshot()).unwrap();
+    for i in 0..4 {
+        let frame = synth_frame(i as u64, 12);
+        store.record_frame(&key(i), &meta_for(i, &frame), &frame).unwrap();
+    }
+    let t = Utc.with_ymd_and_hms(2026, 8, 28, 9, 0, 0).unwrap();
+    let files: Vec<PathBuf> = (0..2)
+        .map(|i| store.frame_path(store.frame_entry(&key(i)).unwrap()))
+        .collect();
+    let bytes: u64 = (0..2).map(|i| store.frame_entry(&key(i)).unwrap().bytes).sum();
+    // Refused: a key without a frame, a key listed twice; nothing journaled.
+    let e = store.record_pruned(&["nope".into()], "budget", t).unwrap_err();
+    assert!(
+        matches!(e, StoreError::NotPrunable { .. }) && e.to_string().contains("\"nope\""),
+        "{e}"
+    );
+    let e = store.record_pruned(&[key(0), key(0)], "budget", t).unwrap_err();
+    assert!(e.to_string().contains("listed twice"), "{e}");
+    assert_eq!(store.entries().len(), 4);
+    let entry = store.record_pruned(&[key(0), key(1)], "budget", t).unwrap();
+    let JournalEntry::Pruned(p) = &entry else {
+        panic!("{entry:?}")
+    };
+    assert_eq!(p.bytes, bytes);
+    assert!(files.iter().all(|f| !f.exists()));
+    assert!(store.completed(&key(0)) && store.pruned(&key(0)) && store.frame_entry(&key(0)).is_none());
+    let e = store.record_pruned(&[key(1)], "budget", t).unwrap_err();
+    assert!(e.to_string().contains("pruned twice"), "{e}");
+    store
+        .record_outage("head", t, t + chrono::Duration::minutes(30), false)
+        .unwrap();
+    let verify = store.verify().unwrap();
+    assert!(verify.is_ok() && verify.frames_checked == 2 && verify.frames_pruned == 2);
+    drop(store);
+
+    // Resume accepts the pruned frames as gone; readers leave them out.
+    let (store, report) = SessionStore::resume(&dir).unwrap();
+    assert!(report.is_clean(), "{report}");
+    assert!(store.pruned(&key(1)) && !store.pruned(&key(2)));
+    assert!(matches!(store.entries().last(), Some(JournalEntry::Outage(o)) if o.device == "head" && !o.open));
+    let reader = SessionReader::open(&dir).unwrap();
+    let keys: Vec<&str> = reader.frames().map(|f| f.key.as_str()).collect();
+    assert_eq!(keys, [key(2), key(3)]);
+    drop(store);
+
+    // A crash between the pruned line and the deletions: resume removes
+    // the files as unjournaled frames.
+    let store = SessionStore::resume(&dir).unwrap().0;
+    let kept = store.frame_path(store.frame_entry(&key(2)).unwrap());
+    let line = JournalEntry::Pruned(PrunedEntry {
+        time: t,
+        keys: vec![key(2)],
+        bytes: 1,
+        reason: "budget".into(),
+    })
+    .to_line();
+    store.storage().append(&dir.join(JOURNAL_FILE), &line).unwrap();
+    drop(store);
+    let (store, report) = SessionStore::resume(&dir).unwrap();
+    assert_eq!(report.orphan_frames_removed, vec![kept.clone()]);
+    assert!(!kept.exists() && store.pruned(&key(2)) && store.completed(&key(2)));
 }

@@ -1,0 +1,446 @@
+//! `campanile station run|status`: the unattended station, and its heartbeat.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail};
+use campanile_capture::clock::SystemClock;
+use campanile_capture::controller::NoProgress;
+use campanile_capture::station::{SerialOpener, StationOptions as RigOptions, StationRig, check_ports, open_camera};
+use campanile_capture::store::{JournalEntry, SessionReader};
+use campanile_capture::unattended::day_rollover::existing_days;
+use campanile_capture::unattended::{
+    self, DeviceState, Heartbeat, NoProcessing, StationEnd, StationInputs, StationOptions, StationReport, StopHandle,
+    StorageBudget, parse_bytes,
+};
+use campanile_sim::faults::{Device, FaultPlan, Outage};
+use campanile_sim::station::{SimOptions, SimStation};
+use chrono::{DateTime, TimeDelta, Utc};
+use clap::{Args, Subcommand};
+
+use super::capture::{Inputs, SimulatedWorld, simulated_world};
+use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
+
+#[derive(Debug, Subcommand)]
+pub enum StationCommand {
+    // The variants take their help from their arguments' doc comments.
+    Run(RunArgs),
+    Status(StatusArgs),
+}
+
+/// Run a plan unattended, day after day, until its days end or it is stopped.
+///
+/// The plan's daily-repeating triggers (e.g. a sun triplet and a sky scan
+/// every 10 minutes while the sun is above 5°) run for all its days.
+///
+/// Each plan day (the site's mean solar day, centred on local mean noon)
+/// is one session directory, STORE/YYYY-MM-DD/. SIGTERM or SIGINT stops at
+/// the next frame boundary with the journal consistent (at once while
+/// waiting for a scan); running the same command again continues where it
+/// stopped: completed shots are kept, shots missed earlier are not retaken.
+///
+/// STORE/heartbeat.json says what the station is doing (state, last
+/// frame, device status, free disk, frames today, current session); see
+/// `campanile station status`. Devices are probed between scans, every
+/// 60 s, and a device that is down every 1, 2, 4 … 60 s (reconnecting);
+/// an outage is journaled with its start and end, and scans due while it
+/// lasts are journaled missed with the outage as the reason.
+///
+/// --budget: when the store holds more (frames and journals), the oldest
+/// raw frames of scans whose processed products exist (listed in their
+/// day's processed/products.ron) are deleted, journaled `pruned` and
+/// logged. This build does not process scans itself yet, so only scans
+/// listed by `campanile process` are deletable; with none, a warning is
+/// logged and capture goes on until the disk is full (then the run stops
+/// cleanly, exit 1; rerun once there is room).
+///
+/// Exposures of the sky tiles are planned across the day from a clear-sky
+/// model and damped from scan to scan (at most 0.5 stop per scan).
+///
+/// Simulated stations (a `Sim` camera) run under simulated time: days pass
+/// as fast as the frames render.
+///
+/// Exit status: 0 when the plan's days are done or the run was stopped by
+/// a signal; 1 when an error stopped it (e.g. the disk is full); 2 for bad
+/// input.
+///
+/// Example:
+///   campanile station run examples/sky-station.ron --station examples/sky-sim-station.ron --store sky --budget 50MB
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub struct RunArgs {
+    /// The plan (RON); its scene is read from the plan's `scene` field.
+    #[arg(value_name = "PLAN")]
+    plan: PathBuf,
+    /// The station (RON).
+    #[arg(long, value_name = "STATION")]
+    station: PathBuf,
+    /// The store: one session directory per plan day, and heartbeat.json.
+    #[arg(long, value_name = "DIR")]
+    store: PathBuf,
+    /// Storage budget, e.g. 2GB, 500MiB (see above).
+    #[arg(long, value_name = "SIZE", value_parser = parse_bytes)]
+    budget: Option<u64>,
+    /// Run only the first N days of the plan.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    days: Option<u32>,
+    /// Simulation: render samples per pixel.
+    #[arg(long, value_name = "N", default_value_t = 2)]
+    sim_samples: u32,
+    /// Simulation: render bounces.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    sim_bounces: u32,
+    /// Simulation: DEVICE (head, wheel or lights) disconnects at START (UTC,
+    /// RFC 3339, e.g. 2026-06-22T18:03:00Z) for DURATION seconds, e.g.
+    /// head:2026-06-22T18:03:00Z:1800. Repeatable. Absolute times, so a
+    /// restarted run keeps them.
+    #[arg(long, value_name = "DEVICE:START:DURATION")]
+    sim_outage: Vec<StationOutageArg>,
+}
+
+/// `--sim-outage DEVICE:START:DURATION`.
+#[derive(Debug, Clone, Copy)]
+pub struct StationOutageArg {
+    device: Device,
+    start: DateTime<Utc>,
+    duration: Duration,
+}
+
+impl std::str::FromStr for StationOutageArg {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad = || {
+            format!(
+                "found {s:?}; expected DEVICE:START:DURATION_S with DEVICE head, wheel or lights and START a UTC time, e.g. head:2026-06-22T18:03:00Z:1800"
+            )
+        };
+        let (device, rest) = s.split_once(':').ok_or_else(bad)?;
+        let (start, duration) = rest.rsplit_once(':').ok_or_else(bad)?;
+        let device = match device {
+            "head" => Device::Head,
+            "wheel" => Device::Wheel,
+            "lights" => Device::Lights,
+            _ => return Err(bad()),
+        };
+        let start = DateTime::parse_from_rfc3339(start)
+            .map_err(|_| bad())?
+            .with_timezone(&Utc);
+        let duration = duration
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite() && *x > 0.0 && *x < 1e9)
+            .map(Duration::from_secs_f64)
+            .ok_or_else(bad)?;
+        Ok(Self {
+            device,
+            start,
+            duration,
+        })
+    }
+}
+
+/// Print a station's heartbeat (exit 1 when it is stale).
+///
+/// Exit status: 0 when the heartbeat was written less than --max-age
+/// seconds ago (wall clock); 1 when it is older (stale: the station is not
+/// running, or stuck; a stopped or finished station is stale too) or
+/// cannot be read. A running station rewrites it at every frame and at
+/// least every 60 s while it waits.
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub struct StatusArgs {
+    /// The store directory (`station run --store DIR`).
+    #[arg(value_name = "DIR")]
+    store: PathBuf,
+    /// Stale beyond this many seconds.
+    #[arg(long, value_name = "SECONDS", default_value_t = 300.0)]
+    max_age: f64,
+}
+
+pub fn run(command: StationCommand) -> u8 {
+    match command {
+        StationCommand::Run(args) => run_station(&args),
+        StationCommand::Status(args) => status(&args),
+    }
+}
+
+fn run_station(args: &RunArgs) -> u8 {
+    let inputs = match Inputs::from_files(&args.plan, &args.station, args.days) {
+        Ok(i) => i,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            return EXIT_USAGE;
+        }
+    };
+    if !inputs.station.uses_simulation() && !args.sim_outage.is_empty() {
+        eprintln!(
+            "error: --sim-outage is for simulated stations; station {:?} ({}) has real devices",
+            inputs.station.name, inputs.station_label
+        );
+        return EXIT_USAGE;
+    }
+    let options = StationOptions {
+        budget: args.budget.map(|max_bytes| StorageBudget { max_bytes }),
+        ..StationOptions::default()
+    };
+    let wall = Instant::now();
+    let result = if inputs.station.uses_simulation() {
+        run_simulated(args, &inputs, &options)
+    } else {
+        run_real(args, &inputs, &options)
+    };
+    match result {
+        Ok(Ok(report)) => {
+            summary(&args.store, &report, wall.elapsed());
+            EXIT_OK
+        }
+        Ok(Err(failure)) => {
+            summary(&args.store, &failure.report, wall.elapsed());
+            eprintln!("error: {:#}", anyhow::Error::new(failure.error));
+            eprintln!("continue with the same command once it is fixed");
+            EXIT_FAILURE
+        }
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            EXIT_FAILURE
+        }
+    }
+}
+
+type StationResult = std::result::Result<StationReport, unattended::StationFailure>;
+
+/// SIGTERM and SIGINT ask `stop` to stop.
+fn stop_on_signals(stop: &StopHandle) -> Result<()> {
+    use tokio::signal::unix::{SignalKind, signal};
+    let mut term = signal(SignalKind::terminate()).context("listening for SIGTERM")?;
+    let mut int = signal(SignalKind::interrupt()).context("listening for SIGINT")?;
+    let stop = stop.clone();
+    tokio::spawn(async move {
+        tokio::select! {
+            _ = term.recv() => tracing::warn!("SIGTERM: stopping at the next frame boundary"),
+            _ = int.recv() => tracing::warn!("SIGINT: stopping at the next frame boundary"),
+        }
+        stop.request();
+    });
+    Ok(())
+}
+
+/// The station time of the last line journaled in any day session of `store`.
+fn last_journaled(store: &Path) -> Result<Option<DateTime<Utc>>> {
+    let mut last = None;
+    for day in existing_days(store).with_context(|| format!("reading {}", store.display()))? {
+        let dir = unattended::day_rollover::day_dir(store, day);
+        let reader = SessionReader::open(&dir).with_context(|| format!("reading {}", dir.display()))?;
+        last = last.max(reader.entries().iter().map(JournalEntry::time).max());
+    }
+    Ok(last)
+}
+
+fn run_simulated(args: &RunArgs, inputs: &Inputs, options: &StationOptions) -> Result<StationResult> {
+    let Some(first) = inputs.timeline.occurrences.first() else {
+        bail!("the plan has no occurrences: nothing to run");
+    };
+    // The simulated calendar begins a minute before the first occurrence,
+    // or, after a stop, a second after the last journaled line.
+    let origin = match last_journaled(&args.store)? {
+        Some(t) => t + TimeDelta::seconds(1),
+        None => first.start - TimeDelta::seconds(60),
+    };
+    let SimulatedWorld { world, home, seed: _ } = simulated_world(inputs, args.sim_samples, args.sim_bounces)?;
+    let outages = args
+        .sim_outage
+        .iter()
+        .filter_map(|o| {
+            let end = o.start + TimeDelta::from_std(o.duration).ok()?;
+            if end <= origin {
+                return None;
+            }
+            let start = o.start.max(origin);
+            Some(Outage {
+                device: o.device,
+                after: (start - origin).to_std().ok()?,
+                duration: (end - start).to_std().ok()?,
+            })
+        })
+        .collect();
+    let sim_options = SimOptions {
+        origin,
+        position_m: home,
+        faults: FaultPlan {
+            outages,
+            ..FaultPlan::default()
+        },
+        ..SimOptions::default()
+    };
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .start_paused(true)
+        .build()
+        .context("starting the runtime")?;
+    runtime.block_on(async {
+        let stop = StopHandle::new();
+        stop_on_signals(&stop)?;
+        let mut sim = SimStation::start(&inputs.station, world, sim_options)
+            .await
+            .context("starting the simulated station")?;
+        let clock = sim.clock();
+        Ok(unattended::run(
+            &station_inputs(inputs),
+            &args.store,
+            &mut sim,
+            &clock,
+            options,
+            &mut NoProcessing,
+            &stop,
+            &mut NoProgress,
+        )
+        .await)
+    })
+}
+
+fn station_inputs(inputs: &Inputs) -> StationInputs<'_> {
+    StationInputs {
+        timeline: &inputs.timeline,
+        plan: &inputs.plan.plan.value,
+        station: &inputs.station,
+        snapshot: &inputs.snapshot,
+    }
+}
+
+fn run_real(args: &RunArgs, inputs: &Inputs, options: &StationOptions) -> Result<StationResult> {
+    check_ports(&inputs.station).with_context(|| format!("station {}", inputs.station_label))?;
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .context("starting the runtime")?;
+    runtime.block_on(async {
+        let stop = StopHandle::new();
+        stop_on_signals(&stop)?;
+        let camera = open_camera(&inputs.station.camera)
+            .with_context(|| format!("opening the camera of station {}", inputs.station_label))?;
+        let link_seq = (Utc::now().timestamp_subsec_micros() % 4096) as u16 + 1;
+        let rig_options = RigOptions {
+            link_seq,
+            ..RigOptions::default()
+        };
+        let mut rig = StationRig::connect(&inputs.station, SerialOpener, camera, rig_options)
+            .await
+            .with_context(|| format!("connecting the devices of station {}", inputs.station_label))?;
+        Ok(unattended::run(
+            &station_inputs(inputs),
+            &args.store,
+            &mut rig,
+            &SystemClock,
+            options,
+            &mut NoProcessing,
+            &stop,
+            &mut NoProgress,
+        )
+        .await)
+    })
+}
+
+fn summary(store: &Path, r: &StationReport, wall: Duration) {
+    println!("store {}", store.display());
+    println!(
+        "  ended                {}",
+        match r.end {
+            StationEnd::Finished => "every occurrence of the plan's days is settled",
+            StationEnd::Stopped => "stopped on request (run the same command to continue)",
+        }
+    );
+    let days: Vec<String> = r.days.iter().map(|d| d.to_string()).collect();
+    println!("  day sessions         {}", days.join(", "));
+    println!(
+        "  scans                {} run, {} settled earlier",
+        r.occurrences_run, r.occurrences_skipped
+    );
+    println!(
+        "  this run             {} frames, {} missed, {} missed in outages, {} metering captures",
+        r.frames, r.missed, r.missed_in_outages, r.metering_captures
+    );
+    for o in &r.outages {
+        println!(
+            "  outage               {} from {} to {} ({:.1} min)",
+            o.device,
+            o.start.format("%Y-%m-%d %H:%M:%S UTC"),
+            o.end.format("%Y-%m-%d %H:%M:%S UTC"),
+            (o.end - o.start).num_seconds() as f64 / 60.0
+        );
+    }
+    println!(
+        "  pruned               {} frames, {} bytes",
+        r.pruned_frames, r.pruned_bytes
+    );
+    println!("  wall time            {:.1} s", wall.as_secs_f64());
+}
+
+fn status(args: &StatusArgs) -> u8 {
+    let beat = match Heartbeat::read(&args.store) {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return EXIT_FAILURE;
+        }
+    };
+    let age = beat.age_s(Utc::now());
+    let t = |d: DateTime<Utc>| d.format("%Y-%m-%d %H:%M:%S UTC").to_string();
+    println!(
+        "station heartbeat {}",
+        args.store.join(unattended::HEARTBEAT_FILE).display()
+    );
+    let state = serde_json::to_value(beat.state)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_owned))
+        .unwrap_or_default();
+    if beat.detail.is_empty() {
+        println!("  state        {state}");
+    } else {
+        println!("  state        {state}: {}", beat.detail);
+    }
+    println!(
+        "  written      {} station time; {age:.0} s ago on this computer's clock (pid {})",
+        t(beat.written_utc),
+        beat.pid
+    );
+    match (&beat.last_frame_utc, &beat.last_frame_key) {
+        (Some(at), Some(key)) => println!("  last frame   {} {key}", t(*at)),
+        _ => println!("  last frame   none in this run"),
+    }
+    if let (Some(day), Some(dir)) = (beat.day, &beat.session_dir) {
+        println!(
+            "  today        {day}: {} frames in {}",
+            beat.frames_today,
+            dir.display()
+        );
+    }
+    for d in &beat.devices {
+        let line = match &d.state {
+            DeviceState::Unknown => "not asked yet".to_owned(),
+            DeviceState::Up { last_answer } => format!("up (last answer {})", t(*last_answer)),
+            DeviceState::Down { since, error, probes } => {
+                format!("DOWN since {} ({probes} failed probes): {error}", t(*since))
+            }
+        };
+        println!("  {:<12} {line}", d.device);
+    }
+    let mb = |b: u64| format!("{:.1} MB", b as f64 / 1e6);
+    println!(
+        "  disk         {} free; the store holds {}{}",
+        beat.free_disk_bytes.map_or("unknown".to_owned(), mb),
+        mb(beat.store_bytes),
+        beat.budget_bytes
+            .map_or(String::new(), |b| format!(" of a {} budget", mb(b)))
+    );
+    if age > args.max_age {
+        println!(
+            "STALE: written {age:.0} s ago, more than --max-age {:.0} s: the station is not running or is stuck",
+            args.max_age
+        );
+        EXIT_FAILURE
+    } else {
+        println!("fresh: written {age:.0} s ago (--max-age {:.0} s)", args.max_age);
+        EXIT_OK
+    }
+}
