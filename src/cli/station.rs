@@ -19,7 +19,12 @@ use chrono::{DateTime, TimeDelta, Utc};
 use clap::{Args, Subcommand};
 
 use super::capture::{Inputs, SimulatedWorld, simulated_world};
+use super::process::sky_series::{SkySeriesOptions, process_scan, recompute_day};
 use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
+use campanile_capture::schedule::Occurrence;
+use campanile_capture::store::PROCESSED_DIR;
+use campanile_capture::unattended::ScanHook;
+use campanile_process::hdr::debevec::DebevecOptions;
 
 #[derive(Debug, Subcommand)]
 pub enum StationCommand {
@@ -49,10 +54,13 @@ pub enum StationCommand {
 /// --budget: when the store holds more (frames and journals), the oldest
 /// raw frames of scans whose processed products exist (listed in their
 /// day's processed/products.ron) are deleted, journaled `pruned` and
-/// logged. This build does not process scans itself yet, so only scans
-/// listed by `campanile process` are deletable; with none, a warning is
-/// logged and capture goes on until the disk is full (then the run stops
-/// cleanly, exit 1; rerun once there is room).
+/// logged. With --process the station processes each scan as it finishes
+/// (the sky time series of `campanile process`: per-scan sun, sky fits and
+/// flags into the day's processed/, the day's CSV, extinction and plots
+/// recomputed), so its frames become deletable; without it only scans
+/// listed by a separate `campanile process` are. With nothing deletable, a
+/// warning is logged and capture goes on until the disk is full (then the
+/// run stops cleanly, exit 1; rerun once there is room).
 ///
 /// Exposures of the sky tiles are planned across the day from a clear-sky
 /// model and damped from scan to scan (at most 0.5 stop per scan).
@@ -81,6 +89,14 @@ pub struct RunArgs {
     /// Storage budget, e.g. 2GB, 500MiB (see above).
     #[arg(long, value_name = "SIZE", value_parser = parse_bytes)]
     budget: Option<u64>,
+    /// Process each scan as it finishes, into its day's processed/ (see
+    /// above). Needs --response.
+    #[arg(long, requires = "response")]
+    process: bool,
+    /// The camera's response curve for --process: a CSV from `campanile hdr
+    /// calibrate`, or a session's processed/response.csv.
+    #[arg(long, value_name = "CSV")]
+    response: Option<PathBuf>,
     /// Run only the first N days of the plan.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     days: Option<u32>,
@@ -291,12 +307,41 @@ fn run_simulated(args: &RunArgs, inputs: &Inputs, options: &StationOptions) -> R
             &mut sim,
             &clock,
             options,
-            &mut NoProcessing,
+            hook(args).as_mut(),
             &stop,
             &mut NoProgress,
         )
         .await)
     })
+}
+
+/// The sky time series of `campanile process`, run on each finished scan.
+struct SkySeriesHook {
+    response: PathBuf,
+}
+
+impl ScanHook for SkySeriesHook {
+    fn on_occurrence_done(&mut self, session_dir: &Path, occurrence: &Occurrence) -> std::result::Result<(), String> {
+        let opts = SkySeriesOptions {
+            out: session_dir.join(PROCESSED_DIR),
+            response: Some(self.response.clone()),
+            shard: None,
+            debevec: DebevecOptions::default(),
+        };
+        process_scan(session_dir, &occurrence.key, &opts).map_err(|e| format!("{e:#}"))?;
+        recompute_day(&opts.out).map_err(|e| format!("{e:#}"))?;
+        Ok(())
+    }
+}
+
+/// The scan hook `args` ask for.
+fn hook(args: &RunArgs) -> Box<dyn ScanHook> {
+    match (&args.response, args.process) {
+        (Some(response), true) => Box::new(SkySeriesHook {
+            response: response.clone(),
+        }),
+        _ => Box::new(NoProcessing),
+    }
 }
 
 fn station_inputs(inputs: &Inputs) -> StationInputs<'_> {
@@ -333,7 +378,7 @@ fn run_real(args: &RunArgs, inputs: &Inputs, options: &StationOptions) -> Result
             &mut rig,
             &SystemClock,
             options,
-            &mut NoProcessing,
+            hook(args).as_mut(),
             &stop,
             &mut NoProgress,
         )
