@@ -12,7 +12,7 @@
 //!   `delta_s`: the indirect specular term (§4.5.1); `ward_fit`: golden
 //!   section / downhill simplex + linear least squares (App. A);
 //!   [`highlight`]: highlight detection (Fig. 4.4); `recover`: the ΔS loop
-//!   and model choice.
+//!   and model choice; `stratified`: the strata of the Monte Carlo rays.
 //!
 //! Ward normalization: the solver fits the lobe in the variant
 //! [`IgiOptions::variant`] names, by default
@@ -31,6 +31,7 @@ mod observation;
 mod radiosity;
 mod recover;
 mod specular_albedo;
+mod stratified;
 pub mod table;
 mod ward_fit;
 

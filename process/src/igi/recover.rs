@@ -21,7 +21,7 @@ use super::observation::{DroppedPixels, Observation, observations};
 use super::radiosity::RadiosityField;
 use super::specular_albedo::SpecularAlbedo;
 use super::ward_fit::{FitSample, Shape, anisotropic, isotropic, linear_fit};
-use crate::brdf::{WardLobe, WardMaterial, WardVariant};
+use crate::brdf::{WardKernel, WardLobe, WardMaterial, WardVariant};
 use crate::model_choice::bic;
 
 /// The model chosen for a surface.
@@ -81,12 +81,21 @@ pub struct SurfaceResult {
 }
 
 /// One ΔS iteration's convergence.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct IterationReport {
     /// Largest relative change of any ρd, ρs, αx or αy from the previous pass.
     pub max_relative_change: f64,
     /// Wall time of the pass, seconds.
     pub seconds: f64,
+    /// Of which: gathering the indirect irradiance (step 2).
+    pub gather_seconds: f64,
+    /// Estimating ΔS at every sample (step 3).
+    pub delta_s_seconds: f64,
+    /// Highlight detection (first pass) and refitting every surface (step 4).
+    pub fit_seconds: f64,
+    /// Every surface's estimate after the pass (`None`: unobserved), so
+    /// that error against iterations can be read from one run.
+    pub materials: Vec<Option<WardMaterial>>,
 }
 
 /// Everything [`recover`] found.
@@ -189,7 +198,10 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
             .map(|m| m.and_then(|m| m.lobe).map(|l| SpecularAlbedo::new(&l)))
             .collect();
         // (2) Indirect irradiance per cell.
+        let tt = Instant::now();
         field.gather(&geometry, input, &materials, &albedos, options.gather_rays, seed);
+        let gather_seconds = tt.elapsed().as_secs_f64();
+        let tt = Instant::now();
         // (3) ΔS at every sample.
         kind_ind = indirect_specular(
             &geometry,
@@ -202,6 +214,8 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
             options.lobe_rays,
             seed ^ 0x5555,
         );
+        let delta_s_seconds = tt.elapsed().as_secs_f64();
+        let tt = Instant::now();
         if it == 0 {
             for s in 0..n_surf {
                 let samples: Vec<DetectorSample> = by_surface[s]
@@ -239,6 +253,7 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
                 fit_surface(&samples, &sparse, &highlights[s], options, previous.get(s))
             })
             .collect();
+        let fit_seconds = tt.elapsed().as_secs_f64();
         let mut change: f64 = 0.0;
         for (s, f) in fits.iter().enumerate() {
             if let (Some(new), Some(old)) = (&f.material, &materials[s]) {
@@ -253,6 +268,10 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
         iterations.push(IterationReport {
             max_relative_change: change,
             seconds: t0.elapsed().as_secs_f64(),
+            gather_seconds,
+            delta_s_seconds,
+            fit_seconds,
+            materials: materials.clone(),
         });
     }
 
@@ -318,6 +337,9 @@ struct SurfaceFit {
     sparse: usize,
     bic: [Option<f64>; 3],
     rms: f64,
+    /// The best anisotropic shape found (chosen or not): the next pass's
+    /// simplex starts from it.
+    anisotropic: Option<Shape>,
 }
 
 impl Default for SurfaceFit {
@@ -329,6 +351,7 @@ impl Default for SurfaceFit {
             sparse: 0,
             bic: [None; 3],
             rms: 0.0,
+            anisotropic: None,
         }
     }
 }
@@ -345,8 +368,9 @@ fn specular_radiance(o: &Observation, m: Option<&WardMaterial>, kind: [f64; 3]) 
         return [0.0; 3];
     };
     let mut s = kind;
+    let kernel = WardKernel::new(&lobe);
     for t in &o.lights {
-        let k = lobe.kernel(&t.wi, &o.wo);
+        let k = kernel.eval(&t.wi, &o.wo);
         for c in 0..3 {
             s[c] += k * t.irradiance[c];
         }
@@ -512,6 +536,7 @@ fn fit_surface(
             sparse: sparse.len(),
             bic: [Some(bic_d), None, None],
             rms: rms(fit.error, dense.len()),
+            anisotropic: None,
         };
     }
     let (alpha, iso, _) = isotropic(sparse, variant, 25);
@@ -523,6 +548,7 @@ fn fit_surface(
     };
     let mut model = SurfaceModel::Isotropic;
     let mut bic_a = None;
+    let mut aniso_shape = None;
     let mut reason = format!(
         "isotropic: {} highlight(s) seen; BIC diffuse {:.1}, isotropic {:.1}",
         seen.len(),
@@ -530,19 +556,12 @@ fn fit_surface(
         bic_i
     );
     if options.allow_anisotropic {
-        let prev_aniso = previous
-            .filter(|p| p.model == SurfaceModel::Anisotropic)
-            .and_then(|p| p.material)
-            .and_then(|m| m.lobe);
-        let (starts, step) = match prev_aniso {
-            Some(l) => (
-                vec![Shape {
-                    alpha_x: l.alpha_x,
-                    alpha_y: l.alpha_y,
-                    gamma_rad: l.gamma_rad,
-                }],
-                0.1,
-            ),
+        // The first pass searches from four orientations; later passes
+        // refine the previous pass's best anisotropic shape (the
+        // roughness moves by a few per cent between passes), which costs a
+        // quarter of the evaluations.
+        let (starts, step) = match previous.and_then(|p| p.anisotropic) {
+            Some(shape) => (vec![shape], 0.1),
             None => (
                 [0.0, 45.0, 90.0, 135.0]
                     .iter()
@@ -556,6 +575,7 @@ fn fit_surface(
             ),
         };
         let (shape, aniso, _) = anisotropic(sparse, variant, &starts, step);
+        aniso_shape = Some(shape);
         let b = bic(aniso.error, n, 9);
         bic_a = Some(b);
         let ratio = shape.alpha_x.max(shape.alpha_y) / shape.alpha_x.min(shape.alpha_y);
@@ -613,6 +633,7 @@ fn fit_surface(
         sparse: sparse.len(),
         bic: [Some(bic_d), Some(bic_i), bic_a],
         rms: rms(fit.error, dense.len()),
+        anisotropic: aniso_shape,
     }
 }
 
