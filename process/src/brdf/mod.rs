@@ -40,7 +40,8 @@
 //! - [`table_4_1`]: the thesis's six test surfaces.
 //!
 //! What does not: conversion between Ward variants (no exact one exists:
-//! [`WardLobe::to_variant`] refuses), `plastic2` and `metal` export,
+//! [`WardLobe::to_variant`] refuses), `plastic2` and `metal` export (see
+//! [`crate::material_export`] for those and for Mitsuba 3),
 //! RADIANCE's widening of α by the light's solid angle, Fresnel terms, and
 //! transmission.
 

@@ -39,5 +39,7 @@ pub use camera::ViewCamera;
 pub use error::IgiError;
 pub use input::{IgiInput, IgiLight, IgiOptions, View};
 pub use observation::DroppedPixels;
-pub use recover::{IgiResult, IterationReport, SpecularKind, SurfaceModel, SurfaceResult, canonical_lobe, recover};
+pub use recover::{
+    IgiResult, IterationReport, SpecularKind, SurfaceModel, SurfaceResult, canonical_lobe, recover, specular_kind,
+};
 pub use table::format_table;

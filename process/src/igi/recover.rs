@@ -283,18 +283,7 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
                 Some(m) => energy(m),
                 None => ([0.0; 2], true),
             };
-            let kind = match material.and_then(|m| m.lobe) {
-                None => SpecularKind::None,
-                Some(l) => {
-                    let mean_s = l.rho_s.iter().sum::<f64>();
-                    let mean_d = material.map_or(0.0, |m| m.rho_d.iter().sum::<f64>());
-                    if mean_s > mean_d {
-                        SpecularKind::Metal
-                    } else {
-                        SpecularKind::Plastic
-                    }
-                }
-            };
+            let kind = material.as_ref().map_or(SpecularKind::None, specular_kind);
             SurfaceResult {
                 name: input.surfaces[s].clone(),
                 model: if by_surface[s].is_empty() {
@@ -637,6 +626,16 @@ fn fit_surface(
     }
 }
 
+/// Plastic or metal by App. A's test: a lobe whose ρs (summed over the
+/// channels) exceeds ρd is a metal's.
+pub fn specular_kind(m: &WardMaterial) -> SpecularKind {
+    match m.lobe {
+        None => SpecularKind::None,
+        Some(l) if l.rho_s.iter().sum::<f64>() > m.rho_d.iter().sum::<f64>() => SpecularKind::Metal,
+        Some(_) => SpecularKind::Plastic,
+    }
+}
+
 /// Largest relative change of the parameters between two estimates.
 fn relative_change(a: &WardMaterial, b: &WardMaterial) -> f64 {
     let rel = |x: f64, y: f64| if y.abs() > 0.0 { ((x - y) / y).abs() } else { x.abs() };
@@ -667,4 +666,78 @@ fn energy(m: &WardMaterial) -> ([f64; 2], bool) {
     let a = [at(0.0), at(60f64.to_radians())];
     let sum_ok = (0..3).all(|c| m.rho_d[c] + m.lobe.map_or(0.0, |l| l.rho_s[c]) <= 1.0);
     (a, sum_ok && a.iter().all(|&v| v <= 1.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_canonical_representation_is_the_same_lobe_with_gamma_below_90_degrees() {
+        let lobe = WardLobe::new([0.1; 3], 0.3, 0.05, 100f64.to_radians(), WardVariant::Ward1992).unwrap();
+        let c = canonical_lobe(lobe);
+        assert!(
+            (c.alpha_x - 0.05).abs() < 1e-15 && (c.alpha_y - 0.3).abs() < 1e-15,
+            "{c:?}"
+        );
+        assert!((c.gamma_rad.to_degrees() - 10.0).abs() < 1e-9, "{c:?}");
+        let pairs: [(Vector3<f64>, Vector3<f64>); 3] = [
+            (Vector3::new(0.3, 0.2, 0.0), Vector3::new(-0.25, -0.1, 0.0)),
+            (Vector3::new(-0.5, 0.1, 0.0), Vector3::new(0.4, 0.05, 0.0)),
+            (Vector3::new(0.1, -0.6, 0.0), Vector3::new(0.0, 0.5, 0.0)),
+        ];
+        for (wi, wo) in pairs {
+            let wi = Vector3::new(wi.x, wi.y, (1.0 - wi.norm_squared()).sqrt());
+            let wo = Vector3::new(wo.x, wo.y, (1.0 - wo.norm_squared()).sqrt());
+            let (a, b) = (lobe.kernel(&wi, &wo), c.kernel(&wi, &wo));
+            assert!((a - b).abs() <= 1e-12 * a.abs().max(1e-30), "{a} vs {b}");
+        }
+        // γ + 180° is the same lobe too.
+        let turned = canonical_lobe(WardLobe {
+            gamma_rad: lobe.gamma_rad + std::f64::consts::PI,
+            ..lobe
+        });
+        assert!((turned.gamma_rad - c.gamma_rad).abs() < 1e-12 && turned.alpha_x == c.alpha_x);
+    }
+
+    #[test]
+    fn the_energy_bound_flags_a_material_reflecting_more_than_it_receives() {
+        let lobe = |rho_s: f64| {
+            Some(WardLobe {
+                rho_s: [rho_s; 3],
+                alpha_x: 0.1,
+                alpha_y: 0.1,
+                gamma_rad: 0.0,
+                variant: WardVariant::Ward1992,
+            })
+        };
+        let ok = WardMaterial {
+            rho_d: [0.2; 3],
+            lobe: lobe(0.05),
+        };
+        let (a, good) = energy(&ok);
+        // ρd + ρs (1 − 3α² + 11α⁴) at normal incidence (brdf::ward's series).
+        assert!((a[0] - (0.2 + 0.05 * 0.9711)).abs() < 2e-3, "{a:?}");
+        assert!(good);
+        // Not a valid WardMaterial (ρd + ρs = 1.2): built directly to check the bound.
+        let bad = WardMaterial {
+            rho_d: [0.7; 3],
+            lobe: lobe(0.5),
+        };
+        let (a, good) = energy(&bad);
+        assert!((a[0] - (0.7 + 0.5 * 0.9711)).abs() < 2e-3, "{a:?}");
+        assert!(!good);
+    }
+
+    #[test]
+    fn plastic_and_metal_by_the_appendix_a_test() {
+        let m = |d: f64, s: Option<f64>| WardMaterial {
+            rho_d: [d; 3],
+            lobe: s.map(|s| WardLobe::isotropic([s; 3], 0.1, WardVariant::Ward1992).unwrap()),
+        };
+        assert_eq!(specular_kind(&m(0.2, Some(0.05))), SpecularKind::Plastic);
+        assert_eq!(specular_kind(&m(0.0, Some(0.8))), SpecularKind::Metal);
+        assert_eq!(specular_kind(&m(0.05, Some(0.6))), SpecularKind::Metal);
+        assert_eq!(specular_kind(&m(0.3, None)), SpecularKind::None);
+    }
 }
