@@ -151,7 +151,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
     // Indoors: the thesis's cube.
     eprintln!("recovering the cube's BRDFs (inverse global illumination) …");
     let (px, samples) = if args.quick { (64, 16) } else { (96, 32) };
-    let cube = indoor::cube(px, samples)?;
+    let cube = indoor::cube(px, samples, &args.out)?;
     sections.push(cube.section);
     let rows = &mut speed.tables[0].rows;
     rows.insert(
