@@ -137,6 +137,8 @@ pub fn cube(wide_px: usize, indirect_samples: u32, out_dir: &Path) -> Result<Cub
                 100.0 * worst,
                 worst_gamma
             ),
+            "The recovered materials are written beside this report as RADIANCE primitives (cube-materials.rad: plastic, plastic2, metal, metal2) and Mitsuba 3 XML (cube-materials.xml), each with its conversion noted in comments."
+                .into(),
             "Not yet: the room session (light triangulation, albedo maps, relighting) — see the README's status table."
                 .into(),
         ],
