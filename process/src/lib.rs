@@ -15,6 +15,7 @@ pub mod exr_io;
 pub mod hdr;
 pub mod igi;
 pub mod irradiance;
+pub mod material_export;
 pub mod model_choice;
 pub mod outdoor;
 pub mod pipeline;

@@ -5,7 +5,7 @@
 //! `cargo run --release -p campanile-sim --example igi_cube [-- SAMPLES ITERATIONS [GATHER_RAYS LOBE_RAYS CELLS SEED [WIDE_PX HIGHLIGHT_PX [SPARSE]]]]`
 //!
 //! SAMPLES: indirect samples per pixel of the photographs (32); ITERATIONS:
-//! ΔS iterations (4); then the solver's gather rays per cell (256), lobe
+//! ΔS iterations (3, the solver's default); then the solver's gather rays per cell (256), lobe
 //! rays per sample (16), cells per triangle edge (24) and seed (1); then
 //! the sizes of the wide and highlight views (96 and 64 pixels square), and
 //! the sparse set's size per surface (2500).
@@ -20,7 +20,10 @@ use campanile_sim::world::igi_photograph::PhotoSettings;
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let samples: u32 = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(32);
-    let iterations: u32 = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(4);
+    let iterations: u32 = args
+        .get(2)
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(IgiOptions::default().iterations);
     let size = |i: usize, default: usize| args.get(i).and_then(|a| a.parse().ok()).unwrap_or(default);
     let cube = CubeRoom::new(1.0);
     let t0 = Instant::now();

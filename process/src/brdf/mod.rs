@@ -40,7 +40,8 @@
 //! - [`table_4_1`]: the thesis's six test surfaces.
 //!
 //! What does not: conversion between Ward variants (no exact one exists:
-//! [`WardLobe::to_variant`] refuses), `plastic2` and `metal` export,
+//! [`WardLobe::to_variant`] refuses), `plastic2` and `metal` export (see
+//! [`crate::material_export`] for those and for Mitsuba 3),
 //! RADIANCE's widening of α by the light's solid angle, Fresnel terms, and
 //! transmission.
 
@@ -63,4 +64,4 @@ pub use quadrature::HemisphereQuadrature;
 pub use radiance_plastic::RadiancePlastic;
 pub use sample::Sample;
 pub use table_4_1::table_4_1;
-pub use ward::{MIN_ALPHA, WardLobe, WardVariant};
+pub use ward::{MIN_ALPHA, WardKernel, WardLobe, WardVariant};

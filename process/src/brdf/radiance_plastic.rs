@@ -10,8 +10,8 @@
 //!
 //! Not handled: RADIANCE widens α² by the light source's solid angle over
 //! 4π on flat surfaces when rendering; that is the renderer's business and
-//! is not undone here. `plastic2` (anisotropic) and `metal` (coloured
-//! specular) are not implemented.
+//! is not undone here. `plastic2` (anisotropic), `metal` and `metal2`
+//! (coloured specular), and whole material files: [`crate::material_export`].
 
 use super::error::BrdfError;
 use super::material::WardMaterial;

@@ -9,7 +9,7 @@
 //! The lobe is the current roughness estimate, held fixed while ρd, ρs and
 //! α are refitted, and the whole is iterated (Fig. 4.6).
 
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
@@ -18,7 +18,8 @@ use super::input::IgiInput;
 use super::observation::Observation;
 use super::radiosity::{REFLECTION_DEPTH, RadiosityField};
 use super::specular_albedo::SpecularAlbedo;
-use crate::brdf::{WardLobe, WardMaterial};
+use super::stratified::Strata;
+use crate::brdf::{WardKernel, WardLobe, WardMaterial};
 use crate::render::Ray;
 
 /// `S_ind` per channel for every observation, with the lobe shape
@@ -35,7 +36,6 @@ pub(crate) fn indirect_specular(
     rays: u32,
     seed: u64,
 ) -> Vec<[f64; 3]> {
-    let side = (f64::from(rays)).sqrt().ceil() as u32;
     observations
         .par_iter()
         .enumerate()
@@ -43,16 +43,14 @@ pub(crate) fn indirect_specular(
             let Some(lobe) = shapes.get(o.surface).copied().flatten() else {
                 return [0.0; 3];
             };
+            let kernel = WardKernel::new(&lobe);
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             rng.set_stream(i as u64);
+            let strata = Strata::new(rays, &mut rng);
             let mut sum = [0.0; 3];
             let origin = o.point + o.frame.normal * SURFACE_OFFSET * (1.0 + o.point.norm());
             for r in 0..rays {
-                let (sx, sy) = (r % side, (r / side) % side);
-                let u = [
-                    (f64::from(sx) + rng.random::<f64>()) / f64::from(side),
-                    (f64::from(sy) + rng.random::<f64>()) / f64::from(side),
-                ];
+                let u = strata.point(r, &mut rng);
                 let Some(wi) = lobe.sample(&o.wo, u) else {
                     continue;
                 };
@@ -60,7 +58,7 @@ pub(crate) fn indirect_specular(
                 if !(pdf > 0.0 && pdf.is_finite()) {
                     continue;
                 }
-                let weight = lobe.kernel(&wi, &o.wo) * wi.z / pdf;
+                let weight = kernel.eval(&wi, &o.wo) * wi.z / pdf;
                 let direction = o.frame.to_world(&wi);
                 let Some(hit) = geometry.intersect(&Ray { origin, direction }, f64::INFINITY) else {
                     continue;

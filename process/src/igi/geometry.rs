@@ -22,6 +22,8 @@ pub(crate) struct Geometry {
     scene: Scene,
     /// Per triangle: corner 0, the edges, and the inverse Gram matrix.
     corners: Vec<Corner>,
+    /// Per triangle, the shading frames on the side of its normal and on the other side.
+    frames: Vec<[ShadingFrame; 2]>,
     /// Cells per triangle edge.
     pub n: usize,
 }
@@ -50,12 +52,21 @@ impl Geometry {
                 (t.vertices[0], e1, e2, [c / det, -b / det, a / det])
             })
             .collect();
+        let frames = tris
+            .iter()
+            .map(|t| [t.normal, -t.normal].map(|n| shading_frame(n, t.texture_axes[0])))
+            .collect();
         let scene = Scene::new(
             tris,
             vec![Material::diffuse("placeholder", [0.0; 3])],
             surfaces.to_vec(),
         )?;
-        Ok(Geometry { scene, corners, n })
+        Ok(Geometry {
+            scene,
+            corners,
+            frames,
+            n,
+        })
     }
 
     /// The triangles.
@@ -128,17 +139,19 @@ impl Geometry {
     /// (tangent = the face's texture `s` axis, as the renderer uses).
     pub fn frame(&self, tri: usize, toward: &Vector3<f64>) -> ShadingFrame {
         let t = &self.triangles()[tri];
-        let n = if t.normal.dot(toward) >= 0.0 {
-            t.normal
-        } else {
-            -t.normal
-        };
-        ShadingFrame::new(n, t.texture_axes[0]).unwrap_or(ShadingFrame {
-            normal: Vector3::z(),
-            tangent: Vector3::x(),
-            bitangent: Vector3::y(),
-        })
+        self.frames[tri][usize::from(t.normal.dot(toward) < 0.0)]
     }
+}
+
+/// The shading frame with normal `n` and tangent `tangent` (the face's
+/// texture `s` axis, as the renderer uses), or the world frame if `n` is
+/// degenerate.
+fn shading_frame(n: Vector3<f64>, tangent: Vector3<f64>) -> ShadingFrame {
+    ShadingFrame::new(n, tangent).unwrap_or(ShadingFrame {
+        normal: Vector3::z(),
+        tangent: Vector3::x(),
+        bitangent: Vector3::y(),
+    })
 }
 
 #[cfg(test)]

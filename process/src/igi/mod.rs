@@ -12,7 +12,7 @@
 //!   `delta_s`: the indirect specular term (§4.5.1); `ward_fit`: golden
 //!   section / downhill simplex + linear least squares (App. A);
 //!   [`highlight`]: highlight detection (Fig. 4.4); `recover`: the ΔS loop
-//!   and model choice.
+//!   and model choice; `stratified`: the strata of the Monte Carlo rays.
 //!
 //! Ward normalization: the solver fits the lobe in the variant
 //! [`IgiOptions::variant`] names, by default
@@ -36,6 +36,7 @@ pub mod relight;
 pub mod relit_scene;
 pub mod scene_file;
 mod specular_albedo;
+mod stratified;
 pub mod table;
 mod ward_fit;
 
@@ -43,5 +44,7 @@ pub use camera::ViewCamera;
 pub use error::IgiError;
 pub use input::{IgiInput, IgiLight, IgiOptions, View};
 pub use observation::DroppedPixels;
-pub use recover::{IgiResult, IterationReport, SpecularKind, SurfaceModel, SurfaceResult, canonical_lobe, recover};
+pub use recover::{
+    IgiResult, IterationReport, SpecularKind, SurfaceModel, SurfaceResult, canonical_lobe, recover, specular_kind,
+};
 pub use table::format_table;

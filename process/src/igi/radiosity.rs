@@ -29,7 +29,8 @@ use super::geometry::{Geometry, SURFACE_OFFSET};
 use super::input::IgiInput;
 use super::observation::light_terms;
 use super::specular_albedo::SpecularAlbedo;
-use crate::brdf::{WardMaterial, cosine_direction};
+use super::stratified::Strata;
+use crate::brdf::{WardKernel, WardMaterial, cosine_direction};
 use crate::render::Ray;
 
 /// Glossy reflections followed per gather ray (module doc of
@@ -114,6 +115,7 @@ impl RadiosityField {
         };
         let frame = geometry.frame(tri, toward);
         let wo = frame.to_local(toward);
+        let kernel = WardKernel::new(&lobe);
         let mut k = [0.0; 3];
         for &li in &self.visible[cell] {
             let light = &input.lights[li];
@@ -123,9 +125,9 @@ impl RadiosityField {
             if wi.z <= 0.0 {
                 continue;
             }
-            let kernel = lobe.kernel(&wi, &wo) * wi.z / d2;
+            let kd = kernel.eval(&wi, &wo) * wi.z / d2;
             for c in 0..3 {
-                k[c] += kernel * light.intensity[c];
+                k[c] += kd * light.intensity[c];
             }
         }
         let reflected = if depth > 0 {
@@ -134,7 +136,7 @@ impl RadiosityField {
             if let Some(wi) = lobe.sample(&wo, u) {
                 let pdf = lobe.pdf(&wi, &wo);
                 if pdf > 0.0 && pdf.is_finite() {
-                    let weight = lobe.kernel(&wi, &wo) * wi.z / pdf;
+                    let weight = kernel.eval(&wi, &wo) * wi.z / pdf;
                     let direction = frame.to_world(&wi);
                     let origin = y + frame.normal * SURFACE_OFFSET * (1.0 + y.norm());
                     if let Some(hit) = geometry.intersect(&Ray { origin, direction }, f64::INFINITY) {
@@ -175,7 +177,6 @@ impl RadiosityField {
         rays: u32,
         seed: u64,
     ) {
-        let side = (f64::from(rays)).sqrt().ceil() as u32;
         let e: Vec<[f64; 3]> = (0..geometry.cell_count())
             .into_par_iter()
             .map(|cell| {
@@ -186,6 +187,7 @@ impl RadiosityField {
                 let frame = geometry.frame(tri, &self.side[tri]);
                 let mut rng = ChaCha8Rng::seed_from_u64(seed);
                 rng.set_stream(cell as u64);
+                let strata = Strata::new(rays, &mut rng);
                 let mut sum = [0.0; 3];
                 let mut count = 0u32;
                 for r in 0..rays {
@@ -194,11 +196,7 @@ impl RadiosityField {
                         continue;
                     };
                     count += 1;
-                    let (sx, sy) = (r % side, (r / side) % side);
-                    let u = [
-                        (f64::from(sx) + rng.random::<f64>()) / f64::from(side),
-                        (f64::from(sy) + rng.random::<f64>()) / f64::from(side),
-                    ];
+                    let u = strata.point(r, &mut rng);
                     let Some(d) = cosine_direction(u) else {
                         continue;
                     };

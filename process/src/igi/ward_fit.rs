@@ -15,7 +15,7 @@
 
 use nalgebra::Vector3;
 
-use crate::brdf::{MIN_ALPHA, WardLobe, WardVariant};
+use crate::brdf::{MIN_ALPHA, WardKernel, WardLobe, WardVariant};
 
 /// One observation as the fit sees it.
 #[derive(Debug, Clone, PartialEq)]
@@ -66,15 +66,16 @@ pub(crate) struct LinearFit {
 
 /// The specular coefficient of each sample for a lobe, per channel.
 fn specular_coefficients(samples: &[FitSample], lobe: Option<&WardLobe>) -> Vec<[f64; 3]> {
+    let kernel = lobe.map(WardKernel::new);
     samples
         .iter()
         .map(|s| {
-            let Some(lobe) = lobe else {
+            let Some(kernel) = kernel else {
                 return [0.0; 3];
             };
             let mut k = s.indirect;
             for (wi, e) in &s.lights {
-                let kern = lobe.kernel(wi, &s.wo);
+                let kern = kernel.eval(wi, &s.wo);
                 if kern > 0.0 {
                     for c in 0..3 {
                         k[c] += kern * e[c];

@@ -159,7 +159,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
     // Indoors: the thesis's cube.
     eprintln!("recovering the cube's BRDFs (inverse global illumination) …");
     let (px, samples) = if args.quick { (64, 16) } else { (96, 32) };
-    let cube = indoor::cube(px, samples)?;
+    let cube = indoor::cube(px, samples, &args.out)?;
     sections.push(cube.section);
     eprintln!("the room: lamps, BRDFs, albedo maps, relit under new lamps …");
     let room = room::room(&args.out, args.quick)?;
