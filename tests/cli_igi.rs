@@ -47,6 +47,15 @@ fn igi_recovers_the_simulated_room_from_its_scene_file_and_relights_it() {
     assert!(stdout.contains("rho_d") && stdout.contains("Anisotropic"), "{stdout}");
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    // The recovered materials exported: the anisotropic board as RADIANCE
+    // plastic2 or metal2, and every exported surface in the Mitsuba file.
+    let rad = std::fs::read_to_string(out.join("materials.rad")).unwrap();
+    let xml = std::fs::read_to_string(out.join("materials.xml")).unwrap();
+    assert!(rad.contains("plastic2") || rad.contains("metal2"), "{rad}");
+    for line in rad.lines().filter(|l| l.starts_with("void ")) {
+        let name = line.split_whitespace().nth(2).unwrap();
+        assert!(xml.contains(&format!("id=\"{name}\"")), "{name} missing from materials.xml");
+    }
     // The lamps, triangulated from their bulbs' images: within 2 mm and 5 %.
     for (name, bulb) in &room.lamps {
         let l = summary["lights"]

@@ -23,6 +23,8 @@ use clap::Args;
 /// of their bulbs to triangulate) and EXR radiance images with optional
 /// masks; the README documents the format. Writes to --out:
 /// materials.txt (Table 4.1's layout, with each surface's model and why),
+/// materials.rad (RADIANCE plastic/plastic2/metal/metal2) and materials.xml
+/// (Mitsuba 3; see the README for the conversions),
 /// summary.json, albedo/GROUP.exr for each planar OBJ group, and with
 /// --relight LIGHTS.ron, relit-CAMERA.exr for every camera with an image.
 ///
@@ -190,6 +192,53 @@ fn summary(r: &Recovered, albedo: &[String]) -> serde_json::Value {
 }
 
 /// Runs `campanile igi`.
+/// Writes the recovered materials of `result` as RADIANCE (`STEM.rad`) and
+/// Mitsuba 3 (`STEM.xml`) files in `dir`. Each surface's shading frame (for
+/// an anisotropic lobe's γ) is its first triangle's, with the normal turned
+/// toward `inside` (a point the photographs were taken from) and the
+/// texture `s` axis as tangent.
+pub fn write_material_files(
+    triangles: &[campanile_process::render::Triangle],
+    inside: &nalgebra::Vector3<f64>,
+    result: &IgiResult,
+    dir: &Path,
+    stem: &str,
+) -> Result<()> {
+    use campanile_process::brdf::ShadingFrame;
+    use campanile_process::material_export::{ExportMaterial, write_mitsuba, write_radiance};
+    let mut list = Vec::new();
+    for (s, surface) in result.surfaces.iter().enumerate() {
+        let Some(material) = &surface.material else {
+            continue;
+        };
+        let mut m = ExportMaterial::new(&surface.name, material);
+        if let Some(t) = triangles.iter().find(|t| t.surface as usize == s) {
+            let n = if t.normal.dot(&(inside - t.vertices[0])) >= 0.0 {
+                t.normal
+            } else {
+                -t.normal
+            };
+            if let Ok(frame) = ShadingFrame::new(n, t.texture_axes[0]) {
+                m = m.with_frame(frame);
+            }
+        }
+        list.push(m);
+    }
+    for (ext, radiance) in [("rad", true), ("xml", false)] {
+        let path = dir.join(format!("{stem}.{ext}"));
+        let mut out = std::io::BufWriter::new(
+            std::fs::File::create(&path).with_context(|| format!("{}: cannot create", path.display()))?,
+        );
+        if radiance {
+            write_radiance(&list, &mut out)
+        } else {
+            write_mitsuba(&list, &mut out)
+        }
+        .with_context(|| format!("{}: writing the recovered materials", path.display()))?;
+    }
+    Ok(())
+}
+
 pub fn run(args: IgiArgs) -> Result<()> {
     let r = recover_scene(&args.scene, args.quick).with_context(|| format!("reading {}", args.scene.display()))?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
@@ -210,11 +259,14 @@ pub fn run(args: IgiArgs) -> Result<()> {
     let materials = args.out.join("materials.txt");
     std::fs::write(&materials, &table).with_context(|| format!("writing {}", materials.display()))?;
     let albedo = write_albedo_maps(&r, &args.out.join("albedo"))?;
+    let cameras = &r.loaded.cameras;
+    let inside = cameras.iter().map(|(_, c)| c.position).sum::<nalgebra::Vector3<f64>>() / cameras.len().max(1) as f64;
+    write_material_files(&r.loaded.input.triangles, &inside, &r.result, &args.out, "materials")?;
     let json = args.out.join("summary.json");
     std::fs::write(&json, serde_json::to_string_pretty(&summary(&r, &albedo))?)
         .with_context(|| format!("writing {}", json.display()))?;
     println!(
-        "wrote {}, {}, {} albedo maps under {}",
+        "wrote {}, materials.rad (RADIANCE), materials.xml (Mitsuba 3), {}, {} albedo maps under {}",
         materials.display(),
         json.display(),
         albedo.len(),

@@ -5,10 +5,9 @@ use std::time::Instant;
 
 use std::path::Path;
 
-use anyhow::{Context, Result, anyhow};
-use campanile_process::brdf::{ShadingFrame, WardMaterial};
+use anyhow::{Result, anyhow};
+use campanile_process::brdf::WardMaterial;
 use campanile_process::igi::{IgiOptions, IgiResult, recover};
-use campanile_process::material_export::{ExportMaterial, write_mitsuba, write_radiance};
 use campanile_process::report::{Section, Table};
 use campanile_sim::world::cube_room::CubeRoom;
 use campanile_sim::world::igi_photograph::PhotoSettings;
@@ -158,36 +157,11 @@ pub fn cube(wide_px: usize, indirect_samples: u32, out_dir: &Path) -> Result<Cub
 /// Mitsuba 3 XML into `out_dir`; each wall's frame is its inward face's
 /// normal and texture tangent (the side the cameras see, γ's reference).
 fn write_materials(room: &CubeRoom, result: &IgiResult, out_dir: &Path) -> Result<()> {
-    let centre = CubeRoom::centre();
-    let mut list = Vec::new();
-    for (s, surface) in result.surfaces.iter().enumerate() {
-        let Some(material) = &surface.material else {
-            continue;
-        };
-        let mut m = ExportMaterial::new(&surface.name, material);
-        if let Some(t) = room.scene.triangles().iter().find(|t| t.surface as usize == s) {
-            let n = if t.normal.dot(&(centre - t.vertices[0])) >= 0.0 {
-                t.normal
-            } else {
-                -t.normal
-            };
-            if let Ok(frame) = ShadingFrame::new(n, t.texture_axes[0]) {
-                m = m.with_frame(frame);
-            }
-        }
-        list.push(m);
-    }
-    for (file, radiance) in [("cube-materials.rad", true), ("cube-materials.xml", false)] {
-        let path = out_dir.join(file);
-        let mut out = std::io::BufWriter::new(
-            std::fs::File::create(&path).with_context(|| format!("{}: cannot create", path.display()))?,
-        );
-        if radiance {
-            write_radiance(&list, &mut out)
-        } else {
-            write_mitsuba(&list, &mut out)
-        }
-        .with_context(|| format!("{}: writing the cube's materials", path.display()))?;
-    }
-    Ok(())
+    crate::cli::igi::write_material_files(
+        room.scene.triangles(),
+        &CubeRoom::centre(),
+        result,
+        out_dir,
+        "cube-materials",
+    )
 }
