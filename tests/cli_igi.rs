@@ -54,7 +54,10 @@ fn igi_recovers_the_simulated_room_from_its_scene_file_and_relights_it() {
     assert!(rad.contains("plastic2") || rad.contains("metal2"), "{rad}");
     for line in rad.lines().filter(|l| l.starts_with("void ")) {
         let name = line.split_whitespace().nth(2).unwrap();
-        assert!(xml.contains(&format!("id=\"{name}\"")), "{name} missing from materials.xml");
+        assert!(
+            xml.contains(&format!("id=\"{name}\"")),
+            "{name} missing from materials.xml"
+        );
     }
     // The lamps, triangulated from their bulbs' images: within 2 mm and 5 %.
     for (name, bulb) in &room.lamps {
