@@ -19,8 +19,8 @@ fn every_example_file_is_valid() {
         }
     }
     assert_eq!(
-        n, 11,
-        "sim station, sky sim station, real station, five plans, three scenes"
+        n, 13,
+        "sim station, sky sim station, real station, six plans, four scenes"
     );
 }
 
@@ -32,6 +32,7 @@ fn plans_run_on_every_station() {
             "campanile-day.ron",
             "campanile-quick.ron",
             "room-lights.ron",
+            "room-igi.ron",
             "sky-day.ron",
             "sky-station.ron",
         ] {

@@ -239,9 +239,11 @@ pub fn write_material_files(
     Ok(())
 }
 
-pub fn run(args: IgiArgs) -> Result<()> {
-    let r = recover_scene(&args.scene, args.quick).with_context(|| format!("reading {}", args.scene.display()))?;
-    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+/// Prints the materials table and the triangulated lights, and writes
+/// `out/materials.txt`, `materials.rad`, `materials.xml`, `summary.json` and
+/// `albedo/GROUP.exr`.
+pub fn write_products(r: &Recovered, out: &Path) -> Result<()> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let table = format_table(&r.result, &[], None);
     print!("{table}");
     for (n, t) in &r.loaded.triangulated {
@@ -256,22 +258,29 @@ pub fn run(args: IgiArgs) -> Result<()> {
             t.ray_rms_m * 1e3
         );
     }
-    let materials = args.out.join("materials.txt");
+    let materials = out.join("materials.txt");
     std::fs::write(&materials, &table).with_context(|| format!("writing {}", materials.display()))?;
-    let albedo = write_albedo_maps(&r, &args.out.join("albedo"))?;
+    let albedo = write_albedo_maps(r, &out.join("albedo"))?;
     let cameras = &r.loaded.cameras;
     let inside = cameras.iter().map(|(_, c)| c.position).sum::<nalgebra::Vector3<f64>>() / cameras.len().max(1) as f64;
-    write_material_files(&r.loaded.input.triangles, &inside, &r.result, &args.out, "materials")?;
-    let json = args.out.join("summary.json");
-    std::fs::write(&json, serde_json::to_string_pretty(&summary(&r, &albedo))?)
+    write_material_files(&r.loaded.input.triangles, &inside, &r.result, out, "materials")?;
+    let json = out.join("summary.json");
+    std::fs::write(&json, serde_json::to_string_pretty(&summary(r, &albedo))?)
         .with_context(|| format!("writing {}", json.display()))?;
     println!(
         "wrote {}, materials.rad (RADIANCE), materials.xml (Mitsuba 3), {}, {} albedo maps under {}",
         materials.display(),
         json.display(),
         albedo.len(),
-        args.out.join("albedo").display()
+        out.join("albedo").display()
     );
+    Ok(())
+}
+
+/// Runs `campanile igi`.
+pub fn run(args: IgiArgs) -> Result<()> {
+    let r = recover_scene(&args.scene, args.quick).with_context(|| format!("reading {}", args.scene.display()))?;
+    write_products(&r, &args.out)?;
     if let Some(lights) = &args.relight {
         let lights: Vec<IgiLight> = load_lights(lights)
             .map_err(|e| anyhow!("{e}"))?

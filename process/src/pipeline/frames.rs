@@ -22,8 +22,10 @@ pub enum Purpose {
         /// The pose's name.
         pose: String,
     },
-    /// Frames with the lights at given levels (indoors, §4.7.2).
+    /// A view from a named pose with the lights at given levels (indoors, §4.7.2).
     Lights {
+        /// The pose's name.
+        pose: String,
         /// Level per light channel.
         levels: Vec<f64>,
     },

@@ -25,6 +25,7 @@ mod illumination;
 mod measured_sky;
 mod radiance;
 mod response;
+pub mod room_views;
 
 pub use frames::{CapturedFrame, FrameGroup, Purpose, group_frames, mean_time};
 pub use illumination::{

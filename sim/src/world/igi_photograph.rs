@@ -55,21 +55,39 @@ pub fn photograph(
     camera: &ViewCamera,
     settings: &PhotoSettings,
 ) -> RadianceImage {
+    let ray = |u: f64, v: f64| {
+        Some(Ray {
+            origin: camera.position,
+            direction: camera.direction(u, v),
+        })
+    };
+    photograph_rays(scene, points, bulbs, (camera.width, camera.height), ray, settings)
+}
+
+/// The radiance image of `width` × `height` pixels whose pixel `(x, y)`
+/// looks along `ray(x + 0.5, y + 0.5)` (any camera: the simulated station's
+/// distorted pinhole on its head, for instance); pixels without a ray are
+/// black. Otherwise as [`photograph`].
+pub fn photograph_rays(
+    scene: &Scene,
+    points: &[PointLight],
+    bulbs: &[SphereLight],
+    (w, h): (usize, usize),
+    ray: impl Fn(f64, f64) -> Option<Ray> + Sync,
+    settings: &PhotoSettings,
+) -> RadianceImage {
     let mut all: Vec<PointLight> = points.to_vec();
     all.extend(bulbs.iter().map(|b| PointLight {
         position: b.center,
         intensity: b.radiance.map(|l| l * std::f64::consts::PI * b.radius * b.radius),
     }));
-    let (w, h) = (camera.width, camera.height);
     let mut data = vec![0f32; w * h * 3];
     data.par_chunks_mut(w * 3).enumerate().for_each(|(y, row)| {
         let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
         rng.set_stream(y as u64);
         for x in 0..w {
-            let direction = camera.direction(x as f64 + 0.5, y as f64 + 0.5);
-            let ray = Ray {
-                origin: camera.position,
-                direction,
+            let Some(ray) = ray(x as f64 + 0.5, y as f64 + 0.5) else {
+                continue;
             };
             let l = pixel(scene, &all, bulbs, &ray, settings, &mut rng);
             for c in 0..3 {

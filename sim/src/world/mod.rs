@@ -225,6 +225,13 @@ impl World {
     }
 
     /// The true radiance the camera sees (before lens falloff, filter and sensor).
+    ///
+    /// Outdoors, path-traced (`quality`: samples per pixel, bounces).
+    /// Indoors, as inverse global illumination's photographs are taken
+    /// ([`igi_photograph`]): each pixel at its centre, the lamps' direct
+    /// light exact, the interreflected light from `quality.samples_per_pixel`
+    /// paths of up to `quality.max_bounces` scattering events, so that a
+    /// lamp-lit room's frames carry noise only in their indirect light.
     pub fn render(
         &self,
         time: DateTime<Utc>,
@@ -232,6 +239,23 @@ impl World {
         light_levels: &[f64],
         seed: u64,
     ) -> Result<RadianceImage, WorldError> {
+        if self.setting == Setting::Indoor {
+            let bulbs = self.bulbs(light_levels);
+            let rays = rig.rays();
+            let settings = igi_photograph::PhotoSettings {
+                indirect_samples: self.quality.samples_per_pixel,
+                max_bounces: self.quality.max_bounces,
+                seed,
+            };
+            return Ok(igi_photograph::photograph_rays(
+                &self.scene.scene,
+                &[],
+                &bulbs,
+                (rig.width, rig.height),
+                |u, v| rays.ray(u, v),
+                &settings,
+            ));
+        }
         let settings = RenderSettings { seed, ..self.quality };
         self.lit(time, light_levels, |lighting| {
             render::render(&self.scene.scene, rig, lighting, &settings)

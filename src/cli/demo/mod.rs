@@ -68,6 +68,31 @@ struct CaptureLine {
     args: CaptureArgs,
 }
 
+/// Captures `plan` on the simulated `station` into `session` (cleared
+/// first) through `campanile capture`, with `extra` arguments.
+pub fn capture_simulated(plan: &Path, station: &Path, session: &Path, extra: &[&str]) -> Result<()> {
+    if session.exists() {
+        std::fs::remove_dir_all(session).with_context(|| format!("{}: cannot clear", session.display()))?;
+    }
+    let mut line: Vec<&std::ffi::OsStr> = vec![
+        "capture".as_ref(),
+        plan.as_os_str(),
+        "--station".as_ref(),
+        station.as_os_str(),
+        "--out".as_ref(),
+        session.as_os_str(),
+    ];
+    line.extend(extra.iter().map(std::ffi::OsStr::new));
+    let line = CaptureLine::try_parse_from(line)?;
+    if super::capture::run(line.args) != super::EXIT_OK {
+        bail!(
+            "the simulated capture of {} did not complete (see above)",
+            plan.display()
+        );
+    }
+    Ok(())
+}
+
 pub fn run(args: DemoArgs) -> Result<()> {
     let wall = Instant::now();
     let examples = examples_dir();
@@ -88,26 +113,11 @@ pub fn run(args: DemoArgs) -> Result<()> {
 
     // 1–2. Capture.
     let session = args.out.join("campanile-session");
-    if session.exists() {
-        std::fs::remove_dir_all(&session).with_context(|| format!("{}: cannot clear", session.display()))?;
-    }
     eprintln!("capturing {} on the simulated station …", plan.display());
-    let line = CaptureLine::try_parse_from([
-        "capture".as_ref(),
-        plan.as_os_str(),
-        "--station".as_ref(),
-        station.as_os_str(),
-        "--out".as_ref(),
-        session.as_os_str(),
-        // Three bounces: the light the ground reflects onto shaded walls,
-        // which the pseudo-albedo model includes (one bounce would omit it).
-        "--sim-bounces".as_ref(),
-        "3".as_ref(),
-    ])?;
     let t = Instant::now();
-    if super::capture::run(line.args) != super::EXIT_OK {
-        bail!("the simulated capture did not complete (see above)");
-    }
+    // Three bounces: the light the ground reflects onto shaded walls,
+    // which the pseudo-albedo model includes (one bounce would omit it).
+    capture_simulated(&plan, &station, &session, &["--sim-bounces", "3"])?;
     let capture_s = t.elapsed().as_secs_f64();
 
     // 3. Process.
@@ -116,7 +126,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
         &session,
         Some(&scene),
         &campanile_process::hdr::debevec::DebevecOptions::default(),
-        (18, 36),
+        Some((18, 36)),
     )?;
     let products = args.out.join("campanile-processed");
     process::write_outputs(&processed, &products)?;

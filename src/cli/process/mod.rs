@@ -4,6 +4,7 @@
 pub mod outdoor_report;
 pub mod outdoor_stage;
 pub mod report_sections;
+pub mod room;
 mod session_frames;
 pub mod sky_series;
 
@@ -109,6 +110,64 @@ pub struct ProcessArgs {
     /// recompute the day (what the station does after each scan).
     #[arg(long, value_name = "ID", conflicts_with_all = ["shard", "merge_shards"])]
     occurrence: Option<String>,
+    /// Room sessions: size of the rectified views handed to inverse global
+    /// illumination, relative to the camera's frames (box-filtered
+    /// radiance; 1 keeps every pixel, smaller is faster).
+    #[arg(long, value_name = "S", default_value_t = 0.5, value_parser = room_scale)]
+    room_scale: f64,
+    /// Room sessions: the solver's faster, coarser settings (fewer
+    /// radiosity cells, rays and ΔS iterations).
+    #[arg(long)]
+    quick: bool,
+}
+
+fn room_scale(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
+    if (0.05..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{v}: expected a scale in [0.05, 1]"))
+    }
+}
+
+/// `process` on a room session: the response and HDR, then the room stage.
+fn run_room(args: &ProcessArgs, out: &Path, debevec: &DebevecOptions) -> Result<()> {
+    let processed = process_session(&args.session, args.scene.as_deref(), debevec, None)?;
+    write_outputs(&processed, out)?;
+    let opts = room::RoomOptions {
+        scale: args.room_scale,
+        quick: args.quick,
+    };
+    let products = room::room_stage(&processed, out, &opts)?;
+    super::igi::write_products(&products.recovered, &out.join("room").join("igi"))?;
+    let mut sections = stage_sections(&processed, None)?;
+    let mut speed = sections.pop().unwrap_or_default();
+    sections.truncate(1); // the response; indoors there is no sun, sky or environment
+    sections.push(room::room_section(&products)?);
+    for (stage, s) in &products.seconds {
+        speed.tables[0].rows.push(vec![stage.clone(), format!("{s:.2}")]);
+    }
+    sections.push(speed);
+    let report = Report {
+        title: format!("Campanile: {}", args.session.display()),
+        intro: vec![format!(
+            "Room session {}, processed by campanile {}.",
+            args.session.display(),
+            env!("CARGO_PKG_VERSION")
+        )],
+        sections,
+    };
+    write_report(&report, &out.join("report.html"))?;
+    println!(
+        "processed {} → {} (scene file {})",
+        args.session.display(),
+        out.display(),
+        products.scene_file.display()
+    );
+    for (stage, s) in processed.summary.stage_seconds.iter().chain(&products.seconds) {
+        println!("  {stage:<44} {s:>7.2} s");
+    }
+    Ok(())
 }
 
 /// What `process` measured, for `summary.json` and the report.
@@ -172,12 +231,16 @@ pub fn run(args: ProcessArgs) -> Result<()> {
             args.session.display()
         );
     }
+    let room = room::is_room_session(&inputs.plan);
     drop(inputs);
+    if room {
+        return run_room(&args, &out, &debevec);
+    }
     let processed = process_session(
         &args.session,
         args.scene.as_deref(),
         &debevec,
-        (args.env_rows, args.env_cols),
+        Some((args.env_rows, args.env_cols)),
     )?;
     write_outputs(&processed, &out)?;
     let outdoor = outdoor_stages(&processed)?;
@@ -337,12 +400,13 @@ pub fn bar(len: u64, what: &str) -> ProgressBar {
     bar
 }
 
-/// Stages 1 and 2 on the session in `dir`.
+/// Stages 1 and 2 on the session in `dir` (stage 2, the sun, sky and
+/// environment, only with `env` = its map's rows and columns).
 pub fn process_session(
     dir: &Path,
     scene: Option<&Path>,
     debevec: &DebevecOptions,
-    env: (usize, usize),
+    env: Option<(usize, usize)>,
 ) -> Result<Processed> {
     let mut stages = Vec::new();
     let t = Instant::now();
@@ -365,9 +429,15 @@ pub fn process_session(
     b.finish_and_clear();
     stages.push((format!("HDR merge ({} maps)", merged.len()), t.elapsed().as_secs_f64()));
 
-    let t = Instant::now();
-    let light = illumination(&merged, &optics, env.0, env.1)?;
-    stages.push(("sun, sky, environment".to_owned(), t.elapsed().as_secs_f64()));
+    let light = match env {
+        Some((rows, cols)) => {
+            let t = Instant::now();
+            let light = illumination(&merged, &optics, rows, cols)?;
+            stages.push(("sun, sky, environment".to_owned(), t.elapsed().as_secs_f64()));
+            light
+        }
+        None => Vec::new(),
+    };
 
     let occurrences = light
         .iter()

@@ -214,7 +214,23 @@ impl SessionInputs {
                     None,
                 )),
             },
-            Step::LightSequence { .. } => Ok((Purpose::Lights { levels: levels() }, None)),
+            Step::LightSequence {
+                lights, all_on, poses, ..
+            } => {
+                // Per pose, each light alone, then all on (capture::schedule).
+                let states = lights.len() + usize::from(*all_on);
+                let name = poses
+                    .get(target / states.max(1))
+                    .ok_or_else(|| bad("no such pose in the light sequence"))?;
+                let (_, position) = pose(name)?;
+                Ok((
+                    Purpose::Lights {
+                        pose: name.clone(),
+                        levels: levels(),
+                    },
+                    position,
+                ))
+            }
         }
     }
 }
