@@ -16,6 +16,12 @@
 //! the store within its budget; the heartbeat; exposures that move at most
 //! 0.5 stop per scan and do not oscillate.
 //!
+//! Each settled scan is processed as `campanile station run --process`
+//! does (the sky time series, through the binary: see
+//! [`process_each_scan`]), with the simulator's true response (the plan
+//! has no calibration bracket; see `sim_response`), and the days' time
+//! series are checked against the journal and the simulator's truth.
+//!
 //! A second test sends a real SIGTERM to a `campanile station run` child
 //! and runs the same command again.
 
