@@ -793,7 +793,7 @@ fn series_follows_the_journal_and_the_truth(i: &Inputs, sessions: &BTreeMap<Naiv
         );
     }
     println!(
-        "sky series: {rows_total} rows ({with_pruned} of scans whose frames were pruned), {missed_scans} scans missed in the outage; worst sun r/g/b {worst_sun:.4?} ({flagged} low-sun scans flagged), worst sky RMS r/g/b {worst_sky:.4?}"
+        "sky series: {rows_total} rows ({with_pruned} of scans whose frames were pruned), {missed_scans} scans missed in the outage; worst sun r/g/b {worst_sun:.4?} ({flagged} flagged clouds_near_sun), worst sky RMS r/g/b {worst_sky:.4?}"
     );
     assert_eq!(missed_scans, 3, "the outage covers 3 scans");
     assert!(with_pruned > 0, "rows of pruned scans");
