@@ -89,8 +89,8 @@ pub enum SunDiscError {
 
 /// Finds and integrates the sun disc. `expected_sr` is the disc's solid
 /// angle for the date ([`super::sun_solid_angle_sr`]). A bright core (the
-/// pixels above half the peak's excess) larger than [`core_limit_sr`] is
-/// refused as clouds or flare.
+/// pixels above half the peak's excess) larger than three times the disc,
+/// or than 2 × 2 pixels when that is more, is refused as clouds or flare.
 ///
 /// The irradiance is the excess over the background integrated over the
 /// core and one ring of pixels around it (§5.3.1), so it does not need the
