@@ -16,20 +16,27 @@
 //! the store within its budget; the heartbeat; exposures that move at most
 //! 0.5 stop per scan and do not oscillate.
 //!
+//! Each settled scan is processed as `campanile station run --process`
+//! does (the sky time series, through the binary: see
+//! [`process_each_scan`]), with the simulator's true response (the plan
+//! has no calibration bracket; see `sim_response`), and the days' time
+//! series are checked against the journal and the simulator's truth.
+//!
 //! A second test sends a real SIGTERM to a `campanile station run` child
 //! and runs the same command again.
 
 mod common;
+mod sim_response;
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use campanile_capture::controller::NoProgress;
 use campanile_capture::schedule::{Occurrence, PlannedExposure, Timeline, TimelineOptions, timeline};
-use campanile_capture::store::{JournalEntry, ProcessedProducts, Provenance, SessionStore, Snapshot};
+use campanile_capture::store::{JournalEntry, PROCESSED_DIR, ProcessedProducts, Provenance, SessionStore, Snapshot};
 use campanile_capture::unattended::day_rollover::{day_dir, existing_days};
 use campanile_capture::unattended::exposure_plan::model_log2;
 use campanile_capture::unattended::{
@@ -37,6 +44,9 @@ use campanile_capture::unattended::{
 };
 use campanile_config::document::LoadedPlan;
 use campanile_config::{Station, load_plan, load_station};
+use campanile_process::pipeline::TRIPLET_AGREEMENT;
+use campanile_process::sky::{angle_between, direction};
+use campanile_process::sky_series::{SkySeries, read_scans, series_width};
 use campanile_sim::faults::{Device, FaultPlan, Outage};
 use campanile_sim::station::{SimOptions, SimStation};
 use campanile_sim::world::{World, load_scene};
@@ -119,14 +129,34 @@ fn outage_from(origin: DateTime<Utc>, start: DateTime<Utc>, length: Duration) ->
     }]
 }
 
-/// The test double of the processing contract: the hook lists each
-/// settled occurrence in its session's `processed/products.ron`, as the
-/// sky-series processor will once it has written the scan's products.
-/// (The processor itself is the process half's, wired by the CLI.)
-fn list_as_processed(dir: &Path, occurrence: &Occurrence) -> Result<(), String> {
-    let mut p = ProcessedProducts::read(dir).map_err(|e| e.to_string())?;
-    p.occurrences.insert(occurrence.key.clone());
-    p.write(dir).map_err(|e| e.to_string())
+/// The scan hook of `campanile station run --process --response CSV`
+/// (its `SkySeriesHook`: `process_scan` on the settled occurrence, then
+/// `recompute_day`), reached through the binary, whose code it is:
+/// `campanile process DAY --occurrence ID --response CSV` calls the same
+/// two functions (and then rewrites the day's report page). Failures are
+/// collected, so that the test can name them.
+fn process_each_scan(
+    response: &Path,
+    failures: Arc<Mutex<Vec<String>>>,
+) -> impl FnMut(&Path, &Occurrence) -> Result<(), String> + Send {
+    let response = response.to_path_buf();
+    move |dir: &Path, occurrence: &Occurrence| {
+        let out = Command::new(env!("CARGO_BIN_EXE_campanile"))
+            .arg("-q")
+            .arg("process")
+            .arg(dir)
+            .args(["--occurrence", &occurrence.key, "--response"])
+            .arg(&response)
+            .output()
+            .map_err(|e| e.to_string())?;
+        if out.status.success() {
+            Ok(())
+        } else {
+            let why = format!("{}: {}", occurrence.key, String::from_utf8_lossy(&out.stderr));
+            failures.lock().unwrap().push(why.clone());
+            Err(why)
+        }
+    }
 }
 
 #[tokio::test(flavor = "current_thread", start_paused = true)]
@@ -180,7 +210,12 @@ async fn three_simulated_days_survive_a_stop_an_outage_and_a_budget() {
             stop.request();
         })
     };
-    let mut hook = list_as_processed;
+    // The sky-station plan has no calibration bracket: the response is the
+    // simulator's own (see `sim_response`).
+    let response = tmp.path().join("response.csv");
+    sim_response::write_true_response(&response, i.station.camera.bit_depth);
+    let failures = Arc::new(Mutex::new(Vec::new()));
+    let mut hook = process_each_scan(&response, failures.clone());
     let first = unattended::run(
         &station_inputs,
         &store,
@@ -392,6 +427,9 @@ async fn three_simulated_days_survive_a_stop_an_outage_and_a_budget() {
     assert_eq!(beat.devices[3].state, DeviceState::Unknown);
 
     exposures_do_not_flap(&i.timeline, &sessions);
+    let failed = failures.lock().unwrap().clone();
+    assert!(failed.is_empty(), "processing failed: {failed:#?}");
+    series_follows_the_journal_and_the_truth(&i, &sessions);
 }
 
 /// A tile's scan: (scan number, log2 exposure, the model's log2 radiance).
@@ -602,4 +640,163 @@ fn sigterm_stops_the_cli_at_a_frame_boundary_and_the_same_command_continues() {
     );
     assert_eq!(seen.len(), promised.len());
     assert!(seen.len() > frames_at_stop);
+}
+
+/// The worst relative error of a scan's direct normal sun irradiance (the
+/// triplet's mean) against the simulator's, per channel, on every scan.
+const SUN_TOLERANCE: f64 = 0.08;
+/// The worst RMS relative error of a scan's fitted sky against the
+/// simulator's (above 10° elevation, more than 10° from the sun), per channel.
+const SKY_TOLERANCE: f64 = 0.10;
+
+/// The sky time series the hook built, one `processed/` per day:
+/// - `sky-series.csv` has exactly one row per occurrence whose promised
+///   shots were all journaled taken (those later pruned included), each as
+///   wide as its header, at a time inside the occurrence's journaled
+///   frames; no row for an occurrence journaled missed in the outage;
+///   every row's occurrence listed in `processed/products.ron`;
+/// - per scan, the sun and the sky against the simulator's truth
+///   ([`SUN_TOLERANCE`], [`SKY_TOLERANCE`]), and the clouds-near-the-sun
+///   flag raised exactly when the triplet disagrees.
+fn series_follows_the_journal_and_the_truth(i: &Inputs, sessions: &BTreeMap<NaiveDate, SessionStore>) {
+    let (mut rows_total, mut with_pruned, mut missed_scans, mut flagged) = (0, 0, 0, 0);
+    let mut worst_sun = [0.0f64; 3];
+    let mut worst_sky = [0.0f64; 3];
+    let mut beyond: Vec<(String, f64, f64)> = Vec::new();
+    for (d, s) in sessions {
+        let out = s.dir().join(PROCESSED_DIR);
+        let csv = std::fs::read_to_string(out.join("sky-series.csv")).unwrap();
+        let mut lines = csv.lines().filter(|l| !l.starts_with('#'));
+        let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+        assert_eq!(header.len(), series_width());
+        let time_col = header.iter().position(|h| *h == "time_utc").unwrap();
+        let mut rows: BTreeMap<String, DateTime<Utc>> = BTreeMap::new();
+        for l in lines {
+            let cells: Vec<&str> = l.split(',').collect();
+            assert_eq!(cells.len(), header.len(), "{d}: {l}");
+            let t = DateTime::parse_from_rfc3339(cells[time_col])
+                .unwrap()
+                .with_timezone(&Utc);
+            assert!(
+                rows.insert(cells[0].to_owned(), t).is_none(),
+                "{d}: two rows for {}",
+                cells[0]
+            );
+        }
+        let listed = ProcessedProducts::read(s.dir()).unwrap();
+        let mut complete = 0;
+        for occ in i
+            .timeline
+            .occurrences
+            .iter()
+            .filter(|o| unattended::day_rollover::plan_day(o) == Some(*d))
+        {
+            let promised: Vec<&str> = occ
+                .shots
+                .iter()
+                .filter(|x| x.promised)
+                .map(|x| x.key.as_str())
+                .collect();
+            let row = rows.get(&occ.key);
+            if promised.iter().all(|k| s.missed(k)) {
+                assert!(row.is_none(), "{}: missed in the outage, yet a row", occ.key);
+                missed_scans += 1;
+                continue;
+            }
+            assert!(promised.iter().all(|k| s.completed(k)), "{}: partly journaled", occ.key);
+            complete += 1;
+            let t = *row.unwrap_or_else(|| panic!("{}: journaled complete, but no row", occ.key));
+            assert!(listed.contains(&occ.key), "{} has a row but is not listed", occ.key);
+            if promised.iter().any(|k| s.pruned(k)) {
+                with_pruned += 1;
+            }
+            let times: Vec<DateTime<Utc>> = s
+                .entries()
+                .iter()
+                .filter_map(JournalEntry::frame)
+                .filter(|f| f.key.starts_with(&format!("{}/", occ.key)))
+                .map(|f| f.meta.time)
+                .collect();
+            let (first, last) = (times.iter().min().unwrap(), times.iter().max().unwrap());
+            assert!(
+                *first <= t && t <= *last,
+                "{}: row time {t} outside its frames {first} … {last}",
+                occ.key
+            );
+        }
+        assert_eq!(rows.len(), complete, "{d}: rows beyond the journaled scans");
+        rows_total += rows.len();
+
+        // Per scan, against the simulator.
+        let scans = read_scans(&out).unwrap();
+        assert_eq!(scans.len(), rows.len());
+        for scan in &scans {
+            let name = &scan.occurrence;
+            let sun = scan
+                .sun
+                .as_ref()
+                .unwrap_or_else(|| panic!("{name}: no sun: {:?}", scan.notes));
+            // The flag follows the triplet's agreement (see the CLI test
+            // `station_process`: at 64×48 it is mostly a false alarm).
+            let spread = sun.spread.iter().copied().fold(0.0, f64::max);
+            assert_eq!(scan.quality.clouds_near_sun, spread > TRIPLET_AGREEMENT, "{name}");
+            flagged += usize::from(scan.quality.clouds_near_sun);
+            let truth = i.world.daylight(sun.time_utc).unwrap().unwrap().sun_irradiance();
+            for c in 0..3 {
+                let rel = (sun.irradiance_w_m2[c] / truth[c] - 1.0).abs();
+                worst_sun[c] = worst_sun[c].max(rel);
+                beyond.push((format!("{name} sun {c}"), rel, SUN_TOLERANCE));
+            }
+            let daylight = i.world.daylight(scan.time_utc).unwrap().unwrap();
+            let sun_dir = daylight.sun_direction;
+            let models = scan
+                .models()
+                .unwrap_or_else(|| panic!("{name}: no sky: {:?}", scan.notes));
+            let dirs: Vec<[f64; 3]> = (0..14)
+                .flat_map(|k| {
+                    (0..36)
+                        .map(move |j| direction((6.0 * f64::from(k)).to_radians(), (10.0 * f64::from(j)).to_radians()))
+                })
+                .filter(|v| v[2] > 10f64.to_radians().sin() && angle_between(*v, sun_dir) > 10f64.to_radians())
+                .collect();
+            for c in 0..3 {
+                let ms = dirs
+                    .iter()
+                    .map(|&v| {
+                        (models[c].radiance(v[2].acos(), angle_between(v, sun_dir)) / daylight.sky_radiance(v)[c] - 1.0)
+                            .powi(2)
+                    })
+                    .sum::<f64>()
+                    / dirs.len() as f64;
+                worst_sky[c] = worst_sky[c].max(ms.sqrt());
+                beyond.push((format!("{name} sky {c}"), ms.sqrt(), SKY_TOLERANCE));
+            }
+        }
+        // The day's Langley fit uses only the unflagged scans: reported, not
+        // bounded here (β against the truth is `tests/sky_series.rs`'s, at
+        // a resolution where the triplets agree).
+        let series = SkySeries::new(scans);
+        let day = &series.days[0];
+        let beta: Vec<String> = day
+            .fit
+            .iter()
+            .zip(i.world.atmosphere.beta)
+            .map(|(f, truth)| match f {
+                Ok(f) => format!("{:.4} (truth {truth:.2})", f.beta),
+                Err(e) => format!("none: {e}"),
+            })
+            .collect();
+        println!(
+            "{d}: β r/g/b {} from {} unflagged scans",
+            beta.join(", "),
+            day.points.len()
+        );
+    }
+    println!(
+        "sky series: {rows_total} rows ({with_pruned} of scans whose frames were pruned), {missed_scans} scans missed in the outage; worst sun r/g/b {worst_sun:.4?} ({flagged} flagged clouds_near_sun), worst sky RMS r/g/b {worst_sky:.4?}"
+    );
+    assert_eq!(missed_scans, 3, "the outage covers 3 scans");
+    assert!(with_pruned > 0, "rows of pruned scans");
+    let failed: Vec<_> = beyond.iter().filter(|(_, v, bound)| v.is_nan() || v >= bound).collect();
+    assert!(failed.is_empty(), "beyond bounds: {failed:?}");
 }

@@ -88,8 +88,15 @@ pub enum SunDiscError {
 }
 
 /// Finds and integrates the sun disc. `expected_sr` is the disc's solid
-/// angle for the date ([`super::sun_solid_angle_sr`]); a bright region more
-/// than three times larger is refused.
+/// angle for the date ([`super::sun_solid_angle_sr`]). A bright core (the
+/// pixels above half the peak's excess) larger than three times the disc,
+/// or than 2 × 2 pixels when that is more, is refused as clouds or flare.
+///
+/// The irradiance is the excess over the background integrated over the
+/// core and one ring of pixels around it (§5.3.1), so it does not need the
+/// disc resolved: a sun smaller than a pixel (a wide, small all-sky or
+/// station camera) is integrated the same way, its flux spread over the
+/// 1–4 pixels it falls on.
 pub fn measure_sun(frame: &SunFrame<'_>, expected_sr: f64) -> Result<SunDisc, SunDiscError> {
     let (w, h) = (frame.width, frame.height);
     if w < 3 || h < 3 || frame.radiance.len() != w * h || frame.clipped.is_some_and(|c| c.len() != w * h) {
@@ -182,7 +189,12 @@ pub fn measure_sun(frame: &SunFrame<'_>, expected_sr: f64) -> Result<SunDisc, Su
             cos * cos * cos / f2
         })
         .sum();
-    if core_sr > 3.0 * expected_sr {
+    let peak_pixel_sr = {
+        let (dx, dy) = ((peak_i % w) as f64 + 0.5 - cx, (peak_i / w) as f64 + 0.5 - cy);
+        let cos = frame.focal_px / (dx * dx + dy * dy + f2).sqrt();
+        cos * cos * cos / f2
+    };
+    if core_sr > core_limit_sr(expected_sr, peak_pixel_sr) {
         return Err(SunDiscError::TooLarge {
             found_sr: core_sr,
             expected_sr,
@@ -198,6 +210,16 @@ pub fn measure_sun(frame: &SunFrame<'_>, expected_sr: f64) -> Result<SunDisc, Su
         background,
         pixels: members.len(),
     })
+}
+
+/// The largest bright core a clear sun may have, sr: three times the
+/// disc's solid angle, or four pixels when that is more (pixels of at
+/// least 3/4 of the disc's solid angle): a disc about a pixel wide or
+/// smaller can straddle 2 × 2 pixels. At such pixel sizes clouds near the
+/// sun are seen by the triplet's spread (a hazy aureole adds to the pixels
+/// the sun is in), not by the core's size.
+fn core_limit_sr(expected_sr: f64, pixel_sr: f64) -> f64 {
+    (3.0 * expected_sr).max(4.0 * pixel_sr)
 }
 
 #[cfg(test)]
@@ -251,6 +273,48 @@ mod tests {
         assert!(
             (d.centroid_px.0 - 31.3).abs() < 0.02 && (d.centroid_px.1 - 30.7).abs() < 0.02,
             "{d:?}"
+        );
+    }
+
+    /// A wide, small camera (80° over 64 px: a pixel is 10× the disc's
+    /// solid angle): the disc, centred on a pixel corner so that it lights
+    /// 2 × 2 pixels, still integrates to its irradiance within 1%; a
+    /// bright region of 3 × 3 pixels is refused.
+    #[test]
+    fn a_sun_smaller_than_a_pixel_is_integrated_and_haze_refused() {
+        let f = 32.0 / 40f64.to_radians().tan();
+        let omega = sun_solid_angle_sr(1.0);
+        let r_px = f * (omega / std::f64::consts::PI).sqrt();
+        assert!(r_px < 0.2, "{r_px}");
+        let t = 1e-3;
+        let l = 900.0 / omega * t;
+        // Centred on the corner of four pixels: a quarter of the disc in each.
+        let mut img = vec![(0.01 * l) as f32; 64 * 48];
+        let quarter = std::f64::consts::PI * r_px * r_px / 4.0;
+        for i in [23 * 64 + 31, 23 * 64 + 32, 24 * 64 + 31, 24 * 64 + 32] {
+            img[i] += (l * quarter) as f32;
+        }
+        let frame = SunFrame {
+            width: 64,
+            height: 48,
+            radiance: &img,
+            clipped: None,
+            focal_px: f,
+            principal_px: (32.0, 24.0),
+            transmittance: t,
+        };
+        let d = measure_sun(&frame, omega).expect("measured");
+        assert!((d.irradiance / 900.0 - 1.0).abs() < 0.01, "{d:?}");
+        assert!((d.centroid_px.0 - 32.0).abs() < 0.05 && (d.centroid_px.1 - 24.0).abs() < 0.05);
+        let haze = render(64, 48, 32.5, 24.5, 1.6, l, 0.01 * l);
+        let hazy = SunFrame {
+            radiance: &haze,
+            ..frame
+        };
+        assert!(
+            matches!(measure_sun(&hazy, omega), Err(SunDiscError::TooLarge { .. })),
+            "{:?}",
+            measure_sun(&hazy, omega)
         );
     }
 
