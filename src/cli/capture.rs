@@ -79,10 +79,11 @@ pub struct CaptureArgs {
     /// Run only the first N days of the plan.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     days: Option<u32>,
-    /// Simulation: render samples per pixel.
+    /// Simulation: render samples per pixel (indoor scenes: paths per pixel
+    /// for the interreflected light; the lamps' direct light is exact).
     #[arg(long, value_name = "N", default_value_t = 2)]
     sim_samples: u32,
-    /// Simulation: render bounces.
+    /// Simulation: render bounces (scattering events per path, the first included).
     #[arg(long, value_name = "N", default_value_t = 1)]
     sim_bounces: u32,
     /// Simulation: chance that a byte is dropped on every serial link (0–0.5).

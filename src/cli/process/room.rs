@@ -213,15 +213,30 @@ pub fn room_stage(p: &Processed, out: &Path, opts: &RoomOptions) -> Result<RoomP
     }
 
     // Bulbs around the lamps' configured positions.
-    let lamps = p
+    // The lamps lit in the all-on state (levels in the station's channel order).
+    let on: Vec<f64> = chosen
+        .iter()
+        .find_map(|(_, g)| match &g.purpose {
+            Purpose::Lights { levels, .. } => Some(levels.clone()),
+            _ => None,
+        })
+        .unwrap_or_default();
+    let lamps: Vec<_> = p
         .inputs
         .station
         .lights
         .as_ref()
         .map(|l| l.channels.clone())
-        .unwrap_or_default();
+        .unwrap_or_default()
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| on.get(*i).is_some_and(|l| *l > 0.0))
+        .map(|(_, c)| c)
+        .collect();
     if lamps.is_empty() {
-        bail!("the station has no lights: a room session's lamps come from its `lights` channels");
+        bail!(
+            "no lamp is on in the views with every lamp on: a room session's lamps are the station's `lights` channels its light sequence switches"
+        );
     }
     // Bulbs are small: cut them from views rectified at the frames' full size.
     let full: Vec<(String, RectifiedView)> = {
