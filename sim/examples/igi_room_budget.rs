@@ -12,7 +12,8 @@
 //! passes from the environment variables `CELLS`, `GATHER`, `ITER`,
 //! `LOBE`, `SPARSE` (defaults 6, 64, 3, 16, 2500); the photographs'
 //! indirect samples per pixel from `SPP` (16), the albedo maps' rays per
-//! irradiance cell from `IRR_RAYS` (64).
+//! irradiance cell, texel and cell sides from `IRR_RAYS` (64), `TEXEL_MM`
+//! (20), `CELL_MM` (250).
 
 use std::time::Instant;
 
@@ -102,6 +103,8 @@ fn main() {
             &result,
             &AlbedoMapOptions {
                 irradiance_rays: env("IRR_RAYS", 64) as u32,
+                texel_m: env("TEXEL_MM", 20) as f64 * 1e-3,
+                irradiance_cell_m: env("CELL_MM", 250) as f64 * 1e-3,
                 max_bounces: b,
                 ..AlbedoMapOptions::default()
             },
