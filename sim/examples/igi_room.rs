@@ -17,7 +17,7 @@ use campanile_process::igi::{IgiLight, IgiOptions, format_table, recover};
 use campanile_process::render::SphereLight;
 use campanile_sim::world::examples_dir;
 use campanile_sim::world::igi_photograph::PhotoSettings;
-use campanile_sim::world::room_igi::{RoomIgi, SceneFileShot, block_average};
+use campanile_sim::world::room_igi::{ROOM_BOUNCES, RoomIgi, SceneFileShot, block_average};
 use nalgebra::Vector3;
 
 fn main() {
@@ -137,7 +137,7 @@ fn main() {
         &camera,
         &PhotoSettings {
             indirect_samples: samples,
-            max_bounces: 4,
+            max_bounces: ROOM_BOUNCES,
             seed: 99,
         },
     );

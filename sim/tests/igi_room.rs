@@ -13,7 +13,7 @@ use campanile_process::igi::{IgiLight, IgiOptions, SurfaceModel, ViewCamera, for
 use campanile_process::render::SphereLight;
 use campanile_sim::world::examples_dir;
 use campanile_sim::world::igi_photograph::PhotoSettings;
-use campanile_sim::world::room_igi::{CEILING_ELEVATION_DEG, RoomIgi, block_average};
+use campanile_sim::world::room_igi::{CEILING_ELEVATION_DEG, ROOM_BOUNCES, RoomIgi, block_average};
 use nalgebra::Vector3;
 
 fn room() -> RoomIgi {
@@ -88,13 +88,17 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
     cams.extend(room.ceiling_cameras(CEILING_ELEVATION_DEG, 60.0, 80, 60));
     let settings = PhotoSettings {
         indirect_samples: 16,
-        max_bounces: 4,
+        max_bounces: ROOM_BOUNCES,
         seed: 7,
     };
     let input = room.igi_input(cams, &settings);
+    // The roughness search on up to 6 000 samples per surface (default
+    // 2 500): the brushed board's wide αy trades against ρd, and with 2 500
+    // αy comes back 6.2 % low (5.2 % with 6 000).
     let opts = IgiOptions {
         cells_per_edge: 6,
         gather_rays: 64,
+        sparse_samples: 6000,
         ..IgiOptions::default()
     };
     let result = recover(&input, &opts).unwrap();
@@ -111,17 +115,19 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
     }
     // Tolerances (percent; γ in degrees) stated from the measured run
     // (ρd, ρs, αx, αy, γ): the shiny boards and floor, seen in their
-    // highlight views, are recovered; the metal sphere's faceted highlight
-    // falls in no view, so it must come back diffuse-only with that reason.
-    let expect: [(&str, SurfaceModel, [f64; 5]); 4] = [
+    // highlight views, are recovered; the matte paint and paper, whose
+    // flagged "highlights" a lobe cannot explain, stay diffuse; the metal
+    // sphere's faceted highlight falls in no view, so it must come back
+    // diffuse-only with that reason.
+    // Measured (photographs with 12 scattering events, BENCHMARKS.md):
+    // wood 3.7, 40.1, 2.2, 2.2; brushed 2.1, 0.7, 2.0, 5.2, 0.3°;
+    // plastic 3.0, 0.0, 2.3, 2.3; paint 1.2; paper 0.7.
+    let expect: [(&str, SurfaceModel, [f64; 5]); 6] = [
         ("wood", SurfaceModel::Isotropic, [20.0, 45.0, 8.0, 8.0, 0.1]),
-        // Brushed αx: 8 % with the solver as these bounds were first measured
-        // (bound 12); 13.2 % since its faster defaults (3 ΔS passes, Latin
-        // hypercube strata, Russian roulette in the photographer). A
-        // regression of the speed change, not fixed: 4 passes or 256 gather
-        // rays bring αx back under 12 % but ρd to 6.7–6.8 % (bound 6).
-        ("brushed", SurfaceModel::Anisotropic, [6.0, 8.0, 15.0, 6.0, 2.0]),
+        ("brushed", SurfaceModel::Anisotropic, [6.0, 8.0, 8.0, 6.0, 2.0]),
         ("plastic", SurfaceModel::Isotropic, [25.0, 20.0, 18.0, 18.0, 0.1]),
+        ("paint", SurfaceModel::DiffuseOnly, [3.0, 0.0, 0.0, 0.0, 0.0]),
+        ("paper", SurfaceModel::DiffuseOnly, [3.0, 0.0, 0.0, 0.0, 0.0]),
         (
             "metal",
             SurfaceModel::DiffuseOnly,
@@ -145,14 +151,9 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
     }
     let metal = result.surfaces.iter().find(|r| r.name == "metal").unwrap();
     assert!(metal.reason.contains("mirror direction"), "{}", metal.reason);
-    // The matte paint and paper: the solver gives them a weak wide lobe
-    // (a highlight is "seen"), but their total reflectance (directional
-    // albedo at normal incidence, largest channel) is within 8 % and 10 %.
-    for (name, tol) in [("paint", 0.08), ("paper", 0.10)] {
-        let s = result.surfaces.iter().position(|r| r.name == name).unwrap();
-        let a = result.surfaces[s].directional_albedo[0];
-        let t = truth[s].rho_d.iter().copied().fold(0.0, f64::max);
-        assert!((a / t - 1.0).abs() < tol, "{name}: total albedo {a} vs {t}");
+    for name in ["paint", "paper"] {
+        let r = result.surfaces.iter().find(|r| r.name == name).unwrap();
+        assert!(r.reason.contains("of the diffuse fit's residual"), "{}", r.reason);
     }
 
     let map = AlbedoMap::build(
@@ -207,7 +208,7 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
     let (_, camera) = room.cameras(60.0, 80, 60).swap_remove(0);
     let rs = RelightSettings {
         indirect_samples: 32,
-        max_bounces: 4,
+        max_bounces: ROOM_BOUNCES,
         seed: 5,
     };
     let ours = relight(&scene, Some(&map), &lights, &camera, &rs);
@@ -218,7 +219,7 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
         &camera,
         &PhotoSettings {
             indirect_samples: 32,
-            max_bounces: 4,
+            max_bounces: ROOM_BOUNCES,
             seed: 99,
         },
     );
@@ -235,5 +236,5 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
     // The renderer itself agrees with the simulator within 5 %; the relit
     // room does not yet meet the 3 % (README: status).
     assert!(floor < 0.05, "noise floor {floor}");
-    assert!(relit < 0.20, "relit {relit}");
+    assert!(relit < 0.12, "relit {relit}");
 }

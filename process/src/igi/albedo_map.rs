@@ -3,9 +3,15 @@
 //! light it receives (direct from the lamps, and indirect, gathered
 //! through the recovered scene) is divided out:
 //!
-//! ρd(x) = π (L(x) − S(x)) / (E_direct(x) + E_indirect(x)),
+//! ρd(x) = π (L(x) − S(x) − ΔS(x)) / (E_direct(x) + E_indirect(x)),
 //!
-//! where S is the recovered lobe's reflection of the lamps. Dividing by the
+//! where S is the recovered lobe's reflection of the lamps and ΔS its
+//! reflection of the indirect light, `ρs a(ωo) E_indirect / π` with `a`
+//! the lobe's directional albedo toward the camera (as the solver's
+//! [`super::radiosity`] takes it beyond one glossy bounce). Without ΔS a
+//! glossy surface lit mostly by the room's walls keeps `ρs a / ρd` of
+//! extra light in its map: measured +12 % on the room's wood floor (ρs
+//! 0.05 on ρd 0.42). Dividing by the
 //! full irradiance removes colour bleeding (the indirect light's colour);
 //! removing S and down-weighting samples whose radiance is mostly specular
 //! removes highlights. Views are combined per texel with the weight
@@ -28,6 +34,8 @@ use super::error::IgiError;
 use super::input::IgiInput;
 use super::recover::IgiResult;
 use super::relit_scene::{point_lights, recovered_scene, seen_sides};
+use super::specular_albedo::SpecularAlbedo;
+use crate::brdf::ShadingFrame;
 use crate::render::surface_bsdf::SurfaceBsdf;
 use crate::render::{Lighting, Material, PointLight, Ray, Scene, Texture, Triangle, trace};
 
@@ -43,7 +51,10 @@ pub struct AlbedoMapOptions {
     pub irradiance_cell_m: f64,
     /// Cosine-distributed rays per irradiance cell.
     pub irradiance_rays: u32,
-    /// Scattering events per gathered path.
+    /// Scattering events per gathered path. Default 12 (see
+    /// [`super::relight::RelightSettings::max_bounces`]): a cut after 4
+    /// leaves the indirect light about 13 % short in a light-walled room,
+    /// and the albedo maps that much high.
     pub max_bounces: u32,
     /// Pixels from the image border over which the border weight rises from 0 to 1.
     pub border_px: f64,
@@ -63,7 +74,7 @@ impl Default for AlbedoMapOptions {
             texel_m: 0.02,
             irradiance_cell_m: 0.25,
             irradiance_rays: 128,
-            max_bounces: 4,
+            max_bounces: 12,
             border_px: 8.0,
             seed: 3,
             indirect: true,
@@ -211,6 +222,11 @@ impl AlbedoMap {
         let fallback: Vec<[f64; 3]> = (0..input.surfaces.len())
             .map(|s| scene.materials()[s].albedo.mean_albedo())
             .collect();
+        let lobe_albedo: Vec<Option<SpecularAlbedo>> = scene
+            .materials()
+            .iter()
+            .map(|m| m.specular.as_ref().map(SpecularAlbedo::new))
+            .collect();
         let mut triangles: Vec<TriangleTexels> = scene
             .triangles()
             .iter()
@@ -268,6 +284,19 @@ impl AlbedoMap {
                         let e: [f64; 3] = [0, 1, 2].map(|c| e_direct[c] + e_ind[c]);
                         if e.iter().any(|v| *v <= 1e-12) {
                             continue;
+                        }
+                        // ΔS: the lobe's reflection of the indirect light (module doc).
+                        if options.remove_specular
+                            && let (Some(lobe), Some(Some(table))) = (
+                                scene.materials()[tri.material as usize].specular,
+                                lobe_albedo.get(tri.material as usize),
+                            )
+                            && let Ok(frame) = ShadingFrame::new(normal, tri.texture_axes[0])
+                        {
+                            let a = table.at(&frame.to_local(&wo));
+                            for c in 0..3 {
+                                specular[c] += lobe.rho_s[c] * a * e_ind[c] * std::f64::consts::FRAC_1_PI;
+                            }
                         }
                         let diffuse: [f64; 3] = [0, 1, 2].map(|c| (radiance[c] - specular[c]).max(0.0));
                         let (lm, dm) = (radiance.iter().sum::<f64>(), diffuse.iter().sum::<f64>());
@@ -401,12 +430,24 @@ fn direct(
     (e, s)
 }
 
-/// Indirect irradiance gathered on a coarse grid of cells per triangle
-/// (barycentric `n × n` over the triangle, `n` from the cell size), on the
-/// side the cameras see.
+/// Indirect irradiance gathered at the nodes of a coarse barycentric
+/// lattice per triangle (`n` divisions per edge, `n` from the cell size:
+/// `(n + 1)(n + 2) / 2` nodes), on the side the cameras see, and
+/// interpolated linearly between them. A piecewise-constant field (one
+/// value per cell) puts a step of the indirect light's gradient at every
+/// cell border, which the albedo map turns into a blocky error: on the
+/// simulated room the relit image was 12.4 % off with constant 25 cm cells,
+/// 8.6 % with constant 10 cm cells (six times the cost).
 struct IndirectField {
-    /// Per triangle: cells per edge and the cells' irradiance.
-    cells: Vec<(usize, Vec<[f64; 3]>)>,
+    /// Per triangle: divisions per edge and the nodes' irradiance, node
+    /// `(i, j)` (at barycentric `(i/n, j/n)`, `i + j ≤ n`) at [`node_index`].
+    nodes: Vec<(usize, Vec<[f64; 3]>)>,
+}
+
+/// Index of lattice node `(i, j)` (`i + j ≤ n`) in row-major order over `j`.
+fn node_index(n: usize, i: usize, j: usize) -> usize {
+    // Rows j' < j hold n + 1 − j' nodes each.
+    j * (n + 1) - j * (j.saturating_sub(1)) / 2 + i
 }
 
 impl IndirectField {
@@ -421,7 +462,7 @@ impl IndirectField {
             points,
             spheres: &[],
         };
-        let cells = scene
+        let nodes = scene
             .triangles()
             .par_iter()
             .zip(sides.par_iter())
@@ -433,31 +474,32 @@ impl IndirectField {
                 let n = ((longest / options.irradiance_cell_m).ceil() as usize).clamp(1, 64);
                 let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
                 rng.set_stream(ti as u64);
-                let values = (0..n * n)
-                    .map(|k| {
-                        let (i, j) = (k % n, k / n);
-                        let (mut u, mut v) = ((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
-                        if u + v > 1.0 {
-                            let s = 0.999 / (u + v);
-                            u *= s;
-                            v *= s;
-                        }
+                let mut values = Vec::with_capacity((n + 1) * (n + 2) / 2);
+                for j in 0..=n {
+                    for i in 0..=n - j {
+                        // Nodes on the edges and corners are pulled 0.1 % toward
+                        // the centroid, so that no gather ray starts in a seam.
+                        let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+                        let third = 1.0 / 3.0;
+                        let (u, v) = (third + (u - third) * 0.999, third + (v - third) * 0.999);
                         let p = tri.point(u, v);
-                        irradiance(scene, &lighting, &p, side, options, &mut rng)
-                    })
-                    .collect();
+                        values.push(irradiance(scene, &lighting, &p, side, options, &mut rng));
+                    }
+                }
                 (n, values)
             })
             .collect();
-        IndirectField { cells }
+        IndirectField { nodes }
     }
 
-    /// The indirect irradiance at `p` on triangle `t` (zero on the side no camera sees).
+    /// The indirect irradiance at `p` on triangle `t` (zero on the side no
+    /// camera sees), interpolated linearly within the lattice's sub-triangle.
     fn at(&self, t: usize, tri: &Triangle, p: &Vector3<f64>, seen_side: bool) -> [f64; 3] {
         if !seen_side {
             return [0.0; 3];
         }
-        let (n, values) = &self.cells[t];
+        let (n, values) = &self.nodes[t];
+        let n = *n;
         let (e1, e2, q) = (
             tri.vertices[1] - tri.vertices[0],
             tri.vertices[2] - tri.vertices[0],
@@ -466,10 +508,34 @@ impl IndirectField {
         let (d11, d12, d22) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
         let (q1, q2) = (q.dot(&e1), q.dot(&e2));
         let det = d11 * d22 - d12 * d12;
-        let u = (d22 * q1 - d12 * q2) / det;
-        let v = (d11 * q2 - d12 * q1) / det;
-        let cell = |x: f64| ((x * *n as f64).floor() as i64).clamp(0, *n as i64 - 1) as usize;
-        values[cell(v) * n + cell(u)]
+        let mut u = ((d22 * q1 - d12 * q2) / det).clamp(0.0, 1.0);
+        let mut v = ((d11 * q2 - d12 * q1) / det).clamp(0.0, 1.0);
+        if !(u.is_finite() && v.is_finite()) {
+            return values[0];
+        }
+        if u + v > 1.0 {
+            let s = 1.0 / (u + v);
+            u *= s;
+            v *= s;
+        }
+        let (x, y) = (u * n as f64, v * n as f64);
+        let a = (x.floor() as usize).min(n - 1);
+        let b = (y.floor() as usize).min(n - 1);
+        let (fu, fv) = (x - a as f64, y - b as f64);
+        let node = |i: usize, j: usize| {
+            let (i, j) = (i.min(n), j.min(n));
+            let i = i.min(n - j);
+            values[node_index(n, i, j)]
+        };
+        let (w, k) = if fu + fv <= 1.0 || a + b + 2 > n {
+            ([1.0 - fu - fv, fu, fv], [node(a, b), node(a + 1, b), node(a, b + 1)])
+        } else {
+            (
+                [fu + fv - 1.0, 1.0 - fv, 1.0 - fu],
+                [node(a + 1, b + 1), node(a + 1, b), node(a, b + 1)],
+            )
+        };
+        [0, 1, 2].map(|c| (w[0] * k[0][c] + w[1] * k[1][c] + w[2] * k[2][c]).max(0.0))
     }
 }
 
@@ -571,5 +637,56 @@ impl AlbedoMap {
             height: h,
             data,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_lattice_nodes_are_numbered_once_each_in_row_order() {
+        for n in 1..9 {
+            let mut k = 0;
+            for j in 0..=n {
+                for i in 0..=n - j {
+                    assert_eq!(node_index(n, i, j), k, "n {n}, node ({i}, {j})");
+                    k += 1;
+                }
+            }
+            assert_eq!(k, (n + 1) * (n + 2) / 2);
+        }
+    }
+
+    #[test]
+    fn a_linear_field_is_interpolated_exactly() {
+        // E(u, v) = 1 + 2u + 3v at the nodes (unpulled) reproduces itself inside.
+        let tri = Triangle::new(
+            [
+                Vector3::new(0.0, 0.0, 0.0),
+                Vector3::new(2.0, 0.0, 0.0),
+                Vector3::new(0.0, 1.0, 0.0),
+            ],
+            0,
+            0,
+        )
+        .unwrap();
+        let n = 4;
+        let mut values = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n - j {
+                let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+                values.push([1.0 + 2.0 * u + 3.0 * v; 3]);
+            }
+        }
+        let field = IndirectField {
+            nodes: vec![(n, values)],
+        };
+        for (u, v) in [(0.1, 0.2), (0.33, 0.41), (0.7, 0.29), (0.0, 1.0), (0.95, 0.02)] {
+            let p = tri.point(u, v);
+            let e = field.at(0, &tri, &p, true)[0];
+            assert!((e - (1.0 + 2.0 * u + 3.0 * v)).abs() < 1e-9, "({u}, {v}): {e}");
+        }
+        assert_eq!(field.at(0, &tri, &tri.point(0.2, 0.2), false), [0.0; 3]);
     }
 }

@@ -24,7 +24,9 @@ use crate::render::{Lighting, Material, Ray, Scene, Texture, trace};
 pub struct RelightSettings {
     /// BRDF-sampled rays per pixel for the interreflected light.
     pub indirect_samples: u32,
-    /// Scattering events per path, the first included.
+    /// Scattering events per path, the first included. Default 12: in a
+    /// closed room of light walls the light falls by about 0.6 per bounce,
+    /// so 4 events miss about 13 % of it and 12 about 0.2 %.
     pub max_bounces: u32,
     /// Seed of every random choice.
     pub seed: u64,
@@ -34,7 +36,7 @@ impl Default for RelightSettings {
     fn default() -> Self {
         RelightSettings {
             indirect_samples: 16,
-            max_bounces: 4,
+            max_bounces: 12,
             seed: 11,
         }
     }
