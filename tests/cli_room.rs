@@ -28,7 +28,7 @@ fn a_lamp_seen_in_one_view_is_refused_by_name() {
             LightSequence(lights: ["lamp-1"], all_on: true, poses: ["wide-sw"]),
             Bracket(aim: Pose("wide-sw"),
                     exposures_s: [0.001, 0.002, 0.004, 0.008, 0.016, 0.032, 0.064, 0.128, 0.256, 0.512, 1.024, 2.048]),
-            AutoBracket(aim: Pose("up-sw"), max_frames: 9),
+            AutoBracket(aim: Pose("bulb-1-sw"), max_frames: 9),
         ],
     )],
 )
@@ -64,7 +64,7 @@ fn a_lamp_seen_in_one_view_is_refused_by_name() {
     assert_eq!(o.status.code(), Some(1), "{stderr}");
     assert!(
         stderr.contains(
-            "lamp \"lamp-1\": its bulb is seen unclipped in 1 view(s) (up-sw), at least 2 are needed to triangulate it"
+            "lamp \"lamp-1\": its bulb is seen unclipped in 1 view(s) (bulb-1-sw), at least 2 are needed to triangulate it"
         ),
         "{stderr}"
     );
@@ -73,7 +73,7 @@ fn a_lamp_seen_in_one_view_is_refused_by_name() {
     // What could be done was written: the response and the rectified views
     // (the wide view with its mask), none of it lost to the refusal.
     assert!(out.join("response.csv").is_file());
-    for f in ["wide-sw.exr", "wide-sw-mask.png", "up-sw.exr"] {
+    for f in ["wide-sw.exr", "wide-sw-mask.png", "bulb-1-sw.exr"] {
         assert!(out.join("room/images").join(f).is_file(), "{f}");
     }
     let img = campanile_process::exr_io::read_rgb_exr(&out.join("room/images/wide-sw.exr")).unwrap();

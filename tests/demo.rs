@@ -74,7 +74,7 @@ fn the_quick_demo_runs_end_to_end_and_its_figures_match_the_simulator() {
     assert!(room("room_relit_rmse") < 0.20);
     assert!(room("room_noise_floor_rmse") < room("room_relit_rmse"));
     // The scene file the room session became: a camera per pose with every
-    // lamp on (9) plus the full-size views the bulbs were cut from, and
+    // lamp on (12) plus the full-size views the bulbs were cut from, and
     // every lamp as bulb images.
     let scene_file = demo.join("room/processed/room/scene.ron");
     let text = std::fs::read_to_string(&scene_file).expect("the room's scene file");

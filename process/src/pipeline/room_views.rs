@@ -164,15 +164,16 @@ pub fn rectify(group: &MergedGroup, mount: &Mount, scale: f64) -> RectifiedView 
 /// position, e.g. from the station's configuration) as seen from the
 /// camera, everything else black: one bulb's image among several lit at
 /// once. `None` when the centre is behind the camera, when a bulb of
-/// radius `bulb_m` there would come within two pixels of the image border
-/// (its image would be cut), or when a pixel inside the window is not
+/// radius `bulb_m` there, with the margin and background ring that
+/// triangulation measures, would reach the image border, or when a pixel inside the window is not
 /// valid (a bulb clipped in every exposure cannot be measured).
 pub fn bulb_window(view: &RectifiedView, center: &Vector3<f64>, bulb_m: f64, window_m: f64) -> Option<RadianceImage> {
     let cam = &view.camera;
     let (cx, cy) = cam.project(center)?;
     let distance = (center - cam.position).norm();
     let focal = cam.height as f64 / 2.0 / (cam.vfov_rad / 2.0).tan();
-    let bulb_px = focal * bulb_m / distance + 2.0;
+    // The bulb, the margin and background ring the triangulation measures, and a pixel.
+    let bulb_px = focal * bulb_m / distance + crate::igi::light_triangulation::BULB_MARGIN_PX as f64 + 3.0;
     if !(cx - bulb_px >= 0.0
         && cy - bulb_px >= 0.0
         && cx + bulb_px <= cam.width as f64

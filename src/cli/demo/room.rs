@@ -18,7 +18,7 @@ use campanile_process::render::SphereLight;
 use campanile_process::report::{Figure, Section, Table, false_colour_png, tonemapped_png};
 use campanile_sim::world::examples_dir;
 use campanile_sim::world::igi_photograph::PhotoSettings;
-use campanile_sim::world::room_igi::{RoomIgi, block_average};
+use campanile_sim::world::room_igi::{ROOM_BOUNCES, RoomIgi, block_average};
 use nalgebra::Vector3;
 
 use crate::cli::igi::{write_albedo_maps, write_exr};
@@ -76,13 +76,16 @@ pub fn room(dir: &Path, quick: bool) -> Result<RoomRun> {
     // with every lamp on rectified into a scene file, the lamps triangulated.
     let session = out.join("session");
     let plan = examples_dir().join("room-igi.ron");
-    let (samples, bounces, scale) = if quick { ("8", "3", 0.25) } else { ("16", "4", 0.5) };
+    // Paths of up to ROOM_BOUNCES scattering events: cut shorter, the
+    // photographs miss interreflected light the solver models (ρd low).
+    let bounces = ROOM_BOUNCES.to_string();
+    let (samples, scale) = if quick { ("8", 0.25) } else { ("16", 0.5) };
     let t = Instant::now();
     crate::cli::demo::capture_simulated(
         &plan,
         &examples_dir().join("sim-station.ron"),
         &session,
-        &["--sim-samples", samples, "--sim-bounces", bounces],
+        &["--sim-samples", samples, "--sim-bounces", &bounces],
     )?;
     let photograph_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
@@ -207,7 +210,7 @@ pub fn room(dir: &Path, quick: bool) -> Result<RoomRun> {
         camera,
         &PhotoSettings {
             indirect_samples: samples,
-            max_bounces: 4,
+            max_bounces: ROOM_BOUNCES,
             seed: 99,
         },
     );
@@ -219,7 +222,7 @@ pub fn room(dir: &Path, quick: bool) -> Result<RoomRun> {
         camera,
         &campanile_process::igi::relight::RelightSettings {
             indirect_samples: samples,
-            max_bounces: 4,
+            max_bounces: ROOM_BOUNCES,
             seed: 5,
         },
     );
