@@ -27,6 +27,13 @@ const HEIGHT: usize = 96;
 const SPP: u32 = 64;
 const SPACING_M: f64 = 2.0;
 
+/// Sub-samples per cell side for a cell's true albedo. The mortar joints
+/// are 5 cm wide and 12% of the wall: an 8 × 8 grid over a 2 m cell (25 cm
+/// apart) aliases with the 0.6 m courses and put 0–25% of its points on
+/// mortar, a ±3% error in the "truth" itself (measured: it was the whole
+/// texture term of the budget).
+const TRUTH_PER_SIDE: usize = 64;
+
 const TRAINING: [&str; 4] = [
     "2026-08-29T15:48:00Z",
     "2026-08-29T20:10:00Z",
@@ -129,7 +136,7 @@ fn recover_day(textured: bool) -> Day {
     let (refl, _) = recover_reflectance(&w.scene.scene, &targets, &photos, &lights, &settings).unwrap();
     let truth = (0..refl.grid.cells.len())
         .map(|c| {
-            let pts = refl.grid.cell_points(&w.scene.scene, c, 8);
+            let pts = refl.grid.cell_points(&w.scene.scene, c, TRUTH_PER_SIDE);
             let tri = refl.grid.cells[c].triangle;
             let mut s = [0.0; 3];
             for p in &pts {
@@ -280,4 +287,51 @@ fn corner_cells_are_not_polluted_by_the_next_wall() {
         day.refl.cells[which]
     );
     assert!(worst <= 0.30, "worst wall cell {worst}");
+}
+
+fn textured_day() -> &'static Day {
+    static DAY: OnceLock<Day> = OnceLock::new();
+    DAY.get_or_init(|| recover_day(true))
+}
+
+/// The simulated day itself, brick texture and all, with the light known
+/// (64 samples per pixel): the pseudo-albedos of every seen cell against
+/// the texture averaged over each cell, and the texture kept (correlation
+/// of recovered and true cell albedos over the sunlit walls). Measured:
+/// ρ_se 2.2% median (p95 9.2%), ρ_sun 1.6% (7.1%), correlation 0.35–0.48
+/// (2 m cells average ~5 bricks of ±12%, so cell means vary by only ~3%,
+/// about the photos' noise here); at 256 samples per pixel 1.6% / 1.2%
+/// (`outdoor_budget`, line "bricks"). The 2% median of issue 9 is reached
+/// for ρ_sun here and for both at 256 samples.
+#[test]
+fn the_textured_day_with_the_light_known() {
+    let day = textured_day();
+    let (mut se, mut sun) = errors(day);
+    let (ms, ps, mu, pu) = (
+        quantile(&mut se, 0.5),
+        quantile(&mut se, 0.95),
+        quantile(&mut sun, 0.5),
+        quantile(&mut sun, 0.95),
+    );
+    let mut corr = Vec::new();
+    for name in ["south-face", "east-face", "west-face"] {
+        let s = day.world.scene.scene.surface_index(name).unwrap();
+        let ids: Vec<usize> = (0..day.truth.len())
+            .filter(|&c| day.refl.grid.cells[c].surface == s && day.refl.cells[c].status != CellStatus::Unseen)
+            .collect();
+        let a: Vec<f64> = ids.iter().map(|&c| day.refl.cells[c].rho_se[1]).collect();
+        let b: Vec<f64> = ids.iter().map(|&c| day.truth[c][1]).collect();
+        let n = a.len() as f64;
+        let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+        let cov: f64 = a.iter().zip(&b).map(|(x, y)| (x - ma) * (y - mb)).sum();
+        let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
+        let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
+        corr.push(cov / (va * vb).sqrt());
+    }
+    eprintln!(
+        "textured: ρ_se median {ms:.4} p95 {ps:.4}; ρ_sun median {mu:.4} p95 {pu:.4}; texture correlation S/E/W {corr:.3?}"
+    );
+    assert!(ms <= 0.025 && mu <= 0.02, "medians ρ_se {ms}, ρ_sun {mu}");
+    assert!(ps <= 0.10 && pu <= 0.10, "p95 ρ_se {ps}, ρ_sun {pu}");
+    assert!(corr.iter().all(|&r| r >= 0.3), "texture correlation {corr:?}");
 }
