@@ -14,7 +14,10 @@
 //!
 //! A cell needs a sunlit and a shadowed view to separate ρ^sun from ρ^se.
 //! Cells never seen sunlit, never seen shadowed, or whose 2 × 2 system is
-//! ill-conditioned are reported and filled from their face (§5.4): the
+//! ill-conditioned (a large column-scaled condition number, or a ρ that
+//! amplifies one observation's relative error more than
+//! [`ReflectanceSettings::max_amplification`], as a grazing sun does) are
+//! reported and filled from their face (§5.4): the
 //! face's median ratio `k = ρ^sun / ρ^se` over its solved cells (or the
 //! surface's, or the scene's) ties the two, and the cell's own photos fit
 //! the one remaining unknown, so its texture is kept. Cells no photo saw
@@ -115,6 +118,10 @@ pub struct CellEstimate {
     /// Condition number of the column-scaled 2 × 2 normal matrix (green
     /// channel); infinite when only one lighting state was seen.
     pub condition: f64,
+    /// How much one observation's relative error is amplified in the worse
+    /// of ρ^sun and ρ^se (all channels; see
+    /// [`ReflectanceSettings::max_amplification`]); infinite when not fitted.
+    pub amplification: f64,
     /// Observations used (photo × lighting state).
     pub observations: usize,
     /// Weighted RMS relative residual of the fit (0 when not fitted).
@@ -344,6 +351,7 @@ fn solve_cell(rows: &[Row], settings: &ReflectanceSettings) -> (CellEstimate, bo
             CellStatus::Solved
         },
         condition: f64::INFINITY,
+        amplification: f64::INFINITY,
         observations: rows.len(),
         rms_relative: 0.0,
     };
@@ -377,6 +385,7 @@ fn solve_cell(rows: &[Row], settings: &ReflectanceSettings) -> (CellEstimate, bo
         est.sigma_sun[ch] = (s2 * inv[(1, 1)]).sqrt();
     }
     est.rms_relative = var_all.sqrt();
+    est.amplification = amplification;
     if amplification > settings.max_amplification
         || est.condition > settings.max_condition
         || est.rho_se.iter().chain(&est.rho_sun).any(|v| !v.is_finite())
