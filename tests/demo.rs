@@ -82,7 +82,7 @@ fn the_quick_demo_runs_end_to_end_and_its_figures_match_the_simulator() {
         campanile_process::igi::scene_file::parse(&scene_file, &text).expect("a valid scene file");
     assert_eq!(
         scene.images.len(),
-        9,
+        12,
         "one view per pose of examples/room-igi-scene.ron"
     );
     assert_eq!(scene.lights.len(), 3);

@@ -63,7 +63,7 @@ fn rig(w: &World, station: &campanile_config::Station, name: &str, width: usize)
 fn truth(w: &World, refl: &Reflectance) -> Vec<[f64; 3]> {
     (0..refl.grid.cells.len())
         .map(|c| {
-            let pts = refl.grid.cell_points(&w.scene.scene, c, 8);
+            let pts = refl.grid.cell_points(&w.scene.scene, c, 64);
             let tri = refl.grid.cells[c].triangle;
             let mut s = [0.0; 3];
             for p in &pts {

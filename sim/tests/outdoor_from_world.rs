@@ -106,7 +106,9 @@ fn daylights(w: &World, times: &[&str]) -> Vec<(DateTime<Utc>, Daylight)> {
 fn truth(w: &World, refl: &Reflectance) -> Vec<[f64; 3]> {
     (0..refl.grid.cells.len())
         .map(|c| {
-            let pts = refl.grid.cell_points(&w.scene.scene, c, 8);
+            // 64 × 64 sub-samples: the 5 cm mortar joints alias with an
+            // 8 × 8 grid (±3% in the truth itself, tests/outdoor_error_budget.rs).
+            let pts = refl.grid.cell_points(&w.scene.scene, c, 64);
             let tri = refl.grid.cells[c].triangle;
             let mut s = [0.0; 3];
             for p in &pts {
@@ -187,7 +189,7 @@ fn training_photos(w: &World) -> &'static [Photo] {
 
 fn median_signed(refl: &Reflectance, truth: &[[f64; 3]], surface: usize, sun: bool) -> f64 {
     let mut v: Vec<f64> = (0..truth.len())
-        .filter(|&c| refl.grid.cells[c].surface == surface && refl.cells[c].status == CellStatus::Solved)
+        .filter(|&c| refl.grid.cells[c].surface == surface && refl.cells[c].status != CellStatus::Unseen)
         .flat_map(|c| {
             let e = &refl.cells[c];
             (0..3).map(move |ch| if sun { e.rho_sun[ch] } else { e.rho_se[ch] } / truth[c][ch] - 1.0)
@@ -228,8 +230,11 @@ fn pseudo_albedos_and_the_held_out_time_match_the_world() {
     let refl = recover(&w, photos, &TRAINING);
     let tr = truth(&w, &refl);
     let solved = |c: usize| refl.cells[c].status == CellStatus::Solved;
+    // 688 of 927 seen cells are solved alone since pixels straddling two
+    // faces are dropped and grazing-sun cells are filled (973 before, many
+    // of them wrong; see tests/outdoor_error_budget.rs).
     assert!(
-        refl.count(CellStatus::Solved) > 800,
+        refl.count(CellStatus::Solved) > 600,
         "{} cells solved",
         refl.count(CellStatus::Solved)
     );

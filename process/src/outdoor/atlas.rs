@@ -230,6 +230,7 @@ pub fn read_materials(scene: &Scene, path: &Path) -> Result<Reflectance, Outdoor
                 CellStatus::Unseen
             },
             condition: f64::INFINITY,
+            amplification: f64::INFINITY,
             observations: 0,
             rms_relative: 0.0,
         });
@@ -281,6 +282,7 @@ mod tests {
                 sigma_se: [0.01; 3],
                 status: CellStatus::Solved,
                 condition: 2.0,
+                amplification: 2.0,
                 observations: 4,
                 rms_relative: 0.01,
             })

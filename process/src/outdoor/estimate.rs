@@ -14,7 +14,10 @@
 //!
 //! A cell needs a sunlit and a shadowed view to separate ρ^sun from ρ^se.
 //! Cells never seen sunlit, never seen shadowed, or whose 2 × 2 system is
-//! ill-conditioned are reported and filled from their face (§5.4): the
+//! ill-conditioned (a large column-scaled condition number, or a ρ that
+//! amplifies one observation's relative error more than
+//! [`ReflectanceSettings::max_amplification`], as a grazing sun does) are
+//! reported and filled from their face (§5.4): the
 //! face's median ratio `k = ρ^sun / ρ^se` over its solved cells (or the
 //! surface's, or the scene's) ties the two, and the cell's own photos fit
 //! the one remaining unknown, so its texture is kept. Cells no photo saw
@@ -27,7 +30,7 @@ use rayon::prelude::*;
 use super::OutdoorError;
 use super::cell_irradiance::{GatherSettings, TimeLight, gather};
 use super::grid::Grid;
-use super::observation::{Observation, SamplingReport, observe};
+use super::observation::{Footprint, Observation, SamplingReport, observe};
 use super::photo::{Illumination, Photo};
 use crate::render::Scene;
 
@@ -42,10 +45,22 @@ pub struct ReflectanceSettings {
     pub passes: usize,
     /// Huber threshold on the relative residual.
     pub huber_relative: f64,
-    /// A photo whose median |ln(observed / fitted)| exceeds this is an outlier.
+    /// A photo whose level |ln(observed / fitted)| (trimmed mean of its
+    /// cells' ratios) exceeds this is an outlier.
     pub outlier_log_ratio: f64,
     /// Cells whose column-scaled normal matrix has a larger condition number are filled.
     pub max_condition: f64,
+    /// Cells whose ρ^sun or ρ^se amplifies the photos' relative error by
+    /// more than this are filled: `σ(ρ)/ρ` per unit relative error of one
+    /// observation, `√(n (AᵀWA)⁻¹ᵢᵢ) / min(ρ^se, ρ^sun)` over the cell's n rows (one
+    /// sunlit and one shadowed view with sun and sky alike give √10 ≈ 3.2;
+    /// a sun four times the sky, 1.8). The column-scaled condition number misses the
+    /// common case of a sun that only grazes the face: a sunlit view whose
+    /// sun term is 5% of the sky term separates ρ^sun from ρ^se, but a 1%
+    /// error in its radiance moves ρ^sun by 20%.
+    pub max_amplification: f64,
+    /// Where a pixel's footprint must lie to be credited to a cell.
+    pub footprint: Footprint,
     /// Smallest relative noise assumed when stating uncertainty.
     pub noise_floor: f64,
     /// A photo's time matches an illumination within this many seconds.
@@ -61,6 +76,8 @@ impl Default for ReflectanceSettings {
             huber_relative: 0.05,
             outlier_log_ratio: 0.1,
             max_condition: 50.0,
+            max_amplification: 5.0,
+            footprint: Footprint::Face,
             noise_floor: 0.01,
             time_tolerance_s: 120.0,
         }
@@ -101,6 +118,10 @@ pub struct CellEstimate {
     /// Condition number of the column-scaled 2 × 2 normal matrix (green
     /// channel); infinite when only one lighting state was seen.
     pub condition: f64,
+    /// How much one observation's relative error is amplified in the worse
+    /// of ρ^sun and ρ^se (all channels; see
+    /// [`ReflectanceSettings::max_amplification`]); infinite when not fitted.
+    pub amplification: f64,
     /// Observations used (photo × lighting state).
     pub observations: usize,
     /// Weighted RMS relative residual of the fit (0 when not fitted).
@@ -112,7 +133,7 @@ pub struct CellEstimate {
 pub struct PhotoCheck {
     /// The photo's label.
     pub label: String,
-    /// Median over its observations of ln(observed / fitted), channel mean.
+    /// ln of the trimmed mean (10% cut each side) of observed / fitted over its solved cells.
     pub median_log_ratio: f64,
     /// Observations it contributed.
     pub observations: usize,
@@ -178,26 +199,58 @@ fn median(v: &mut [f64]) -> Option<f64> {
     })
 }
 
+/// The mean of `v` without its lowest and highest tenth: the level of a
+/// photo's observed-to-fitted ratios. Unlike their median it is not pulled
+/// down by the skewed Monte Carlo noise of shaded walls, which had noisy
+/// but correctly exposed photos rejected as outliers.
+fn trimmed_mean(v: &mut [f64]) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(|a, b| a.total_cmp(b));
+    let cut = v.len() / 10;
+    let kept = &v[cut..v.len() - cut];
+    Some(kept.iter().sum::<f64>() / kept.len() as f64)
+}
+
 /// Weighted least squares of `y ≈ a·x1 + b·x2` on relative residuals with
 /// Huber reweighting; returns (a, b, covariance scale matrix (AᵀWA)⁻¹,
 /// weighted residual variance, condition number).
 fn fit2(rows: &[(f64, f64, f64, f64)], huber: f64) -> Option<(Vector2<f64>, Matrix2<f64>, f64, f64)> {
     let mut robust = vec![1.0; rows.len()];
+    // The scale of each relative residual: the observation at first, then
+    // the fitted value. Dividing by the noisy observation itself favours the
+    // observations that came out low (a bias of about the relative variance
+    // of one observation, percents on noisy photographs).
+    let mut scale: Vec<f64> = rows.iter().map(|r| r.0).collect();
     let mut sol = None;
     for _ in 0..4 {
         let mut m = Matrix2::zeros();
         let mut r = Vector2::zeros();
-        for ((y, x1, x2, w), h) in rows.iter().zip(&robust) {
-            let wy = w * h / y.max(1e-12).powi(2);
+        for (((y, x1, x2, w), h), s) in rows.iter().zip(&robust).zip(&scale) {
+            let wy = w * h / s.max(1e-12).powi(2);
             let x = Vector2::new(*x1, *x2);
             m += x * x.transpose() * wy;
             r += x * (wy * y);
         }
         let inv = m.try_inverse()?;
         let p = inv * r;
-        for ((y, x1, x2, _), h) in rows.iter().zip(robust.iter_mut()) {
-            let rel = ((y - p[0] * x1 - p[1] * x2) / y.max(1e-12)).abs();
-            *h = if rel <= huber { 1.0 } else { huber / rel };
+        let mut rels = Vec::with_capacity(rows.len());
+        for ((y, x1, x2, _), s) in rows.iter().zip(scale.iter_mut()) {
+            let fitted = p[0] * x1 + p[1] * x2;
+            if fitted > 0.0 {
+                *s = fitted;
+            }
+            rels.push(((y - fitted) / s.max(1e-12)).abs());
+        }
+        // Huber's threshold at 1.345 robust standard deviations of the
+        // residuals (MAD), never below `huber`: on noisy photographs a fixed
+        // small threshold turns the fit into a median, which is biased low
+        // for the skewed noise of shaded walls (−10% at 2 samples per pixel).
+        let mut sorted = rels.clone();
+        let threshold = median(&mut sorted).map_or(huber, |mad| (1.345 * 1.4826 * mad).max(huber));
+        for (rel, h) in rels.iter().zip(robust.iter_mut()) {
+            *h = if *rel <= threshold { 1.0 } else { threshold / rel };
         }
         // Condition of the column-scaled matrix.
         let d = Vector2::new(m[(0, 0)].sqrt(), m[(1, 1)].sqrt());
@@ -208,8 +261,8 @@ fn fit2(rows: &[(f64, f64, f64, f64)], huber: f64) -> Option<(Vector2<f64>, Matr
     }
     let (p, inv, cond) = sol?;
     let mut rss = 0.0;
-    for ((y, x1, x2, w), h) in rows.iter().zip(&robust) {
-        let rel = (y - p[0] * x1 - p[1] * x2) / y.max(1e-12);
+    for (((y, x1, x2, w), h), s) in rows.iter().zip(&robust).zip(&scale) {
+        let rel = (y - p[0] * x1 - p[1] * x2) / s.max(1e-12);
         rss += w * h * rel * rel;
     }
     let dof = rows.len() as f64 - 2.0;
@@ -266,6 +319,12 @@ fn rows_of(
         .collect()
 }
 
+/// A face's ratio ρ^sun/ρ^se is taken from its own solved cells only when it
+/// has at least this many (else from its surface, else the scene): on a face
+/// the sun only grazes, the few cells that pass are the noisiest (a north
+/// wall's ratio came out 3.5 from three of them).
+const MIN_RATIO_CELLS: usize = 10;
+
 /// A photo is judged an outlier only on at least this many solved cells.
 pub const MIN_OUTLIER_EVIDENCE: usize = 30;
 
@@ -292,6 +351,7 @@ fn solve_cell(rows: &[Row], settings: &ReflectanceSettings) -> (CellEstimate, bo
             CellStatus::Solved
         },
         condition: f64::INFINITY,
+        amplification: f64::INFINITY,
         observations: rows.len(),
         rms_relative: 0.0,
     };
@@ -300,6 +360,7 @@ fn solve_cell(rows: &[Row], settings: &ReflectanceSettings) -> (CellEstimate, bo
     }
     let floor2 = settings.noise_floor.powi(2);
     let mut var_all = 0.0;
+    let mut amplification: f64 = 0.0;
     for ch in 0..3 {
         let sys: Vec<(f64, f64, f64, f64)> = rows.iter().map(|r| (r.y[ch], r.e_se[ch], r.e_sun[ch], r.w)).collect();
         let Some((p, inv, var, cond)) = fit2(&sys, settings.huber_relative) else {
@@ -309,6 +370,13 @@ fn solve_cell(rows: &[Row], settings: &ReflectanceSettings) -> (CellEstimate, bo
         if ch == 1 {
             est.condition = cond;
         }
+        // Relative to the smaller of the two estimates: a ρ^sun blown up by
+        // a grazing sun would otherwise look well determined against itself.
+        let n = rows.len() as f64;
+        let scale = p[0].abs().min(p[1].abs()).max(1e-12);
+        amplification = amplification
+            .max((n * inv[(0, 0)]).max(0.0).sqrt() / scale)
+            .max((n * inv[(1, 1)]).max(0.0).sqrt() / scale);
         let s2 = var.max(floor2);
         var_all += var / 3.0;
         est.rho_se[ch] = p[0];
@@ -317,7 +385,11 @@ fn solve_cell(rows: &[Row], settings: &ReflectanceSettings) -> (CellEstimate, bo
         est.sigma_sun[ch] = (s2 * inv[(1, 1)]).sqrt();
     }
     est.rms_relative = var_all.sqrt();
-    if est.condition > settings.max_condition || est.rho_se.iter().chain(&est.rho_sun).any(|v| !v.is_finite()) {
+    est.amplification = amplification;
+    if amplification > settings.max_amplification
+        || est.condition > settings.max_condition
+        || est.rho_se.iter().chain(&est.rho_sun).any(|v| !v.is_finite())
+    {
         est.status = CellStatus::IllConditioned;
         return (est, false);
     }
@@ -370,7 +442,7 @@ pub fn recover_reflectance(
         .collect::<Result<_, _>>()?;
     let viewpoints: Vec<_> = photos.iter().map(|p| p.rig.position).collect();
     let grid = Grid::new(scene, targets, settings.spacing_m, &viewpoints)?;
-    let (obs, sampling) = observe(scene, &grid, photos, lights, &times)?;
+    let (obs, sampling) = observe(scene, &grid, photos, lights, &times, settings.footprint)?;
     let tls: Vec<TimeLight> = lights
         .iter()
         .map(|l| gather(scene, &grid, l, &settings.gather))
@@ -400,7 +472,7 @@ pub fn recover_reflectance(
         // Face, surface and scene ratios from the solved cells.
         let ratio_of = |ids: &mut dyn Iterator<Item = usize>| -> Option<([f64; 3], [f64; 3])> {
             let ids: Vec<usize> = ids.filter(|&i| solved[i].1).collect();
-            if ids.len() < 3 {
+            if ids.len() < MIN_RATIO_CELLS {
                 return None;
             }
             let mut k = [0.0; 3];
@@ -481,7 +553,7 @@ pub fn recover_reflectance(
             .iter()
             .enumerate()
             .map(|(p, photo)| {
-                let mut lr: Vec<f64> = obs
+                let mut ratios: Vec<f64> = obs
                     .iter()
                     .filter(|o| o.photo == p && est[o.cell].status == CellStatus::Solved)
                     .filter_map(|o| {
@@ -491,17 +563,17 @@ pub fn recover_reflectance(
                         let v: f64 = (0..3)
                             .map(|ch| {
                                 let fit = rho_se[o.cell][ch] * e_se[ch] + rho_sun[o.cell][ch] * e_sun[ch];
-                                (std::f64::consts::PI * o.radiance[ch] / fit).ln()
+                                std::f64::consts::PI * o.radiance[ch] / fit
                             })
                             .sum::<f64>()
                             / 3.0;
                         v.is_finite().then_some(v)
                     })
                     .collect();
-                let count = lr.len();
+                let count = ratios.len();
                 PhotoCheck {
                     label: photo.label.clone(),
-                    median_log_ratio: median(&mut lr).unwrap_or(0.0),
+                    median_log_ratio: trimmed_mean(&mut ratios).filter(|m| *m > 0.0).map_or(0.0, f64::ln),
                     observations: count,
                     outlier: !active[p],
                 }

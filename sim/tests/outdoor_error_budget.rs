@@ -1,0 +1,337 @@
+//! The outdoor reflectance stage (issue 9) against the simulated campanile
+//! day with its ingredients controlled (the error budget of BENCHMARKS.md,
+//! `cargo run --release -p campanile-sim --example outdoor_budget`): the
+//! true sun, sky and environment, photographs with little Monte Carlo
+//! noise, and the tower's materials either of constant albedo (so a cell's
+//! truth is unambiguous) or with their brick texture.
+
+// Channel loops index several arrays at once; they read better with an index.
+#![allow(clippy::needless_range_loop)]
+
+use std::sync::OnceLock;
+
+use campanile_process::camera::image::RadianceImage;
+use campanile_process::outdoor::rerender::target_mask;
+use campanile_process::outdoor::{
+    CellStatus, Illumination, Photo, Reflectance, ReflectanceSettings, RerenderSettings, recover_reflectance, rerender,
+};
+use campanile_process::pose::HeadPose;
+use campanile_process::render::{CameraRig, Scene, Texture};
+use campanile_sim::world::{World, examples_dir, load_scene};
+use chrono::{DateTime, Utc};
+
+/// Photo size and samples: small, so the test stays fast (≈ 16 s in the dev
+/// profile); a 2 m cell sees ~10 pixels per photo.
+const WIDTH: usize = 128;
+const HEIGHT: usize = 96;
+const SPP: u32 = 64;
+const SPACING_M: f64 = 2.0;
+
+/// Sub-samples per cell side for a cell's true albedo. The mortar joints
+/// are 5 cm wide and 12% of the wall: an 8 × 8 grid over a 2 m cell (25 cm
+/// apart) aliases with the 0.6 m courses and put 0–25% of its points on
+/// mortar, a ±3% error in the "truth" itself (measured: it was the whole
+/// texture term of the budget).
+const TRUTH_PER_SIDE: usize = 64;
+
+const TRAINING: [&str; 4] = [
+    "2026-08-29T15:48:00Z",
+    "2026-08-29T20:10:00Z",
+    "2026-08-29T22:42:00Z",
+    "2026-08-30T01:38:00Z",
+];
+const HELD_OUT: &str = "2026-08-29T20:30:00Z";
+const VIEWS: [&str; 4] = ["view-se", "view-sw", "view-nw", "view-ne"];
+const TOWER: [&str; 6] = ["south-face", "east-face", "north-face", "west-face", "pillars", "roof"];
+
+fn time(s: &str) -> DateTime<Utc> {
+    s.parse().unwrap()
+}
+
+fn station() -> campanile_config::Station {
+    campanile_config::document::load_station(&examples_dir().join("sim-station.ron"))
+        .unwrap()
+        .value
+}
+
+/// The world, with the tower's materials flattened to their mean albedo
+/// unless `textured`.
+fn world(textured: bool) -> World {
+    let mut w = World::new(
+        &station(),
+        load_scene(&examples_dir().join("campanile-scene.ron")).unwrap(),
+    );
+    w.quality.samples_per_pixel = SPP;
+    w.quality.max_bounces = 2;
+    if !textured {
+        let scene = &w.scene.scene;
+        let tower: Vec<u32> = TOWER.iter().map(|s| scene.surface_index(s).unwrap() as u32).collect();
+        let tower_materials: Vec<u32> = scene
+            .triangles()
+            .iter()
+            .filter(|t| tower.contains(&t.surface))
+            .map(|t| t.material)
+            .collect();
+        let materials = scene
+            .materials()
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                let mut m = m.clone();
+                if tower_materials.contains(&(i as u32)) {
+                    m.albedo = Texture::Constant(m.albedo.mean_albedo());
+                }
+                m
+            })
+            .collect();
+        w.scene.scene = Scene::new(scene.triangles().to_vec(), materials, scene.surfaces().to_vec()).unwrap();
+    }
+    w
+}
+
+fn rig(w: &World, name: &str) -> CameraRig {
+    let station = station();
+    let pose = w.scene.description.pose(name).unwrap();
+    let (pan, tilt) = station.head.reach(pose.azimuth_deg, pose.elevation_deg).unwrap();
+    let head = HeadPose {
+        pan_rad: pan.to_radians(),
+        tilt_rad: tilt.to_radians(),
+    };
+    let (x, y, z) = pose.position_m;
+    w.rig(head, [x, y, z], WIDTH, HEIGHT)
+}
+
+struct Day {
+    world: World,
+    refl: Reflectance,
+    /// Truth per cell: the world's albedo averaged over the cell.
+    truth: Vec<[f64; 3]>,
+}
+
+fn recover_day(textured: bool) -> Day {
+    let w = world(textured);
+    let mut photos = Vec::new();
+    for (i, t) in TRAINING.iter().enumerate() {
+        for (j, v) in VIEWS.iter().enumerate() {
+            let r = rig(&w, v);
+            photos.push(Photo {
+                label: format!("{t} {v}"),
+                image: w.render(time(t), &r, &[], 100 + (i * 4 + j) as u64).unwrap(),
+                rig: r,
+                time: time(t),
+                mask: None,
+            });
+        }
+    }
+    let days: Vec<_> = TRAINING
+        .iter()
+        .map(|t| (time(t), w.daylight(time(t)).unwrap().unwrap()))
+        .collect();
+    let lights: Vec<Illumination> = days.iter().map(|(t, d)| Illumination { time: *t, sky: d }).collect();
+    let targets: Vec<usize> = TOWER.iter().map(|s| w.scene.scene.surface_index(s).unwrap()).collect();
+    let settings = ReflectanceSettings {
+        spacing_m: SPACING_M,
+        ..ReflectanceSettings::default()
+    };
+    let (refl, _) = recover_reflectance(&w.scene.scene, &targets, &photos, &lights, &settings).unwrap();
+    let truth = (0..refl.grid.cells.len())
+        .map(|c| {
+            let pts = refl.grid.cell_points(&w.scene.scene, c, TRUTH_PER_SIDE);
+            let tri = refl.grid.cells[c].triangle;
+            let mut s = [0.0; 3];
+            for p in &pts {
+                let a = w.pseudo_albedos(tri, [p.x, p.y, p.z]).sun;
+                for ch in 0..3 {
+                    s[ch] += a[ch] / pts.len() as f64;
+                }
+            }
+            s
+        })
+        .collect();
+    Day { world: w, refl, truth }
+}
+
+fn flat_day() -> &'static Day {
+    static DAY: OnceLock<Day> = OnceLock::new();
+    DAY.get_or_init(|| recover_day(false))
+}
+
+fn quantile(v: &mut [f64], q: f64) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v[((v.len() - 1) as f64 * q).round() as usize]
+}
+
+/// |relative error| of ρ_se and ρ_sun over every cell some photo saw
+/// (solved or filled), all channels: (ρ_se, ρ_sun).
+fn errors(day: &Day) -> (Vec<f64>, Vec<f64>) {
+    let (mut se, mut sun) = (Vec::new(), Vec::new());
+    for (c, t) in day.truth.iter().enumerate() {
+        let e = &day.refl.cells[c];
+        if e.status == CellStatus::Unseen {
+            continue;
+        }
+        for ch in 0..3 {
+            se.push((e.rho_se[ch] / t[ch] - 1.0).abs());
+            sun.push((e.rho_sun[ch] / t[ch] - 1.0).abs());
+        }
+    }
+    (se, sun)
+}
+
+/// Relative RMSE of k × k block means over blocks wholly in `mask`.
+fn block_rmse(a: &RadianceImage, b: &RadianceImage, mask: &[bool], k: usize) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    for by in 0..a.height / k {
+        for bx in 0..a.width / k {
+            let px: Vec<usize> = (0..k * k)
+                .map(|q| (by * k + q / k) * a.width + bx * k + q % k)
+                .collect();
+            if !px.iter().all(|&i| mask[i]) {
+                continue;
+            }
+            for ch in 0..3 {
+                let m = |im: &RadianceImage| {
+                    px.iter().map(|&i| f64::from(im.data[i * 3 + ch])).sum::<f64>() / px.len() as f64
+                };
+                num += (m(a) - m(b)).powi(2);
+                den += m(b).powi(2);
+            }
+        }
+    }
+    (num / den).sqrt()
+}
+
+/// With the light known and the walls of constant albedo, what is left is
+/// the solver's own error and the photos' noise (64 samples per pixel):
+/// the pseudo-albedos of every seen cell (solved or filled) within 2%
+/// (median) and 10% (p95), both pseudo-BRDFs. Measured: ρ_se 1.75% / 8.6%,
+/// ρ_sun 1.04% / 5.6% (at 256 samples per pixel: 1.2% / 5.0% and 0.6% /
+/// 3.2%; BENCHMARKS.md, "Outdoor error budget"). Before the footprint test,
+/// the amplification test and the fitted-value weights: 2.5% / 46% and
+/// 1.8% / 370% at 256 samples.
+#[test]
+fn with_the_light_known_pseudo_albedos_are_within_two_percent() {
+    let day = flat_day();
+    let (mut se, mut sun) = errors(day);
+    let seen = day.refl.grid.cells.len() - day.refl.count(CellStatus::Unseen);
+    let (ms, ps, mu, pu) = (
+        quantile(&mut se, 0.5),
+        quantile(&mut se, 0.95),
+        quantile(&mut sun, 0.5),
+        quantile(&mut sun, 0.95),
+    );
+    eprintln!(
+        "{seen} cells seen, {} solved; ρ_se median {ms:.4} p95 {ps:.4}; ρ_sun median {mu:.4} p95 {pu:.4}; {:?}",
+        day.refl.count(CellStatus::Solved),
+        day.refl.sampling
+    );
+    assert!(seen >= 300, "{seen} cells seen");
+    assert!(ms <= 0.02 && mu <= 0.02, "medians ρ_se {ms}, ρ_sun {mu}");
+    assert!(ps <= 0.10 && pu <= 0.10, "p95 ρ_se {ps}, ρ_sun {pu}");
+    assert!(day.refl.photos.iter().all(|p| !p.outlier), "{:?}", day.refl.photos);
+}
+
+/// The held-out time re-rendered from those pseudo-albedos, against the
+/// simulator's photographs of three views (64 samples per pixel), per
+/// 4 × 4-pixel block (about one 2 m cell): ≤ 3% (measured 2.1%, 0.8%, 1.9%;
+/// two 64-sample renders differ by 1–2% per block).
+#[test]
+fn with_the_light_known_the_held_out_time_is_within_three_percent() {
+    let day = flat_day();
+    let w = &day.world;
+    let held = w.daylight(time(HELD_OUT)).unwrap().unwrap();
+    let light = Illumination {
+        time: time(HELD_OUT),
+        sky: &held,
+    };
+    for v in ["view-se", "view-sw", "view-nw"] {
+        let r = rig(w, v);
+        let reference = w.render(time(HELD_OUT), &r, &[], 7).unwrap();
+        let (image, _) = rerender(&w.scene.scene, &day.refl, &r, &light, &RerenderSettings::default());
+        let mask = target_mask(&w.scene.scene, &day.refl, &r);
+        let block = block_rmse(&image, &reference, &mask, 4);
+        eprintln!("{v}: relative RMSE per 4×4 block {block:.4}");
+        assert!(block <= 0.03, "{v}: block relative RMSE {block}");
+    }
+}
+
+/// A pixel straddling the tower's corner sees a sunlit and a shaded wall at
+/// once; without the footprint test the corner cells came out up to twice
+/// too bright and their ρ_sun wrong tenfold (p95 of |error| 3.7 before).
+/// The worst cell of the four walls is now within 30% (measured 24%, a
+/// cell under the belfry seen by four pixels).
+#[test]
+fn corner_cells_are_not_polluted_by_the_next_wall() {
+    let day = flat_day();
+    let mut worst: f64 = 0.0;
+    let mut which = 0;
+    for (c, t) in day.truth.iter().enumerate() {
+        let e = &day.refl.cells[c];
+        let surface = &day.world.scene.scene.surfaces()[day.refl.grid.cells[c].surface];
+        if e.status == CellStatus::Unseen || !surface.ends_with("-face") {
+            continue;
+        }
+        for ch in 0..3 {
+            let err = (e.rho_se[ch] / t[ch] - 1.0)
+                .abs()
+                .max((e.rho_sun[ch] / t[ch] - 1.0).abs());
+            if err > worst {
+                worst = err;
+                which = c;
+            }
+        }
+    }
+    eprintln!(
+        "walls: worst |relative error| {worst:.4} at cell {which} {:?} {:?}",
+        day.refl.grid.cells[which].centre.as_slice(),
+        day.refl.cells[which]
+    );
+    assert!(worst <= 0.30, "worst wall cell {worst}");
+}
+
+fn textured_day() -> &'static Day {
+    static DAY: OnceLock<Day> = OnceLock::new();
+    DAY.get_or_init(|| recover_day(true))
+}
+
+/// The simulated day itself, brick texture and all, with the light known
+/// (64 samples per pixel): the pseudo-albedos of every seen cell against
+/// the texture averaged over each cell, and the texture kept (correlation
+/// of recovered and true cell albedos over the sunlit walls). Measured:
+/// ρ_se 2.2% median (p95 9.2%), ρ_sun 1.6% (7.1%), correlation 0.35–0.48
+/// (2 m cells average ~5 bricks of ±12%, so cell means vary by only ~3%,
+/// about the photos' noise here); at 256 samples per pixel 1.6% / 1.2%
+/// (`outdoor_budget`, line "bricks"). The 2% median of issue 9 is reached
+/// for ρ_sun here and for both at 256 samples.
+#[test]
+fn the_textured_day_with_the_light_known() {
+    let day = textured_day();
+    let (mut se, mut sun) = errors(day);
+    let (ms, ps, mu, pu) = (
+        quantile(&mut se, 0.5),
+        quantile(&mut se, 0.95),
+        quantile(&mut sun, 0.5),
+        quantile(&mut sun, 0.95),
+    );
+    let mut corr = Vec::new();
+    for name in ["south-face", "east-face", "west-face"] {
+        let s = day.world.scene.scene.surface_index(name).unwrap();
+        let ids: Vec<usize> = (0..day.truth.len())
+            .filter(|&c| day.refl.grid.cells[c].surface == s && day.refl.cells[c].status != CellStatus::Unseen)
+            .collect();
+        let a: Vec<f64> = ids.iter().map(|&c| day.refl.cells[c].rho_se[1]).collect();
+        let b: Vec<f64> = ids.iter().map(|&c| day.truth[c][1]).collect();
+        let n = a.len() as f64;
+        let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+        let cov: f64 = a.iter().zip(&b).map(|(x, y)| (x - ma) * (y - mb)).sum();
+        let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
+        let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
+        corr.push(cov / (va * vb).sqrt());
+    }
+    eprintln!(
+        "textured: ρ_se median {ms:.4} p95 {ps:.4}; ρ_sun median {mu:.4} p95 {pu:.4}; texture correlation S/E/W {corr:.3?}"
+    );
+    assert!(ms <= 0.025 && mu <= 0.02, "medians ρ_se {ms}, ρ_sun {mu}");
+    assert!(ps <= 0.10 && pu <= 0.10, "p95 ρ_se {ps}, ρ_sun {pu}");
+    assert!(corr.iter().all(|&r| r >= 0.3), "texture correlation {corr:?}");
+}
