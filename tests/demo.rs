@@ -57,10 +57,10 @@ fn the_quick_demo_runs_end_to_end_and_its_figures_match_the_simulator() {
     // The room (§4.7.2) at the quick settings, captured through the
     // controller and processed as `campanile process` does: the lamps
     // triangulated from their bulbs in the merged, rectified views within
-    // 5 mm and 5 % (the camera's gauge error divided out), and the room
-    // relit under new lamps within 20 % per 4×4 block of the simulator's
-    // render (measured 16.2 % with a Monte Carlo floor of 4.8 %: issue
-    // 10's 3 % is not met).
+    // 3 mm and 3 % (the camera's gauge error divided out; measured 1.4 mm,
+    // 1.4 %), and the room relit under new lamps within 15 % per 4×4 block
+    // of the simulator's render (measured 10.6 % at 64×48 with a Monte
+    // Carlo floor of 5.3 %: issue 10's 3 % is not met).
     let room = |k: &str| figures[k].as_f64().unwrap_or(f64::NAN);
     println!(
         "room: relit {:.1}% (floor {:.1}%), lamps {:.2} mm, {:.2}%",
@@ -69,9 +69,9 @@ fn the_quick_demo_runs_end_to_end_and_its_figures_match_the_simulator() {
         room("room_triangulation_mm"),
         100.0 * room("room_intensity_relative")
     );
-    assert!(room("room_triangulation_mm") < 5.0);
-    assert!(room("room_intensity_relative") < 0.05);
-    assert!(room("room_relit_rmse") < 0.20);
+    assert!(room("room_triangulation_mm") < 3.0);
+    assert!(room("room_intensity_relative") < 0.03);
+    assert!(room("room_relit_rmse") < 0.15);
     assert!(room("room_noise_floor_rmse") < room("room_relit_rmse"));
     // The scene file the room session became: a camera per pose with every
     // lamp on (12) plus the full-size views the bulbs were cut from, and
@@ -94,21 +94,23 @@ fn the_quick_demo_runs_end_to_end_and_its_figures_match_the_simulator() {
     }
 
     // Outdoors, at the quick plan's two training times and two views (2
-    // render samples per pixel): the pseudo-albedo medians within 30% and
-    // the held-out views within 25% per 4×4 block. These are loose: the
-    // full day does better (BENCHMARKS.md), and issue 9's 2% / 3% are not
-    // met yet.
+    // render samples per pixel): the pseudo-albedo medians within 8%
+    // (measured 5.2% and 3.7% against the truth averaged over 64×64 points
+    // per cell) and the held-out views within 13% per 4×4 block (measured
+    // 9.2% and 9.0%). The 2-sample photographs' noise dominates (about 9
+    // points, BENCHMARKS "outdoor error budget"); issue 9's 2% / 3% are met
+    // only on less noisy photographs (sim/tests/outdoor_error_budget.rs).
     for key in ["albedo_se_median", "albedo_sun_median"] {
         let v = figures[key].as_f64().unwrap_or(f64::NAN);
         println!("{key}: {:.1}%", 100.0 * v);
-        assert!(v < 0.30, "{key} = {v}");
+        assert!(v < 0.08, "{key} = {v}");
     }
     let held = figures["held_out_rmse_pixel_block"].as_array().unwrap();
     assert!(!held.is_empty(), "no held-out view was compared");
     for v in held {
         let block = v[1].as_f64().unwrap_or(f64::NAN);
         println!("held-out view: {:.1}% per 4×4 block", 100.0 * block);
-        assert!(block < 0.25, "held-out block RMSE {block}");
+        assert!(block < 0.13, "held-out block RMSE {block}");
     }
 
     // `campanile process` on the demo's session, finding the scene's

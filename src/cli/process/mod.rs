@@ -554,12 +554,12 @@ pub fn write_outdoor(o: &Outdoor, out: &Path) -> Result<()> {
     let photos: Vec<serde_json::Value> = refl
         .photos
         .iter()
-        .map(|c| serde_json::json!({"photo": c.label, "observations": c.observations, "median_log_ratio": c.median_log_ratio, "outlier": c.outlier}))
+        .map(|c| serde_json::json!({"photo": c.label, "observations": c.observations, "trimmed_mean_log_ratio": c.median_log_ratio, "outlier": c.outlier}))
         .collect();
     let json = serde_json::json!({
         "cells": refl.cells.len(),
         "photos": photos,
-        "pixels": {"used": refl.sampling.used, "shadow_edge": refl.sampling.shadow_edge, "mirror": refl.sampling.mirror, "grazing": refl.sampling.grazing, "invalid": refl.sampling.invalid},
+        "pixels": {"used": refl.sampling.used, "shadow_edge": refl.sampling.shadow_edge, "mirror": refl.sampling.mirror, "grazing": refl.sampling.grazing, "invalid": refl.sampling.invalid, "mixed": refl.sampling.mixed},
         "diagnostics": refl.diagnostics,
         "held_out": summary,
         "stage_seconds": o.products.seconds,
