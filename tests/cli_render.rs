@@ -47,6 +47,7 @@ fn grey_tower(dir: &std::path::Path) -> std::path::PathBuf {
             condition: 1.0,
             observations: 2,
             rms_relative: 0.0,
+            amplification: 1.0,
         })
         .collect();
     let refl = Reflectance {
