@@ -11,6 +11,7 @@ pub mod brdf;
 pub mod camera;
 pub mod csv_cell;
 pub mod environment;
+pub mod error_figures;
 pub mod exr_io;
 pub mod hdr;
 pub mod igi;

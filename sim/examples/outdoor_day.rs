@@ -14,6 +14,7 @@
 use std::time::Instant;
 
 use campanile_process::camera::image::RadianceImage;
+use campanile_process::error_figures::{block_relative_rmse, quantile};
 use campanile_process::outdoor::atlas::write_materials;
 use campanile_process::outdoor::rerender::{relative_rmse, target_mask};
 use campanile_process::outdoor::{
@@ -75,34 +76,6 @@ fn truth(w: &World, refl: &Reflectance) -> Vec<[f64; 3]> {
             s
         })
         .collect()
-}
-
-fn quantile(v: &mut [f64], q: f64) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
-    v[((v.len() - 1) as f64 * q).round() as usize]
-}
-
-/// Relative RMSE of k × k block means over blocks wholly in `mask`.
-fn block_rmse(a: &RadianceImage, b: &RadianceImage, mask: &[bool], k: usize) -> f64 {
-    let (mut num, mut den) = (0.0, 0.0);
-    for by in 0..a.height / k {
-        for bx in 0..a.width / k {
-            let px: Vec<usize> = (0..k * k)
-                .map(|q| (by * k + q / k) * a.width + bx * k + q % k)
-                .collect();
-            if !px.iter().all(|&i| mask[i]) {
-                continue;
-            }
-            for ch in 0..3 {
-                let m = |im: &RadianceImage| {
-                    px.iter().map(|&i| f64::from(im.data[i * 3 + ch])).sum::<f64>() / px.len() as f64
-                };
-                num += (m(a) - m(b)).powi(2);
-                den += m(b).powi(2);
-            }
-        }
-    }
-    (num / den).sqrt()
 }
 
 /// Skies fitted to noisy samples of the world's sky at the training times,
@@ -244,13 +217,13 @@ fn main() {
             };
             let (img, _) = rerender(&w.scene.scene, &refl, r, &light, &RerenderSettings::default());
             px = px.max(relative_rmse(&img, reference, &mask).unwrap_or(f64::NAN));
-            bl = bl.max(block_rmse(&img, reference, &mask, 4));
+            bl = bl.max(block_relative_rmse(&img, reference, &mask, 4));
             let light = Illumination {
                 time: time(HELD_OUT),
                 sky: &predicted,
             };
             let (img, _) = rerender(&w.scene.scene, &refl, r, &light, &RerenderSettings::default());
-            bp = bp.max(block_rmse(&img, reference, &mask, 4));
+            bp = bp.max(block_relative_rmse(&img, reference, &mask, 4));
         }
         let t_render = t2.elapsed().as_secs_f64() / 2.0;
         println!(

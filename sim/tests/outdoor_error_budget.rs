@@ -10,7 +10,7 @@
 
 use std::sync::OnceLock;
 
-use campanile_process::camera::image::RadianceImage;
+use campanile_process::error_figures::{block_relative_rmse, quantile};
 use campanile_process::outdoor::rerender::target_mask;
 use campanile_process::outdoor::{
     CellStatus, Illumination, Photo, Reflectance, ReflectanceSettings, RerenderSettings, recover_reflectance, rerender,
@@ -156,11 +156,6 @@ fn flat_day() -> &'static Day {
     DAY.get_or_init(|| recover_day(false))
 }
 
-fn quantile(v: &mut [f64], q: f64) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
-    v[((v.len() - 1) as f64 * q).round() as usize]
-}
-
 /// |relative error| of ρ_se and ρ_sun over every cell some photo saw
 /// (solved or filled), all channels: (ρ_se, ρ_sun).
 fn errors(day: &Day) -> (Vec<f64>, Vec<f64>) {
@@ -176,29 +171,6 @@ fn errors(day: &Day) -> (Vec<f64>, Vec<f64>) {
         }
     }
     (se, sun)
-}
-
-/// Relative RMSE of k × k block means over blocks wholly in `mask`.
-fn block_rmse(a: &RadianceImage, b: &RadianceImage, mask: &[bool], k: usize) -> f64 {
-    let (mut num, mut den) = (0.0, 0.0);
-    for by in 0..a.height / k {
-        for bx in 0..a.width / k {
-            let px: Vec<usize> = (0..k * k)
-                .map(|q| (by * k + q / k) * a.width + bx * k + q % k)
-                .collect();
-            if !px.iter().all(|&i| mask[i]) {
-                continue;
-            }
-            for ch in 0..3 {
-                let m = |im: &RadianceImage| {
-                    px.iter().map(|&i| f64::from(im.data[i * 3 + ch])).sum::<f64>() / px.len() as f64
-                };
-                num += (m(a) - m(b)).powi(2);
-                den += m(b).powi(2);
-            }
-        }
-    }
-    (num / den).sqrt()
 }
 
 /// With the light known and the walls of constant albedo, what is left is
@@ -249,7 +221,7 @@ fn with_the_light_known_the_held_out_time_is_within_three_percent() {
         let reference = w.render(time(HELD_OUT), &r, &[], 7).unwrap();
         let (image, _) = rerender(&w.scene.scene, &day.refl, &r, &light, &RerenderSettings::default());
         let mask = target_mask(&w.scene.scene, &day.refl, &r);
-        let block = block_rmse(&image, &reference, &mask, 4);
+        let block = block_relative_rmse(&image, &reference, &mask, 4);
         eprintln!("{v}: relative RMSE per 4×4 block {block:.4}");
         assert!(block <= 0.03, "{v}: block relative RMSE {block}");
     }

@@ -6,7 +6,7 @@
 // Channel loops index several arrays at once; they read better with an index.
 #![allow(clippy::needless_range_loop)]
 
-use campanile_process::camera::image::RadianceImage;
+use campanile_process::error_figures::{block_relative_rmse, quantile};
 use campanile_process::outdoor::rerender::{relative_rmse, target_mask};
 use campanile_process::outdoor::{
     CellStatus, Illumination, Photo, Reflectance, ReflectanceSettings, RerenderSettings, recover_reflectance, rerender,
@@ -137,11 +137,6 @@ fn errors(refl: &Reflectance, truth: &[[f64; 3]], keep: impl Fn(usize) -> bool) 
     (sun, se)
 }
 
-fn quantile(v: &mut [f64], q: f64) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
-    v[((v.len() - 1) as f64 * q).round() as usize]
-}
-
 /// Correlation between recovered and true albedos over the cells of one
 /// surface (green channel): the texture, not just the mean.
 fn texture_correlation(refl: &Reflectance, truth: &[[f64; 3]], surface: usize) -> f64 {
@@ -156,29 +151,6 @@ fn texture_correlation(refl: &Reflectance, truth: &[[f64; 3]], surface: usize) -
     let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
     let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
     cov / (va * vb).sqrt()
-}
-
-/// Block-averaged images (k × k pixels, blocks wholly inside `mask`) and
-/// the relative RMSE between them: the comparison at the grid's resolution.
-fn block_rmse(a: &RadianceImage, b: &RadianceImage, mask: &[bool], k: usize) -> f64 {
-    let (mut num, mut den) = (0.0, 0.0);
-    for by in 0..a.height / k {
-        for bx in 0..a.width / k {
-            let px: Vec<usize> = (0..k * k)
-                .map(|q| (by * k + q / k) * a.width + bx * k + q % k)
-                .collect();
-            if !px.iter().all(|&i| mask[i]) {
-                continue;
-            }
-            for ch in 0..3 {
-                let sa: f64 = px.iter().map(|&i| f64::from(a.data[i * 3 + ch])).sum::<f64>() / px.len() as f64;
-                let sb: f64 = px.iter().map(|&i| f64::from(b.data[i * 3 + ch])).sum::<f64>() / px.len() as f64;
-                num += (sa - sb).powi(2);
-                den += sb * sb;
-            }
-        }
-    }
-    (num / den).sqrt()
 }
 
 /// The training day's photos, rendered once for all tests of this file.
@@ -275,7 +247,7 @@ fn pseudo_albedos_and_the_held_out_time_match_the_world() {
         let (image, _) = rerender(&w.scene.scene, &refl, &r, &light, &RerenderSettings::default());
         let mask = target_mask(&w.scene.scene, &refl, &r);
         let pixel = relative_rmse(&image, &reference, &mask).unwrap();
-        let block = block_rmse(&image, &reference, &mask, 4);
+        let block = block_relative_rmse(&image, &reference, &mask, 4);
         eprintln!("{v}: relative RMSE per pixel {pixel:.4}, per 4×4 block {block:.4}");
         assert!(block <= 0.03, "{v}: block relative RMSE {block}");
         assert!(pixel <= 0.12, "{v}: pixel relative RMSE {pixel}");

@@ -338,6 +338,17 @@ mod tests {
         }
     }
 
+    fn bulb_views<'a>(cams: &[ViewCamera], images: &'a [RadianceImage]) -> Vec<BulbImage<'a>> {
+        cams.iter()
+            .zip(images)
+            .map(|(c, i)| BulbImage {
+                name: "v",
+                camera: *c,
+                image: i,
+            })
+            .collect()
+    }
+
     #[test]
     fn a_bulb_seen_from_three_views_is_found_within_a_millimetre() {
         let centre = Vector3::new(1.0, 1.0, 2.6);
@@ -360,15 +371,7 @@ mod tests {
         })
         .collect();
         let images: Vec<RadianceImage> = cams.iter().map(|c| bulb_image(c, centre, radius, l)).collect();
-        let views: Vec<BulbImage> = cams
-            .iter()
-            .zip(&images)
-            .map(|(c, i)| BulbImage {
-                name: "v",
-                camera: *c,
-                image: i,
-            })
-            .collect();
+        let views = bulb_views(&cams, &images);
         let t = triangulate("lamp", &views).unwrap();
         let err_mm = (t.light.position - centre).norm() * 1e3;
         eprintln!(
@@ -454,25 +457,9 @@ mod tests {
                 }
             })
             .collect();
-        let views: Vec<BulbImage> = cams
-            .iter()
-            .zip(&images)
-            .map(|(c, i)| BulbImage {
-                name: "v",
-                camera: *c,
-                image: i,
-            })
-            .collect();
+        let views = bulb_views(&cams, &images);
         let t = triangulate("lamp", &views).unwrap();
-        let sharp_views: Vec<BulbImage> = cams
-            .iter()
-            .zip(&sharp_images)
-            .map(|(c, i)| BulbImage {
-                name: "v",
-                camera: *c,
-                image: i,
-            })
-            .collect();
+        let sharp_views = bulb_views(&cams, &sharp_images);
         let sharp = triangulate("lamp", &sharp_views).unwrap();
         let err_mm = (t.light.position - centre).norm() * 1e3;
         let truth = sharp.light.intensity;

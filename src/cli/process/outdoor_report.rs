@@ -18,14 +18,7 @@ pub struct AlbedoErrors {
     pub sun: Vec<f64>,
 }
 
-/// Quantile `q` of `v` (sorted in place); NaN when empty.
-pub fn quantile(v: &mut [f64], q: f64) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    v[((v.len() - 1) as f64 * q).round() as usize]
-}
+pub use campanile_process::error_figures::quantile;
 
 /// Relative errors of every cell against `truth(triangle, point)` averaged
 /// over 64×64 points of the cell (fewer alias with a brick texture's
