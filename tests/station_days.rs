@@ -643,11 +643,16 @@ fn sigterm_stops_the_cli_at_a_frame_boundary_and_the_same_command_continues() {
 }
 
 /// The worst relative error of a scan's direct normal sun irradiance (the
-/// triplet's mean) against the simulator's, per channel, on every scan.
-const SUN_TOLERANCE: f64 = 0.08;
+/// triplet's mean) against the simulator's, per channel, on every scan
+/// (measured 1.85 %, the simulator integrating the sub-pixel disc exactly).
+const SUN_TOLERANCE: f64 = 0.04;
 /// The worst RMS relative error of a scan's fitted sky against the
-/// simulator's (above 10° elevation, more than 10° from the sun), per channel.
-const SKY_TOLERANCE: f64 = 0.10;
+/// simulator's (above 10° elevation, more than 10° from the sun), per
+/// channel (measured 4.8 %).
+const SKY_TOLERANCE: f64 = 0.07;
+/// The day's extinction β per channel against the simulator's (issue 12:
+/// within 5 %; measured within 0.6 %).
+const BETA_TOLERANCE: f64 = 0.05;
 
 /// The sky time series the hook built, one `processed/` per day:
 /// - `sky-series.csv` has exactly one row per occurrence whose promised
@@ -772,18 +777,23 @@ fn series_follows_the_journal_and_the_truth(i: &Inputs, sessions: &BTreeMap<Naiv
                 beyond.push((format!("{name} sky {c}"), ms.sqrt(), SKY_TOLERANCE));
             }
         }
-        // The day's Langley fit uses only the unflagged scans: reported, not
-        // bounded here (β against the truth is `tests/sky_series.rs`'s, at
-        // a resolution where the triplets agree).
+        // The day's Langley fit over the unflagged scans.
         let series = SkySeries::new(scans);
         let day = &series.days[0];
         let beta: Vec<String> = day
             .fit
             .iter()
             .zip(i.world.atmosphere.beta)
-            .map(|(f, truth)| match f {
-                Ok(f) => format!("{:.4} (truth {truth:.2})", f.beta),
-                Err(e) => format!("none: {e}"),
+            .enumerate()
+            .map(|(c, (f, truth))| match f {
+                Ok(f) => {
+                    beyond.push((format!("{d} β {c}"), (f.beta / truth - 1.0).abs(), BETA_TOLERANCE));
+                    format!("{:.4} (truth {truth:.2})", f.beta)
+                }
+                Err(e) => {
+                    beyond.push((format!("{d} β {c}: {e}"), f64::NAN, BETA_TOLERANCE));
+                    format!("none: {e}")
+                }
             })
             .collect();
         println!(
@@ -796,6 +806,10 @@ fn series_follows_the_journal_and_the_truth(i: &Inputs, sessions: &BTreeMap<Naiv
         "sky series: {rows_total} rows ({with_pruned} of scans whose frames were pruned), {missed_scans} scans missed in the outage; worst sun r/g/b {worst_sun:.4?} ({flagged} flagged clouds_near_sun), worst sky RMS r/g/b {worst_sky:.4?}"
     );
     assert_eq!(missed_scans, 3, "the outage covers 3 scans");
+    // The simulated days are clear: a triplet that disagrees is rare (4 of
+    // 246 measured, near sunrise and sunset, where the disc's pixel changes
+    // fastest); a cloud flag on most scans would be a false alarm.
+    assert!(flagged * 20 <= rows_total, "{flagged} of {rows_total} clear scans flagged clouds_near_sun");
     assert!(with_pruned > 0, "rows of pruned scans");
     let failed: Vec<_> = beyond.iter().filter(|(_, v, bound)| v.is_nan() || v >= bound).collect();
     assert!(failed.is_empty(), "beyond bounds: {failed:?}");

@@ -17,7 +17,7 @@ use super::camera::CameraRig;
 use super::light::{PointLight, SphereLight};
 use super::mesh::Ray;
 use super::scene::Scene;
-use super::sky::Sky;
+use super::sky::{Sky, SolarDisc};
 use super::surface_bsdf::SurfaceBsdf;
 use crate::camera::image::RadianceImage;
 
@@ -100,6 +100,20 @@ pub fn trace(scene: &Scene, lighting: &Lighting, ray: Ray, max_bounces: u32, rng
 /// times: the disc and the bulbs count only for camera rays (`bounce == 0`),
 /// since every later vertex samples them explicitly.
 fn path(scene: &Scene, lighting: &Lighting, ray: Ray, bounce: u32, max_bounces: u32, rng: &mut impl Rng) -> [f64; 3] {
+    path_seeing_disc(scene, lighting, ray, bounce, max_bounces, true, rng)
+}
+
+/// [`path`], with the solar disc seen by a camera ray only if `disc_seen`
+/// (the renderer adds the disc of pixels near the sun exactly instead).
+fn path_seeing_disc(
+    scene: &Scene,
+    lighting: &Lighting,
+    ray: Ray,
+    bounce: u32,
+    max_bounces: u32,
+    disc_seen: bool,
+    rng: &mut impl Rng,
+) -> [f64; 3] {
     let mut radiance = [0.0; 3];
     let mut beta = [1.0; 3];
     let mut ray = ray;
@@ -123,6 +137,7 @@ fn path(scene: &Scene, lighting: &Lighting, ray: Ray, bounce: u32, max_bounces: 
             if let Some(sky) = lighting.sky {
                 add_scaled(&mut radiance, &beta, &sky.radiance(&ray.direction), 1.0);
                 if bounce == 0
+                    && disc_seen
                     && let Some(sun) = sky.sun().filter(|s| s.contains(&ray.direction))
                 {
                     add_scaled(&mut radiance, &beta, &sun.radiance, 1.0);
@@ -174,9 +189,72 @@ fn path(scene: &Scene, lighting: &Lighting, ray: Ray, bounce: u32, max_bounces: 
 /// Samples per pixel for pixels within a few pixels of the solar disc.
 pub const SUN_PIXEL_SAMPLES: u32 = 1024;
 
+/// Points per side of the grid over the solar disc's bounding box that
+/// measures how much of each pixel the (unoccluded) disc covers.
+pub const SUN_COVERAGE_GRID: usize = 96;
+
+/// The fraction of each pixel of `camera`'s image that sees the solar
+/// disc, unoccluded by the scene or a lamp, keyed by `y · width + x`: a
+/// `SUN_COVERAGE_GRID`² grid of image points over the disc's bounding box,
+/// each cast through the camera (distortion included) and kept if its ray
+/// falls on the disc and escapes the scene. The grid spacing is a small
+/// fraction of the disc whatever the pixel size, so the coverage of a disc
+/// much smaller than a pixel (a wide sky camera) is measured to about 0.1 %
+/// instead of being sampled by the few of a pixel's paths that hit it.
+fn sun_coverage(scene: &Scene, camera: &CameraRig, lighting: &Lighting, disc: &SolarDisc) -> Vec<(usize, f64)> {
+    let centre = camera.position + disc.direction * 1e9;
+    let Some((cu, cv)) = camera.project(&centre) else {
+        return Vec::new();
+    };
+    // Half-width in pixels: the disc's radius with room for the lens's
+    // distortion (a few percent) and the off-axis stretch of the projection.
+    let (pu, pv) = camera.pinhole.principal_px;
+    let off_axis = ((cu - pu).hypot(cv - pv) / camera.pinhole.focal_px).atan().cos();
+    let half = 1.25 * camera.pinhole.focal_px * disc.angular_radius_rad.tan() / (off_axis * off_axis);
+    let (w, h) = (camera.width as f64, camera.height as f64);
+    if cu + half < 0.0 || cv + half < 0.0 || cu - half > w || cv - half > h {
+        return Vec::new();
+    }
+    let caster = camera.rays();
+    let n = SUN_COVERAGE_GRID;
+    let step = 2.0 * half / n as f64;
+    let cell = step * step;
+    let mut cover: Vec<(usize, f64)> = Vec::new();
+    for j in 0..n {
+        let v = cv - half + (j as f64 + 0.5) * step;
+        if !(0.0..h).contains(&v) {
+            continue;
+        }
+        for i in 0..n {
+            let u = cu - half + (i as f64 + 0.5) * step;
+            if !(0.0..w).contains(&u) {
+                continue;
+            }
+            let Some(ray) = caster.ray(u, v) else { continue };
+            if !disc.contains(&ray.direction)
+                || scene.intersect(&ray, f64::INFINITY).is_some()
+                || lighting
+                    .spheres
+                    .iter()
+                    .any(|s| s.intersect(&ray.origin, &ray.direction, 0.0, f64::INFINITY).is_some())
+            {
+                continue;
+            }
+            let k = v as usize * camera.width + u as usize;
+            match cover.iter_mut().find(|(p, _)| *p == k) {
+                Some((_, c)) => *c += cell,
+                None => cover.push((k, cell)),
+            }
+        }
+    }
+    cover
+}
+
 /// Renders the radiance image a camera sees: `samples_per_pixel` stratified
 /// paths per pixel, rows in parallel, each row from its own random stream;
-/// pixels near the solar disc take [`SUN_PIXEL_SAMPLES`].
+/// pixels near the solar disc take [`SUN_PIXEL_SAMPLES`] for the sky around
+/// it, and the disc itself as its measured coverage of the pixel times its
+/// radiance (`sun_coverage`), not as the paths that happen to hit it.
 pub fn render(scene: &Scene, camera: &CameraRig, lighting: &Lighting, settings: &RenderSettings) -> RadianceImage {
     let (w, h) = (camera.width, camera.height);
     let spp = settings.samples_per_pixel.max(1);
@@ -196,12 +274,16 @@ pub fn render(scene: &Scene, camera: &CameraRig, lighting: &Lighting, settings: 
             })
         })
     };
+    let coverage = sun
+        .as_ref()
+        .map_or_else(Vec::new, |d| sun_coverage(scene, camera, lighting, d));
     data.par_chunks_mut(w * 3).enumerate().for_each(|(y, row)| {
         let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
         rng.set_stream(y as u64);
         for x in 0..w {
             let mut sum = [0.0; 3];
-            let (spp, side) = if near_sun(x as f64 + 0.5, y as f64 + 0.5) {
+            let near = near_sun(x as f64 + 0.5, y as f64 + 0.5);
+            let (spp, side) = if near {
                 (spp.max(SUN_PIXEL_SAMPLES), side.max(SUN_PIXEL_SAMPLES.isqrt()))
             } else {
                 (spp, side)
@@ -211,12 +293,21 @@ pub fn render(scene: &Scene, camera: &CameraRig, lighting: &Lighting, settings: 
                 let u = x as f64 + (f64::from(sx) + rng.random::<f64>()) / f64::from(side);
                 let v = y as f64 + (f64::from(sy) + rng.random::<f64>()) / f64::from(side);
                 if let Some(ray) = caster.ray(u, v) {
-                    let l = trace(scene, lighting, ray, settings.max_bounces, &mut rng);
+                    // Near the sun the disc itself is added exactly below.
+                    let l = path_seeing_disc(scene, lighting, ray, 0, settings.max_bounces, !near, &mut rng);
                     (0..3).for_each(|c| sum[c] += l[c]);
                 }
             }
             for c in 0..3 {
                 row[x * 3 + c] = (sum[c] / f64::from(spp)) as f32;
+            }
+            if near && let Some(disc) = &sun {
+                let k = y * w + x;
+                if let Some((_, f)) = coverage.iter().find(|(p, _)| *p == k) {
+                    for c in 0..3 {
+                        row[x * 3 + c] += (f * disc.radiance[c]) as f32;
+                    }
+                }
             }
         }
     });
