@@ -809,7 +809,10 @@ fn series_follows_the_journal_and_the_truth(i: &Inputs, sessions: &BTreeMap<Naiv
     // The simulated days are clear: a triplet that disagrees is rare (4 of
     // 246 measured, near sunrise and sunset, where the disc's pixel changes
     // fastest); a cloud flag on most scans would be a false alarm.
-    assert!(flagged * 20 <= rows_total, "{flagged} of {rows_total} clear scans flagged clouds_near_sun");
+    assert!(
+        flagged * 20 <= rows_total,
+        "{flagged} of {rows_total} clear scans flagged clouds_near_sun"
+    );
     assert!(with_pruned > 0, "rows of pruned scans");
     let failed: Vec<_> = beyond.iter().filter(|(_, v, bound)| v.is_nan() || v >= bound).collect();
     assert!(failed.is_empty(), "beyond bounds: {failed:?}");
