@@ -21,7 +21,7 @@ use anyhow::{Context, Result, anyhow, bail};
 use campanile_config::Plan;
 use campanile_config::plan::Step;
 use campanile_process::igi::scene_file::{BulbImageEntry, CameraEntry, IgiScene, ImageEntry, LightEntry, SurfaceGroup};
-use campanile_process::pipeline::room_views::{RectifiedView, bulb_window, rectify};
+use campanile_process::pipeline::room_views::{RectifiedView, bulb_window, rectified_camera, rectify};
 use campanile_process::pipeline::{MergedGroup, Purpose};
 use campanile_process::report::{Figure, Section, Table, tonemapped_png};
 use nalgebra::Vector3;
@@ -238,11 +238,32 @@ pub fn room_stage(p: &Processed, out: &Path, opts: &RoomOptions) -> Result<RoomP
             "no lamp is on in the views with every lamp on: a room session's lamps are the station's `lights` channels its light sequence switches"
         );
     }
-    // Bulbs are small: cut them from views rectified at the frames' full size.
+    // Bulbs are small: cut them from views rectified at the frames' full
+    // size, rectifying again only the views in which some lamp's configured
+    // position falls inside the frame.
+    let priors: Vec<Vector3<f64>> = lamps
+        .iter()
+        .map(|l| Vector3::new(l.position_m.0, l.position_m.1, l.position_m.2))
+        .collect();
     let full: Vec<(String, RectifiedView)> = {
         use rayon::prelude::*;
         chosen
             .par_iter()
+            .filter(|(_, g)| {
+                let cam = rectified_camera(
+                    &g.pinhole,
+                    (g.map.width, g.map.height),
+                    &p.optics.mount,
+                    g.head,
+                    g.position_m,
+                    1.0,
+                );
+                priors.iter().any(|prior| {
+                    cam.project(prior).is_some_and(|(u, v)| {
+                        (0.0..cam.width as f64).contains(&u) && (0.0..cam.height as f64).contains(&v)
+                    })
+                })
+            })
             .map(|(pose, g)| {
                 let v = if opts.scale == 1.0 {
                     rectified.iter().find(|(p, _, _)| p == pose).map(|(_, _, v)| v.clone())
@@ -256,13 +277,11 @@ pub fn room_stage(p: &Processed, out: &Path, opts: &RoomOptions) -> Result<RoomP
     let medians: Vec<f64> = full.iter().map(|(_, v)| median_radiance(v)).collect();
     let mut lights = Vec::new();
     let mut bulbs = Vec::new();
-    for lamp in &lamps {
-        let (x, y, z) = lamp.position_m;
-        let prior = Vector3::new(x, y, z);
+    for (lamp, prior) in lamps.iter().zip(&priors) {
         let mut seen = Vec::new();
         let mut list = Vec::new();
         for ((pose, v), median) in full.iter().zip(&medians) {
-            let Some(img) = bulb_window(v, &prior, lamp.radius_m, lamp.radius_m + BULB_WINDOW_M) else {
+            let Some(img) = bulb_window(v, prior, lamp.radius_m, lamp.radius_m + BULB_WINDOW_M) else {
                 continue;
             };
             let peak = img
@@ -306,7 +325,7 @@ pub fn room_stage(p: &Processed, out: &Path, opts: &RoomOptions) -> Result<RoomP
             name: lamp.name.clone(),
             images: list,
         });
-        bulbs.push((lamp.name.clone(), prior, seen));
+        bulbs.push((lamp.name.clone(), *prior, seen));
     }
 
     // Surfaces: the OBJ groups of each material (they share specular parameters, §4.4).
