@@ -413,7 +413,10 @@ pub fn zoom_albedo(
             fate[i] = Some(PixelFate::ShadowEdge);
         }
         if let (None, Some((smooth, restricted, side))) = (fate[i], r.smoothed) {
-            let dark = ls.iter().chain(le.iter()).any(|v| v.is_nan() || *v <= settings.min_albedo)
+            let dark = ls
+                .iter()
+                .chain(le.iter())
+                .any(|v| v.is_nan() || *v <= settings.min_albedo)
                 || smooth.iter().any(|v| !(*v > 0.0 && v.is_finite()));
             if dark {
                 fate[i] = Some(PixelFate::Dark);
