@@ -248,7 +248,7 @@ fn a_zoom_photo_gives_per_pixel_albedos_and_a_sharp_render() {
         (t, Daylight::clear(sun.direction(), &Atmosphere::clear()))
     };
     let ((t0, d0), (t1, d1)) = (day_at("2026-08-29T20:30:00Z"), day_at("2026-08-29T22:42:00Z"));
-    let f = |i: usize| if (i % w + i / w) % 2 == 0 { 1.2 } else { 0.8 };
+    let f = |i: usize| if (i % w + i / w).is_multiple_of(2) { 1.2 } else { 0.8 };
     let (base0, _) = rerender(
         &loaded.scene,
         &refl,
