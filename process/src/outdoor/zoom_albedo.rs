@@ -464,3 +464,145 @@ pub fn rerender_zoom(
     let f = |x: usize, y: usize, t: usize| zoom.at(refl, x, y, t);
     rerender_with_pixel_albedos(scene, refl, &zoom.rig, light, settings, Some(&f)).0
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::outdoor::estimate::{CellEstimate, CellStatus};
+    use crate::outdoor::grid::Grid;
+    use crate::outdoor::observation::SamplingReport;
+    use crate::pose::{HeadPose, Mount, Pinhole};
+    use crate::render::{Material, Triangle};
+    use crate::sky::{Atmosphere, Daylight};
+    use chrono::{TimeZone, Utc};
+
+    /// An 8 m wall in the plane y = 0 facing the camera at y = −10, under a
+    /// 3 m overhang at its top (z = 8; not a target): with the sun at 45°
+    /// straight ahead, the top 3 m of the wall are in shadow.
+    fn wall_under_overhang() -> Scene {
+        let v = |x: f64, y: f64, z: f64| Vector3::new(x, y, z);
+        let tris = vec![
+            Triangle::new([v(-4.0, 0.0, 0.0), v(4.0, 0.0, 0.0), v(4.0, 0.0, 8.0)], 0, 0).unwrap(),
+            Triangle::new([v(-4.0, 0.0, 0.0), v(4.0, 0.0, 8.0), v(-4.0, 0.0, 8.0)], 0, 0).unwrap(),
+            Triangle::new([v(-6.0, -3.0, 8.0), v(6.0, -3.0, 8.0), v(6.0, 0.5, 8.0)], 0, 1).unwrap(),
+            Triangle::new([v(-6.0, -3.0, 8.0), v(6.0, 0.5, 8.0), v(-6.0, 0.5, 8.0)], 0, 1).unwrap(),
+        ];
+        Scene::new(
+            tris,
+            vec![Material::diffuse("m", [0.5; 3])],
+            vec!["wall".into(), "overhang".into()],
+        )
+        .unwrap()
+    }
+
+    fn rig() -> CameraRig {
+        CameraRig {
+            pinhole: Pinhole {
+                focal_px: 40.0,
+                principal_px: (32.0, 24.0),
+                k1: 0.0,
+                k2: 0.0,
+            },
+            mount: Mount::default(),
+            head: HeadPose {
+                pan_rad: 0.0,
+                tilt_rad: 0.2,
+            },
+            position: Vector3::new(0.0, -10.0, 4.0),
+            width: 64,
+            height: 48,
+        }
+    }
+
+    fn uniform(scene: &Scene, rho: f64) -> Reflectance {
+        let grid = Grid::new(scene, &[0], 2.0, &[Vector3::new(0.0, -10.0, 4.0)]).unwrap();
+        let cells = grid
+            .cells
+            .iter()
+            .map(|_| CellEstimate {
+                rho_sun: [rho; 3],
+                rho_se: [rho; 3],
+                sigma_sun: [0.0; 3],
+                sigma_se: [0.0; 3],
+                status: CellStatus::Solved,
+                condition: 1.0,
+                amplification: 1.0,
+                observations: 2,
+                rms_relative: 0.0,
+            })
+            .collect();
+        Reflectance {
+            face_ratio: vec![[1.0; 3]; grid.faces.len()],
+            grid,
+            cells,
+            photos: Vec::new(),
+            sampling: SamplingReport::default(),
+            diagnostics: Vec::new(),
+        }
+    }
+
+    /// A uniform wall photographed half in shadow: the photo's radiance
+    /// jumps fivefold at the shadow line, but the albedo does not. Windows
+    /// restricted to their sun status give back ρ = 0.5 exactly (to 1e-9)
+    /// on every used pixel; averaged across the edge they would print the
+    /// shadow into the albedo (a factor 3 off for a shadowed pixel whose window
+    /// is half sunlit). The edge pixels are counted.
+    #[test]
+    fn a_shadow_edge_is_not_printed_into_the_albedo() {
+        let scene = wall_under_overhang();
+        let refl = uniform(&scene, 0.5);
+        let rig = rig();
+        let sun_dir = Vector3::new(0.0, -1.0, 1.0).normalize();
+        let day = Daylight::clear([sun_dir.x, sun_dir.y, sun_dir.z], &Atmosphere::clear());
+        let time = Utc.with_ymd_and_hms(2026, 8, 29, 20, 30, 0).unwrap();
+        let light = Illumination { time, sky: &day };
+        let sun = light.sky.sun().unwrap();
+        let n = Vector3::new(0.0, -1.0, 0.0);
+        let mut data = vec![0.1f32; 64 * 48 * 3];
+        let mut lit_rows = (0, 0);
+        for i in 0..64 * 48 {
+            let ray = rig.ray((i % 64) as f64 + 0.5, (i / 64) as f64 + 0.5).unwrap();
+            if let Some(hit) = scene.intersect(&ray, f64::INFINITY).filter(|h| h.triangle < 2) {
+                let lit = sun_visible(&scene, &sun, &hit.point, &n);
+                if lit {
+                    lit_rows.0 += 1;
+                } else {
+                    lit_rows.1 += 1;
+                }
+                let e = if lit { 50.0 } else { 10.0 };
+                (0..3).for_each(|c| data[i * 3 + c] = (0.5 * e) as f32);
+            }
+        }
+        assert!(lit_rows.0 > 200 && lit_rows.1 > 200, "{lit_rows:?}");
+        let photo = Photo {
+            label: "overhang".into(),
+            image: RadianceImage {
+                width: 64,
+                height: 48,
+                data,
+            },
+            rig,
+            time,
+            mask: None,
+        };
+        let zoom = zoom_albedo(&scene, &refl, &photo, &light, &ZoomSettings::default()).unwrap();
+        let r = &zoom.report;
+        assert!(r.used > 500 && r.shadow_edge >= 16 && r.status_restricted > 50, "{r}");
+        assert_eq!(
+            r.used + r.non_target + r.face_edge + r.shadow_edge + r.dark + r.invalid_radiance,
+            64 * 48
+        );
+        for i in 0..64 * 48 {
+            if zoom.fate[i] == PixelFate::Used {
+                for c in 0..3 {
+                    assert!(
+                        (zoom.rho_sun[i][c] - 0.5).abs() < 1e-9,
+                        "pixel {i}: {:?}",
+                        zoom.rho_sun[i]
+                    );
+                    assert!((zoom.rho_se[i][c] - 0.5).abs() < 1e-9);
+                }
+            }
+        }
+    }
+}
