@@ -98,6 +98,16 @@ pub enum OutdoorError {
         /// Its time.
         time: DateTime<Utc>,
     },
+    /// A knob of [`ZoomSettings`] is out of range.
+    #[error("zoom settings: {field} = {value}, expected {expected}")]
+    BadZoomSetting {
+        /// The field.
+        field: &'static str,
+        /// The value given.
+        value: f64,
+        /// What it must be.
+        expected: &'static str,
+    },
     /// A zoom photograph sees none of the target surfaces.
     #[error(
         "photo {photo:?}: none of its {pixels} pixels sees a target surface (from its visible side); \

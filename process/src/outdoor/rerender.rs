@@ -10,6 +10,9 @@
 //! returns its material's albedo times its direct irradiance over π; a ray
 //! that escapes returns the sky (and the solar disc). The back of a target
 //! surface, which no photo saw, is shaded like the environment.
+//! [`rerender_with_pixel_albedos`] takes the pseudo-albedos per pixel
+//! instead where it is given them (a zoom photo's eq. 5.16 albedos,
+//! [`super::zoom_albedo`]); [`rerender`] is it with none.
 
 use std::collections::HashMap;
 

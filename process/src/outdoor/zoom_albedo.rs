@@ -76,6 +76,30 @@ impl Default for ZoomSettings {
     }
 }
 
+impl ZoomSettings {
+    /// The settings, or the first knob out of range.
+    pub fn check(&self) -> Result<(), OutdoorError> {
+        let bad = |field, value, expected| Err(OutdoorError::BadZoomSetting { field, value, expected });
+        if !(self.window_cells.is_finite() && self.window_cells > 0.0) {
+            return bad("window_cells", self.window_cells, "a finite number of cells > 0");
+        }
+        if !(self.min_albedo.is_finite() && self.min_albedo >= 0.0) {
+            return bad("min_albedo", self.min_albedo, "a finite albedo ≥ 0");
+        }
+        if !(0.0..=1.0).contains(&self.min_same_status) {
+            return bad("min_same_status", self.min_same_status, "a fraction in [0, 1]");
+        }
+        if !(self.time_tolerance_s.is_finite() && self.time_tolerance_s >= 0.0) {
+            return bad(
+                "time_tolerance_s",
+                self.time_tolerance_s,
+                "a finite number of seconds ≥ 0",
+            );
+        }
+        Ok(())
+    }
+}
+
 /// What became of one pixel of the zoom photo.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum PixelFate {
@@ -200,7 +224,8 @@ impl ZoomAlbedo {
 /// zoom photograph taken under `light`, from the grid's recovered
 /// pseudo-albedos `refl` (see the module doc).
 ///
-/// Errors: the photo's buffer or mask does not match its camera's size;
+/// Errors: a setting out of range; the photo's buffer or mask does not
+/// match its camera's size;
 /// `light` is not at the photo's time; no pixel of the photo sees a target
 /// surface.
 pub fn zoom_albedo(
@@ -210,6 +235,7 @@ pub fn zoom_albedo(
     light: &Illumination,
     settings: &ZoomSettings,
 ) -> Result<ZoomAlbedo, OutdoorError> {
+    settings.check()?;
     let rig = photo.rig;
     let (w, h) = (rig.width, rig.height);
     let n = w * h;
@@ -300,7 +326,7 @@ pub fn zoom_albedo(
         .collect();
     let rho_sun_cells: Vec<[f64; 3]> = refl.cells.iter().map(|c| c.rho_sun).collect();
     let rho_se_cells: Vec<[f64; 3]> = refl.cells.iter().map(|c| c.rho_se).collect();
-    let half = 0.5 * settings.window_cells.max(1e-6) * grid.spacing_m;
+    let half = 0.5 * settings.window_cells * grid.spacing_m;
     // Pixels that may enter a window: on a target, valid, off edges.
     let smoothable: Vec<bool> = fate.iter().map(Option::is_none).collect();
     struct PixelResult {
@@ -592,6 +618,12 @@ mod tests {
             r.used + r.non_target + r.face_edge + r.shadow_edge + r.dark + r.invalid_radiance,
             64 * 48
         );
+        let bad = ZoomSettings {
+            window_cells: f64::NAN,
+            ..ZoomSettings::default()
+        };
+        let err = zoom_albedo(&scene, &refl, &photo, &light, &bad).unwrap_err();
+        assert!(err.to_string().contains("window_cells = NaN"), "{err}");
         for i in 0..64 * 48 {
             if zoom.fate[i] == PixelFate::Used {
                 for c in 0..3 {
