@@ -12,7 +12,7 @@
 //! - [`rerender`]: radiance images at any time and sky (§5.5, §5.6).
 //! - [`atlas`]: pseudo-albedo texture atlases (EXR) and the materials file.
 //! - [`photograph`]: renders through a response curve at a chosen shutter.
-//! - [`zoom_albedo`]: pseudo-albedos at pixel resolution from a zoom
+//! - [`mod@zoom_albedo`]: pseudo-albedos at pixel resolution from a zoom
 //!   photograph (§5.6.4, eq. 5.16) and the zoom view re-rendered with them.
 //!
 //! The environment is the scene's non-target surfaces (ground, landscape)

@@ -12,7 +12,7 @@
 //! surface, which no photo saw, is shaded like the environment.
 //! [`rerender_with_pixel_albedos`] takes the pseudo-albedos per pixel
 //! instead where it is given them (a zoom photo's eq. 5.16 albedos,
-//! [`super::zoom_albedo`]); [`rerender`] is it with none.
+//! [`mod@super::zoom_albedo`]); [`rerender`] is it with none.
 
 use std::collections::HashMap;
 
@@ -116,7 +116,7 @@ pub fn rerender(
 /// [`rerender`], with the pseudo-albedos of the target cells a pixel sees
 /// taken from `pixel_albedos` where it gives them (the high-resolution
 /// pseudo-albedos of a zoom photograph from this very camera, §5.6.4,
-/// [`super::zoom_albedo`]); the irradiance is the grid's as in
+/// [`mod@super::zoom_albedo`]); the irradiance is the grid's as in
 /// [`rerender`]. With `None` it is [`rerender`].
 pub fn rerender_with_pixel_albedos(
     scene: &Scene,
