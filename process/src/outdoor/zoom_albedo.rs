@@ -477,7 +477,7 @@ pub fn zoom_albedo(
 }
 
 /// The zoom photo's view re-rendered under `light` (any time and sky) at
-/// pixel resolution: [`super::rerender`] with the pixels' eq. (5.16)
+/// pixel resolution: [`super::rerender()`] with the pixels' eq. (5.16)
 /// pseudo-albedos in place of the grid's bilinear ones where `zoom` has
 /// them (§5.6.4, the thesis's Fig. 5.12c).
 pub fn rerender_zoom(
