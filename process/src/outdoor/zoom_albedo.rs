@@ -329,6 +329,31 @@ pub fn zoom_albedo(
     let half = 0.5 * settings.window_cells * grid.spacing_m;
     // Pixels that may enter a window: on a target, valid, off edges.
     let smoothable: Vec<bool> = fate.iter().map(Option::is_none).collect();
+    // What the window sums read, packed (half the memory of the hits).
+    #[derive(Clone, Copy)]
+    struct Sample {
+        /// The face, or `usize::MAX` for a pixel that enters no window.
+        face: usize,
+        sunlit: bool,
+        st: [f64; 2],
+        rgb: [f32; 3],
+    }
+    let samples: Vec<Sample> = (0..n)
+        .map(|i| match hits[i].filter(|_| smoothable[i]) {
+            Some(o) => Sample {
+                face: o.face,
+                sunlit: o.sunlit,
+                st: o.st,
+                rgb: [img.data[i * 3], img.data[i * 3 + 1], img.data[i * 3 + 2]],
+            },
+            None => Sample {
+                face: usize::MAX,
+                sunlit: false,
+                st: [0.0; 2],
+                rgb: [0.0; 3],
+            },
+        })
+        .collect();
     struct PixelResult {
         low: ([f64; 3], [f64; 3]),
         smoothed: Option<([f64; 3], bool, f64)>,
@@ -377,21 +402,15 @@ pub fn zoom_albedo(
             let side = (x1.saturating_sub(x0)).max(y1.saturating_sub(y0)) as f64;
             let (mut sum, mut same, mut all) = ([0.0; 3], 0usize, 0usize);
             for y in y0..y1 {
-                for x in x0..x1 {
-                    let j = y * w + x;
-                    if !smoothable[j] {
-                        continue;
-                    }
-                    let Some(o) = hits[j] else { continue };
+                for o in &samples[y * w + x0..y * w + x1] {
                     if o.face != hit.face || (o.st[0] - hit.st[0]).abs() > half || (o.st[1] - hit.st[1]).abs() > half {
                         continue;
                     }
                     all += 1;
                     if o.sunlit == hit.sunlit {
                         same += 1;
-                        let r = radiance(j);
                         for c in 0..3 {
-                            sum[c] += r[c];
+                            sum[c] += f64::from(o.rgb[c]);
                         }
                     }
                 }
