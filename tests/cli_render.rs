@@ -198,3 +198,148 @@ fn a_sequence_runs_from_sunrise_to_sunset_and_bad_input_is_named() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("--overcast 1.5"));
 }
+
+/// `render --zoom`: a zoom photo of the grey tower with a checkerboard of
+/// ±20% painted over it (the detail finer than the 4 m cells) gives
+/// per-pixel pseudo-albedos 0.5·f and 0.4·f (eq. 5.16: ρ̃ · I/Ĩ, the
+/// checkerboard averaging to 1 over a cell's ≈ 32-pixel window), and the
+/// zoom view re-rendered at a new time carries the same factor over the
+/// grid's render. Clipped pixels (mask ≠ 0 in the radiance EXR) are refused.
+/// Measured: 99.8% of the pixels within 3% (asserted ≥ 85%).
+#[test]
+fn a_zoom_photo_gives_per_pixel_albedos_and_a_sharp_render() {
+    use campanile_process::exr_io::write_radiance_exr;
+    use campanile_process::hdr::merge::RadianceMap;
+    use campanile_process::outdoor::rerender::relative_rmse;
+    let dir = tempfile::tempdir().unwrap();
+    let materials = grey_tower(dir.path());
+    let station = campanile_config::document::load_station(&examples_dir().join("sim-station.ron"))
+        .unwrap()
+        .value;
+    let loaded = load_scene(&examples_dir().join("campanile-scene.ron")).unwrap();
+    let refl = campanile_process::outdoor::atlas::read_materials(&loaded.scene, &materials).unwrap();
+    let pose = loaded.description.pose("zoom-south").unwrap();
+    let (pan, tilt) = station.head.reach(pose.azimuth_deg, pose.elevation_deg).unwrap();
+    let (w, h) = (64, 48);
+    let mut pinhole = pinhole_at(&station.camera, w, h);
+    pinhole.focal_px *= 10.0;
+    let rig = CameraRig {
+        pinhole,
+        mount: mount(&station.head.mount),
+        head: HeadPose {
+            pan_rad: pan.to_radians(),
+            tilt_rad: tilt.to_radians(),
+        },
+        position: Vector3::new(pose.position_m.0, pose.position_m.1, pose.position_m.2),
+        width: w,
+        height: h,
+    };
+    let s = &station.site;
+    let observer = Observer::from_degrees(
+        s.latitude_deg,
+        s.longitude_deg,
+        s.elevation_m,
+        s.pressure_mbar,
+        s.temperature_c,
+    );
+    let day_at = |t: &str| {
+        let t: DateTime<Utc> = t.parse().unwrap();
+        let sun = sun_position(t, &observer, s.delta_t_s).unwrap();
+        (t, Daylight::clear(sun.direction(), &Atmosphere::clear()))
+    };
+    let ((t0, d0), (t1, d1)) = (day_at("2026-08-29T20:30:00Z"), day_at("2026-08-29T22:42:00Z"));
+    let f = |i: usize| if (i % w + i / w).is_multiple_of(2) { 1.2 } else { 0.8 };
+    let (base0, _) = rerender(
+        &loaded.scene,
+        &refl,
+        &rig,
+        &Illumination { time: t0, sky: &d0 },
+        &RerenderSettings::default(),
+    );
+    let mut mask = vec![0u8; w * h];
+    mask[24 * w + 30..24 * w + 35].iter_mut().for_each(|m| *m = 1);
+    let photo = RadianceMap {
+        width: w,
+        height: h,
+        rgb: base0
+            .data
+            .iter()
+            .enumerate()
+            .map(|(k, v)| v * f(k / 3) as f32)
+            .collect(),
+        variance: vec![0.0; w * h * 3],
+        mask,
+    };
+    let zoom_exr = dir.path().join("zoom.exr");
+    write_radiance_exr(&photo, &zoom_exr).unwrap();
+    let out = dir.path().join("zoom");
+    let focal = format!("{}", rig.pinhole.focal_px);
+    let args = |focal: &str| {
+        campanile(&[
+            "render",
+            "--scene",
+            "examples/campanile-scene.ron",
+            "--station",
+            "examples/sim-station.ron",
+            "--materials",
+            materials.to_str().unwrap(),
+            "--pose",
+            "zoom-south",
+            "--zoom",
+            zoom_exr.to_str().unwrap(),
+            "--zoom-time",
+            "2026-08-29T20:30:00Z",
+            &format!("--zoom-focal-px={focal}"),
+            "--time",
+            "2026-08-29T22:42:00Z",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
+    let o = args(&focal);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    eprintln!("{text}");
+    assert!(text.contains("5 invalid radiance"), "{text}");
+    let sun = read_rgb_exr(&out.join("zoom-albedo-sun.exr")).unwrap();
+    let se = read_rgb_exr(&out.join("zoom-albedo-se.exr")).unwrap();
+    let render = read_rgb_exr(&out.join("render-zoom-20260829T224200Z.exr")).unwrap();
+    assert_eq!((render.width, render.height), (w, h));
+    let (low, _) = rerender(
+        &loaded.scene,
+        &refl,
+        &rig,
+        &Illumination { time: t1, sky: &d1 },
+        &RerenderSettings::default(),
+    );
+    let within = |got: f32, want: f64| (f64::from(got) / want - 1.0).abs() <= 0.03;
+    let good: Vec<bool> = (0..w * h)
+        .map(|i| {
+            let k = i * 3 + 1;
+            within(sun.data[k], 0.5 * f(i))
+                && within(se.data[k], 0.4 * f(i))
+                && within(render.data[k], f64::from(low.data[k]) * f(i))
+        })
+        .collect();
+    let share = good.iter().filter(|g| **g).count() as f64 / (w * h) as f64;
+    eprintln!(
+        "{:.3} of the pixels within 3% of 0.5·f, 0.4·f and the grid's render × f",
+        share
+    );
+    assert!(share >= 0.85, "{share}");
+    // Against the grid's render times f over those pixels: the factor is applied.
+    let mut want = low.clone();
+    want.data
+        .iter_mut()
+        .enumerate()
+        .for_each(|(k, v)| *v *= f(k / 3) as f32);
+    assert!(relative_rmse(&render, &want, &good).unwrap() <= 0.03);
+
+    let o = args("-3");
+    assert!(!o.status.success());
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("--zoom-focal-px -3"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}

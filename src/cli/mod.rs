@@ -89,7 +89,8 @@ pub enum Command {
     Process(process::ProcessArgs),
     /// List serial ports and cameras, or test a station's devices (`devices test --station FILE`).
     Devices(devices::DevicesArgs),
-    /// Render the scene at a time, a sunrise-to-sunset sequence or overcast, from recovered pseudo-albedos.
+    /// Render the scene at a time, a sunrise-to-sunset sequence or overcast, from recovered pseudo-albedos
+    /// (`--zoom EXR`: a zoom photo's view at pixel resolution, with eq. 5.16 per-pixel pseudo-albedos).
     Render(render::RenderArgs),
     /// Plans: simulate one forward without devices (timeline, frames, durations, what it will not cover).
     Plan {

@@ -6,13 +6,15 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use campanile_process::camera::image::RadianceImage;
-use campanile_process::exr_io::write_radiance_exr;
+use campanile_process::exr_io::{read_radiance_exr, read_rgb_exr, write_radiance_exr};
 use campanile_process::hdr::curve::ResponseCurve;
 use campanile_process::hdr::image_file::write_png;
 use campanile_process::hdr::merge::RadianceMap;
 use campanile_process::outdoor::atlas::read_materials;
 use campanile_process::outdoor::photograph::photograph;
-use campanile_process::outdoor::{Illumination, RerenderSettings, rerender};
+use campanile_process::outdoor::{
+    Illumination, Photo, RerenderSettings, ZoomSettings, rerender, rerender_zoom, zoom_albedo,
+};
 use campanile_process::pose::HeadPose;
 use campanile_process::render::CameraRig;
 use campanile_process::sky::{Atmosphere, Daylight};
@@ -51,6 +53,20 @@ const OVERCAST_ZENITH: [f64; 3] = [30.0, 32.0, 36.0];
 /// --camera NAME), writing relit-CAMERA.exr.
 ///
 /// Example: campanile render --igi room/scene.ron --lights new-lights.ron --out relit/
+///
+/// High resolution (§5.6.4, eq. 5.16): --zoom EXR is a radiance photo
+/// taken from --pose with a longer lens (--zoom-focal-px, its focal length
+/// in its own pixels) at --zoom-time. Its detail finer than the grid's
+/// cells becomes per-pixel pseudo-albedos (zoom-albedo-sun.exr,
+/// zoom-albedo-se.exr), and that view is rendered at its own resolution
+/// (render-zoom-<time>.exr; --width/--height are ignored). Pixels at a
+/// sun-shadow edge, on a face outline, clipped in the merge or off the
+/// targets keep the grid's pseudo-albedos; their counts are printed.
+///
+/// Example: campanile render --scene examples/campanile-scene.ron \
+///            --station examples/sim-station.ron --materials out/materials.ron \
+///            --pose zoom-south --zoom zoom.exr --zoom-time 2026-08-29T20:30:00Z \
+///            --zoom-focal-px 2217 --time 2026-08-29T22:42:00Z --out zoom/
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct RenderArgs {
@@ -105,9 +121,71 @@ pub struct RenderArgs {
     /// Radiance of one unit of relative exposure per second (the merge's radiometric scale).
     #[arg(long, default_value_t = 1.0)]
     scale: f64,
+    /// A zoom photograph from --pose (radiance EXR, as `campanile hdr` writes, or plain RGB):
+    /// render that view with per-pixel pseudo-albedos (eq. 5.16).
+    #[arg(long, requires_all = ["zoom_time", "zoom_focal_px"], conflicts_with = "igi")]
+    zoom: Option<PathBuf>,
+    /// UTC time the zoom photograph was taken (RFC 3339): its sun tells sunlit pixels from shadowed.
+    #[arg(long, requires = "zoom")]
+    zoom_time: Option<DateTime<Utc>>,
+    /// Focal length of the zoom photograph, in its own pixels.
+    #[arg(long, requires = "zoom")]
+    zoom_focal_px: Option<f64>,
     /// Output directory.
     #[arg(long)]
     out: PathBuf,
+}
+
+/// The zoom photograph of `path` as a posed photo from `rig`'s place and
+/// aim, with its own size and focal length.
+fn zoom_photo(path: &Path, rig: &CameraRig, focal_px: f64, time: DateTime<Utc>) -> Result<Photo> {
+    if !(focal_px.is_finite() && focal_px > 0.0) {
+        bail!("--zoom-focal-px {focal_px}: expected a focal length > 0 pixels");
+    }
+    let (image, mask) = match read_radiance_exr(path) {
+        Ok(m) => {
+            let mask = (0..m.width * m.height).map(|p| m.is_valid(p)).collect();
+            (
+                RadianceImage {
+                    width: m.width,
+                    height: m.height,
+                    data: m.rgb,
+                },
+                Some(mask),
+            )
+        }
+        Err(_) => (
+            read_rgb_exr(path)
+                .map_err(|e| anyhow::anyhow!("{e}"))
+                .with_context(|| format!("reading --zoom {}", path.display()))?,
+            None,
+        ),
+    };
+    let (w, h) = (image.width, image.height);
+    if w == 0 || h == 0 {
+        bail!("--zoom {}: the image is empty", path.display());
+    }
+    let mut zrig = *rig;
+    zrig.pinhole.principal_px = (w as f64 / 2.0, h as f64 / 2.0);
+    zrig.pinhole.focal_px = focal_px;
+    zrig.width = w;
+    zrig.height = h;
+    Ok(Photo {
+        label: path.display().to_string(),
+        image,
+        rig: zrig,
+        time,
+        mask,
+    })
+}
+
+/// Per-pixel pseudo-albedos as an image.
+fn albedo_image(rho: &[[f64; 3]], rig: &CameraRig) -> RadianceImage {
+    RadianceImage {
+        width: rig.width,
+        height: rig.height,
+        data: rho.iter().flat_map(|p| p.map(|v| v as f32)).collect(),
+    }
 }
 
 fn write_exr(image: &RadianceImage, path: &Path) -> Result<()> {
@@ -234,7 +312,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         None => None,
     };
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
-    for t in times {
+    let clear_day = |t: DateTime<Utc>| -> Result<(Daylight, f64)> {
         let sun = sun_position(t, &observer, site.delta_t_s).map_err(|e| anyhow::anyhow!("{e}"))?;
         if sun.elevation_rad() <= 0.0 {
             bail!(
@@ -242,19 +320,52 @@ pub fn run(args: RenderArgs) -> Result<()> {
                 sun.elevation_rad().to_degrees()
             );
         }
-        let mut day = Daylight::clear(sun.direction(), &Atmosphere::clear());
+        Ok((
+            Daylight::clear(sun.direction(), &Atmosphere::clear()),
+            sun.elevation_rad(),
+        ))
+    };
+    let zoom = match (&args.zoom, args.zoom_time, args.zoom_focal_px) {
+        (Some(path), Some(t), Some(f)) => {
+            let photo = zoom_photo(path, &rig, f, t)?;
+            let (day, _) = clear_day(t).context("--zoom-time")?;
+            let light = Illumination { time: t, sky: &day };
+            let z = zoom_albedo(scene, &refl, &photo, &light, &ZoomSettings::default())
+                .map_err(|e| anyhow::anyhow!("{e}"))
+                .with_context(|| format!("--zoom {}", path.display()))?;
+            println!("zoom: {}", z.report);
+            for (name, rho) in [("zoom-albedo-sun", &z.rho_sun), ("zoom-albedo-se", &z.rho_se)] {
+                let exr = args.out.join(format!("{name}.exr"));
+                write_exr(&albedo_image(rho, &z.rig), &exr)?;
+                println!("{}", exr.display());
+            }
+            Some(z)
+        }
+        _ => None,
+    };
+    for t in times {
+        let (mut day, elevation) = clear_day(t)?;
         if args.overcast > 0.0 {
             day = day.with_clouds(args.overcast, OVERCAST_ZENITH);
         }
         let light = Illumination { time: t, sky: &day };
-        let (image, _) = rerender(scene, &refl, &rig, &light, &RerenderSettings::default());
-        let stem = format!("render-{}", t.format("%Y%m%dT%H%M%SZ"));
+        let (image, prefix) = match &zoom {
+            Some(z) => (
+                rerender_zoom(scene, &refl, z, &light, &RerenderSettings::default()),
+                "render-zoom",
+            ),
+            None => (
+                rerender(scene, &refl, &rig, &light, &RerenderSettings::default()).0,
+                "render",
+            ),
+        };
+        let stem = format!("{prefix}-{}", t.format("%Y%m%dT%H%M%SZ"));
         let exr = args.out.join(format!("{stem}.exr"));
         write_exr(&image, &exr)?;
         println!(
             "{}  sun elevation {:.1}°  {}",
             t.to_rfc3339(),
-            sun.elevation_rad().to_degrees(),
+            elevation.to_degrees(),
             exr.display()
         );
         if let Some(c) = &curve {

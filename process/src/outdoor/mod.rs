@@ -12,6 +12,8 @@
 //! - [`rerender`]: radiance images at any time and sky (§5.5, §5.6).
 //! - [`atlas`]: pseudo-albedo texture atlases (EXR) and the materials file.
 //! - [`photograph`]: renders through a response curve at a chosen shutter.
+//! - [`mod@zoom_albedo`]: pseudo-albedos at pixel resolution from a zoom
+//!   photograph (§5.6.4, eq. 5.16) and the zoom view re-rendered with them.
 //!
 //! The environment is the scene's non-target surfaces (ground, landscape)
 //! with their materials' albedo, lit by the same sun and sky: the lead sets
@@ -21,8 +23,7 @@
 //! &lights, &ReflectanceSettings::default())?;` then
 //! `rerender(&scene, &refl, &rig, &light, &RerenderSettings::default())`.
 //!
-//! Not done: the high-resolution pseudo-albedo from a zoom photograph
-//! (§5.6.4, eq. 5.16); specular pseudo-BRDFs (the surfaces are taken as
+//! Not done: specular pseudo-BRDFs (the surfaces are taken as
 //! Lambertian); landscape radiance from an environment map.
 
 // Channel loops index several arrays at once; they read better with an index.
@@ -36,6 +37,7 @@ pub mod observation;
 pub mod photo;
 pub mod photograph;
 pub mod rerender;
+pub mod zoom_albedo;
 
 use chrono::{DateTime, Utc};
 use thiserror::Error;
@@ -44,6 +46,7 @@ pub use estimate::{CellEstimate, CellStatus, PhotoCheck, Reflectance, Reflectanc
 pub use grid::Grid;
 pub use photo::{Illumination, Photo};
 pub use rerender::{RerenderSettings, rerender};
+pub use zoom_albedo::{ZoomAlbedo, ZoomReport, ZoomSettings, rerender_zoom, zoom_albedo};
 
 /// Why the outdoor reflectance could not be recovered or rendered.
 #[derive(Debug, Error)]
@@ -94,6 +97,27 @@ pub enum OutdoorError {
         photo: String,
         /// Its time.
         time: DateTime<Utc>,
+    },
+    /// A knob of [`ZoomSettings`] is out of range.
+    #[error("zoom settings: {field} = {value}, expected {expected}")]
+    BadZoomSetting {
+        /// The field.
+        field: &'static str,
+        /// The value given.
+        value: f64,
+        /// What it must be.
+        expected: &'static str,
+    },
+    /// A zoom photograph sees none of the target surfaces.
+    #[error(
+        "photo {photo:?}: none of its {pixels} pixels sees a target surface (from its visible side); \
+         aim the zoom photo at the solved surfaces or check its camera pose"
+    )]
+    NoTargetInView {
+        /// The photo.
+        photo: String,
+        /// Pixels in it.
+        pixels: usize,
     },
     /// An output file could not be written or read.
     #[error("{path}: {message}")]

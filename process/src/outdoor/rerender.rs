@@ -10,6 +10,9 @@
 //! returns its material's albedo times its direct irradiance over π; a ray
 //! that escapes returns the sky (and the solar disc). The back of a target
 //! surface, which no photo saw, is shaded like the environment.
+//! [`rerender_with_pixel_albedos`] takes the pseudo-albedos per pixel
+//! instead where it is given them (a zoom photo's eq. 5.16 albedos,
+//! [`mod@super::zoom_albedo`]); [`rerender`] is it with none.
 
 use std::collections::HashMap;
 
@@ -46,7 +49,7 @@ impl Default for RerenderSettings {
 
 /// The pseudo-albedos at `point` on target `triangle`, in cell `cell`.
 #[allow(clippy::too_many_arguments)]
-fn albedos_at(
+pub(crate) fn albedos_at(
     scene: &Scene,
     refl: &Reflectance,
     rho_sun: &[[f64; 3]],
@@ -92,6 +95,12 @@ fn albedos_at(
     (sun.map(|v| v / wsum), se.map(|v| v / wsum))
 }
 
+/// Per-pixel pseudo-albedos that replace the grid's for one view: given
+/// the pixel `(x, y)` and the target triangle a ray through it met, `(ρ^sun,
+/// ρ^se)` per channel, or `None` to keep the grid's (see
+/// [`rerender_with_pixel_albedos`]).
+pub type PixelAlbedos<'a> = &'a (dyn Fn(usize, usize, usize) -> Option<([f64; 3], [f64; 3])> + Sync);
+
 /// The scene's radiance seen by `rig` under `light`, from the recovered
 /// pseudo-albedos `refl`. Also returns the light gathered on the grid.
 pub fn rerender(
@@ -100,6 +109,22 @@ pub fn rerender(
     rig: &CameraRig,
     light: &Illumination,
     settings: &RerenderSettings,
+) -> (RadianceImage, TimeLight) {
+    rerender_with_pixel_albedos(scene, refl, rig, light, settings, None)
+}
+
+/// [`rerender`], with the pseudo-albedos of the target cells a pixel sees
+/// taken from `pixel_albedos` where it gives them (the high-resolution
+/// pseudo-albedos of a zoom photograph from this very camera, §5.6.4,
+/// [`mod@super::zoom_albedo`]); the irradiance is the grid's as in
+/// [`rerender`]. With `None` it is [`rerender`].
+pub fn rerender_with_pixel_albedos(
+    scene: &Scene,
+    refl: &Reflectance,
+    rig: &CameraRig,
+    light: &Illumination,
+    settings: &RerenderSettings,
+    pixel_albedos: Option<PixelAlbedos>,
 ) -> (RadianceImage, TimeLight) {
     let grid = &refl.grid;
     let tl = gather(scene, grid, light, &settings.gather);
@@ -155,16 +180,18 @@ pub fn rerender(
                         .filter(|vn| vn.dot(&n) > 0.0)
                         .and_then(|_| grid.nearest_cell(scene, hit.triangle, &hit.point));
                     if let Some(c) = cell {
-                        let (rs, re) = albedos_at(
-                            scene,
-                            refl,
-                            &rho_sun,
-                            &rho_se,
-                            c,
-                            hit.triangle,
-                            &hit.point,
-                            settings.bilinear,
-                        );
+                        let (rs, re) = pixel_albedos.and_then(|f| f(x, y, hit.triangle)).unwrap_or_else(|| {
+                            albedos_at(
+                                scene,
+                                refl,
+                                &rho_sun,
+                                &rho_se,
+                                c,
+                                hit.triangle,
+                                &hit.point,
+                                settings.bilinear,
+                            )
+                        });
                         for ch in 0..3 {
                             let es = if lit { e_sun[ch] * cos } else { 0.0 };
                             sum[ch] += (rs[ch] * es + re[ch] * e_se[c][ch]) / std::f64::consts::PI;

@@ -12,6 +12,7 @@ pub mod rig;
 pub mod room_igi;
 pub mod scene_file;
 pub mod truth;
+pub mod zoom_truth;
 
 use std::path::PathBuf;
 
