@@ -9,16 +9,12 @@ use campanile_process::igi::light_triangulation::{BulbImage, triangulate};
 use campanile_process::igi::relight::{RelightSettings, relative_rmse, relight};
 use campanile_process::igi::relit_scene::recovered_scene;
 use campanile_process::igi::table::errors;
-use campanile_process::igi::{IgiLight, IgiOptions, SurfaceModel, ViewCamera, format_table, recover};
-use campanile_process::render::SphereLight;
-use campanile_sim::world::examples_dir;
+use campanile_process::igi::{IgiOptions, SurfaceModel, ViewCamera, format_table, recover};
 use campanile_sim::world::igi_photograph::PhotoSettings;
-use campanile_sim::world::room_igi::{CEILING_ELEVATION_DEG, ROOM_BOUNCES, RoomIgi, block_average};
-use nalgebra::Vector3;
+use campanile_sim::world::room_igi::{ROOM_BOUNCES, RoomIgi, igi_lights_of, new_lamps, relit_block_error};
 
 fn room() -> RoomIgi {
-    let station = campanile_config::document::load_station(&examples_dir().join("sim-station.ron")).unwrap();
-    RoomIgi::load(&examples_dir().join("room-scene.ron"), &station.value).unwrap()
+    RoomIgi::example().unwrap()
 }
 
 #[test]
@@ -83,9 +79,7 @@ fn the_lamps_are_triangulated_from_their_bulbs() {
 #[test]
 fn the_room_is_recovered_and_relit_under_new_lamps() {
     let room = room();
-    let mut cams = room.cameras(60.0, 80, 60);
-    cams.extend(room.highlight_cameras(20.0, 40));
-    cams.extend(room.ceiling_cameras(CEILING_ELEVATION_DEG, 60.0, 80, 60));
+    let cams = room.solver_cameras(80, 60);
     let settings = PhotoSettings {
         indirect_samples: 16,
         max_bounces: ROOM_BOUNCES,
@@ -175,6 +169,7 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
         &AlbedoMapOptions {
             indirect: false,
             remove_specular: false,
+            shrink_noise: false,
             ..AlbedoMapOptions::default()
         },
     )
@@ -193,19 +188,9 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
     }
 
     let scene = recovered_scene(&input, &result).unwrap();
-    let new_lamps = [
-        SphereLight::with_intensity(Vector3::new(2.0, 2.2, 2.4), 0.05, [2.5, 2.4, 2.0]),
-        SphereLight::with_intensity(Vector3::new(3.6, 2.8, 2.0), 0.05, [1.4, 1.7, 2.3]),
-    ];
-    let lights: Vec<IgiLight> = new_lamps
-        .iter()
-        .map(|b| IgiLight {
-            position: b.center,
-            radius: b.radius,
-            intensity: b.radiance.map(|l| l * std::f64::consts::PI * b.radius * b.radius),
-        })
-        .collect();
-    let (_, camera) = room.cameras(60.0, 80, 60).swap_remove(0);
+    let new_lamps = new_lamps();
+    let lights = igi_lights_of(&new_lamps);
+    let camera = input.views[0].camera;
     let rs = RelightSettings {
         indirect_samples: 32,
         max_bounces: ROOM_BOUNCES,
@@ -223,10 +208,8 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
             seed: 99,
         },
     );
-    let (ours_b, same_b, sim_b) = (block_average(&ours, 4), block_average(&same, 4), block_average(&sim, 4));
-    let keep = |i: usize| sim_b.data[i * 3] < 20.0;
-    let relit = relative_rmse(&ours_b, &sim_b, keep).unwrap();
-    let floor = relative_rmse(&same_b, &sim_b, keep).unwrap();
+    let relit = relit_block_error(&ours, &sim).unwrap();
+    let floor = relit_block_error(&same, &sim).unwrap();
     eprintln!(
         "relit: {:.2} % (4x4 blocks); noise floor (true materials, same renderer) {:.2} %; per pixel {:.2} %",
         100.0 * relit,
