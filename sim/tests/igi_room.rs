@@ -154,15 +154,19 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
         &input,
         &result,
         &AlbedoMapOptions {
-            irradiance_rays: 64,
+            irradiance_rays: 256,
             ..AlbedoMapOptions::default()
         },
     )
     .unwrap();
     // Albedo maps against the true textures: median relative error over
-    // the seen texels (tolerances from the measured run; see the README),
-    // and against a baseline that divides by the lamps' light only and
-    // keeps highlights (colour bleeding and interreflection stay in it).
+    // the seen texels, and against a baseline that divides by the lamps'
+    // light only and keeps highlights (colour bleeding and interreflection
+    // stay in it); the textured surfaces' pattern, by the correlation of
+    // map and truth over the texels. Measured (256 irradiance rays, noise
+    // shrinkage): paint 3.1 %, paper 12.3 % (correlation 0.71), wood
+    // 10.0 % (0.23: 3 cm stripes on 2 cm texels seen by pixels about 5 cm
+    // wide); before the shrinkage 11.4 / 15.3 / 20.1 % (bounds 15 / 20 / 25 %).
     let naive = AlbedoMap::build(
         &input,
         &result,
@@ -174,25 +178,36 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
         },
     )
     .unwrap();
-    for (surface, tol) in [("paint", 0.15), ("paper", 0.20), ("wood", 0.25)] {
+    for (surface, tol, min_correlation) in [
+        ("paint", 0.05, None),
+        ("paper", 0.16, Some(0.65)),
+        ("wood", 0.13, Some(0.18)),
+    ] {
         let s = input.surfaces.iter().position(|n| n == surface).unwrap();
         let (median, n) = room.albedo_map_error(&map, s);
         let (base, _) = room.albedo_map_error(&naive, s);
+        let correlation = room.albedo_map_texture_correlation(&map, s);
         eprintln!(
-            "albedo map {surface}: median relative error {:.2} % over {n} texels; baseline {:.2} %",
+            "albedo map {surface}: median relative error {:.2} % over {n} texels; baseline {:.2} %; texture correlation {correlation:.3}",
             100.0 * median,
             100.0 * base
         );
         assert!(n > 500 && median < tol, "{surface}: {median} over {n} texels");
         assert!(median < base, "{surface}: {median} not below the baseline's {base}");
+        if let Some(c) = min_correlation {
+            assert!(correlation > c, "{surface}: texture correlation {correlation}");
+        }
     }
 
     let scene = recovered_scene(&input, &result).unwrap();
     let new_lamps = new_lamps();
     let lights = igi_lights_of(&new_lamps);
     let camera = input.views[0].camera;
+    // 256 stratified paths per pixel in both renders, so that their Monte
+    // Carlo noise (the "floor", about 1.2 % per block together) stays well
+    // below the 3 % checked.
     let rs = RelightSettings {
-        indirect_samples: 32,
+        indirect_samples: 256,
         max_bounces: ROOM_BOUNCES,
         seed: 5,
     };
@@ -203,7 +218,7 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
         &[],
         &camera,
         &PhotoSettings {
-            indirect_samples: 32,
+            indirect_samples: 256,
             max_bounces: ROOM_BOUNCES,
             seed: 99,
         },
@@ -216,8 +231,10 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
         100.0 * floor,
         100.0 * relative_rmse(&ours, &sim, |i| sim.data[i * 3] < 20.0).unwrap()
     );
-    // The renderer itself agrees with the simulator within 5 %; the relit
-    // room does not yet meet the 3 % (README: status).
-    assert!(floor < 0.05, "noise floor {floor}");
-    assert!(relit < 0.12, "relit {relit}");
+    // Measured: relit 3.72 %, floor 1.40 % (256 paths per pixel in both
+    // renders; 9.5 % and 3.8 % before, at 32 paths and without the maps'
+    // noise shrinkage). The 3 % is not met yet (README: status;
+    // BENCHMARKS.md: the noise budget).
+    assert!(floor < 0.02, "noise floor {floor}");
+    assert!(relit < 0.045, "relit {relit}");
 }

@@ -5,10 +5,11 @@
 //!
 //! At a surface point seen by the camera, the lamps' light is exact
 //! (shadow-tested) and the light from other surfaces is estimated by
-//! `samples` BRDF-sampled rays whose two direction numbers are stratified
-//! ([`super::stratified`]: a jittered grid for a square count, a Latin
-//! hypercube otherwise), so that the estimate of the smooth interreflected
-//! light converges faster than with independent rays at the same cost.
+//! `samples` BRDF-sampled rays whose two direction numbers are, for the
+//! renders, stratified ([`super::stratified`]: a jittered grid for a
+//! square count, a Latin hypercube otherwise), so that the estimate of the
+//! smooth interreflected light converges faster than with independent rays
+//! at the same cost (the simulator's photographs keep independent rays).
 //! Each ray is continued as a path with next-event estimation to every
 //! lamp at each vertex and Russian roulette from its second vertex on
 //! (survival probability the path's largest throughput, capped at 1):
@@ -80,15 +81,17 @@ pub fn add_direct(scene: &Scene, points: &[PointLight], v: &PathVertex, beta: &[
 }
 
 /// The radiance leaving `v` toward its viewer: the lamps' light (exact)
-/// plus the interreflected light estimated by `samples` stratified
-/// BRDF-sampled paths of up to `max_bounces − 1` further scattering
-/// events (module doc). `max_bounces < 2` or `samples == 0`: direct only.
+/// plus the interreflected light estimated by `samples` BRDF-sampled
+/// paths of up to `max_bounces − 1` further scattering events (module
+/// doc), their first directions stratified if `stratified`, otherwise
+/// independent (the simulator's photographs, whose noise realisation the
+/// solver's tests were measured with). `max_bounces < 2` or
+/// `samples == 0`: direct only.
 pub fn surface_radiance(
     scene: &Scene,
     points: &[PointLight],
     v: &PathVertex,
-    samples: u32,
-    max_bounces: u32,
+    (samples, max_bounces, stratified): (u32, u32, bool),
     rng: &mut ChaCha8Rng,
 ) -> [f64; 3] {
     let mut l = [0.0; 3];
@@ -96,11 +99,17 @@ pub fn surface_radiance(
     if max_bounces < 2 || samples == 0 {
         return l;
     }
-    let strata = Strata::new(samples, rng);
+    let strata = stratified.then(|| Strata::new(samples, rng));
     let mut sum = [0.0; 3];
     for k in 0..samples {
-        let [u1, u2] = strata.point(k, rng);
-        let Some(s) = v.bsdf.sample(&v.wo, [rng.random(), u1, u2]) else {
+        let u = match &strata {
+            Some(strata) => {
+                let [u1, u2] = strata.point(k, rng);
+                [rng.random(), u1, u2]
+            }
+            None => [rng.random(), rng.random(), rng.random()],
+        };
+        let Some(s) = v.bsdf.sample(&v.wo, u) else {
             continue;
         };
         let cos = s.direction.dot(&v.normal);

@@ -109,7 +109,13 @@ fn pixel(
         None => base.clone(),
     };
     let v = PathVertex::at(&material, tri, &hit.point, -ray.direction);
-    surface_radiance(scene, points, &v, settings.indirect_samples, settings.max_bounces, rng)
+    surface_radiance(
+        scene,
+        points,
+        &v,
+        (settings.indirect_samples, settings.max_bounces, true),
+        rng,
+    )
 }
 
 /// Relative root-mean-square difference of `a` from `reference` over the

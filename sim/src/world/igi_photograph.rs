@@ -6,7 +6,7 @@
 //! solver evaluates its model along the same ray). There, the light
 //! arriving straight from each lamp is reflected through the true BRDF
 //! (shadow-tested, no noise); the light arriving from other surfaces is
-//! estimated by `indirect_samples` stratified BRDF-sampled rays, each
+//! estimated by `indirect_samples` independent BRDF-sampled rays, each
 //! continued as a path for up to `max_bounces − 1` further scattering
 //! events, with next-event estimation to every lamp at each vertex and
 //! Russian roulette from the second vertex on: the path loop of
@@ -125,6 +125,12 @@ fn pixel(
     let tri = &scene.triangles()[hit.triangle];
     let material = &scene.materials()[tri.material as usize];
     let v = PathVertex::at(material, tri, &hit.point, -ray.direction);
-    let l = surface_radiance(scene, points, &v, settings.indirect_samples, settings.max_bounces, rng);
+    let l = surface_radiance(
+        scene,
+        points,
+        &v,
+        (settings.indirect_samples, settings.max_bounces, false),
+        rng,
+    );
     [0, 1, 2].map(|c| material.emission[c] + l[c])
 }
