@@ -57,7 +57,8 @@ pub fn settings(quick: bool) -> (IgiOptions, AlbedoMapOptions, RelightSettings) 
     // the relit image's noise well below the relit error (BENCHMARKS.md,
     // the room's noise budget).
     let map = AlbedoMapOptions {
-        irradiance_rays: if quick { 64 } else { 256 },
+        irradiance_rays: if quick { 64 } else { 128 },
+        irradiance_cell_m: 0.125,
         ..AlbedoMapOptions::default()
     };
     let relight = RelightSettings {
