@@ -32,11 +32,12 @@
 
 use std::time::Instant;
 
+use campanile_process::camera::image::RadianceImage;
 use campanile_process::igi::albedo_map::{AlbedoMap, AlbedoMapOptions};
 use campanile_process::igi::relight::{RelightSettings, relative_rmse, relight};
 use campanile_process::igi::relit_scene::recovered_scene;
 use campanile_process::igi::table::errors;
-use campanile_process::igi::{IgiOptions, recover};
+use campanile_process::igi::{IgiOptions, ViewCamera, recover};
 use campanile_sim::world::igi_photograph::PhotoSettings;
 use campanile_sim::world::room_igi::{RoomIgi, block_average, igi_lights_of, new_lamps, relit_block_error};
 
@@ -163,49 +164,7 @@ fn main() {
             100.0 * relative_rmse(&fb, &sb, keep).unwrap_or(f64::NAN),
             100.0 * (mean(&ours) / mean(&sim) - 1.0)
         );
-        {
-            // The relit error by the material a block's centre ray meets.
-            let names = room.material_names();
-            let mut per = vec![(0.0f64, 0.0f64, 0usize); names.len() + 1];
-            for y in 0..sb.height {
-                for x in 0..sb.width {
-                    let i = y * sb.width + x;
-                    if !keep(i) {
-                        continue;
-                    }
-                    let ray = campanile_process::render::Ray {
-                        origin: camera.position,
-                        direction: camera.direction(x as f64 * 4.0 + 2.0, y as f64 * 4.0 + 2.0),
-                    };
-                    let m = room
-                        .scene()
-                        .intersect(&ray, f64::INFINITY)
-                        .map_or(names.len(), |h| room.scene().triangles()[h.triangle].material as usize);
-                    for c in 0..3 {
-                        let (a, r) = (f64::from(ob.data[i * 3 + c]), f64::from(sb.data[i * 3 + c]));
-                        per[m].0 += (a - r) * (a - r);
-                        per[m].1 += r;
-                        per[m].2 += 1;
-                    }
-                }
-            }
-            let total: f64 = per.iter().map(|p| p.0).sum();
-            let line: Vec<String> = per
-                .iter()
-                .enumerate()
-                .filter(|(_, p)| p.2 > 0)
-                .map(|(k, p)| {
-                    format!(
-                        "{} {:.1} % ({} blocks, {:.0} % of the squared error)",
-                        names.get(k).map_or("none", String::as_str),
-                        100.0 * (p.0 / p.2 as f64).sqrt() / (p.1 / p.2 as f64),
-                        p.2 / 3,
-                        100.0 * p.0 / total
-                    )
-                })
-                .collect();
-            println!("  relit by material: {}", line.join("; "));
-        }
+        println!("  relit by material: {}", by_material(&room, &camera, &ours, &sim));
         if env("ASCII", 0) == 1 {
             // Per 4×4 block, relit / simulator − 1 in tens of per cent (channel sum).
             for y in 0..sb.height {
@@ -291,45 +250,6 @@ fn main() {
             let true_scene = recovered_scene(&input, &true_result).unwrap();
             let map_true = AlbedoMap::build(&input_conv, &true_result, &irr).unwrap();
             let r_true = relight(&true_scene, Some(&map_true), &lights, &camera, &conv_rs);
-            let by_material = |img: &campanile_process::camera::image::RadianceImage| {
-                let (ib, rb) = (block_average(img, 4), block_average(&reference, 4));
-                let names = room.material_names();
-                let mut per = vec![(0.0f64, 0.0f64, 0usize); names.len() + 1];
-                for y in 0..rb.height {
-                    for x in 0..rb.width {
-                        let i = y * rb.width + x;
-                        if rb.data[i * 3] >= 20.0 {
-                            continue;
-                        }
-                        let ray = campanile_process::render::Ray {
-                            origin: camera.position,
-                            direction: camera.direction(x as f64 * 4.0 + 2.0, y as f64 * 4.0 + 2.0),
-                        };
-                        let m = room
-                            .scene()
-                            .intersect(&ray, f64::INFINITY)
-                            .map_or(names.len(), |h| room.scene().triangles()[h.triangle].material as usize);
-                        for c in 0..3 {
-                            let (a, r) = (f64::from(ib.data[i * 3 + c]), f64::from(rb.data[i * 3 + c]));
-                            per[m].0 += (a - r) * (a - r);
-                            per[m].1 += r;
-                            per[m].2 += 1;
-                        }
-                    }
-                }
-                per.iter()
-                    .enumerate()
-                    .filter(|(_, p)| p.2 > 0)
-                    .map(|(k, p)| {
-                        format!(
-                            "{} {:.1}",
-                            names.get(k).map_or("none", String::as_str),
-                            100.0 * (p.0 / p.2 as f64).sqrt() / (p.1 / p.2 as f64)
-                        )
-                    })
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            };
             for (name, m) in [
                 ("photos converged", &map_pc),
                 ("irradiance converged", &map_ic),
@@ -373,12 +293,18 @@ fn main() {
                 "    (e) bias: converged maps and renders vs converged reference        {:6.2}",
                 e(&r_both, &reference)
             );
-            println!("        by material (%): {}", by_material(&r_both));
+            println!(
+                "        by material (%): {}",
+                by_material(&room, &camera, &r_both, &reference)
+            );
             println!(
                 "        the same with the true BRDFs (maps from converged photographs)  {:6.2}",
                 e(&r_true, &reference)
             );
-            println!("        by material (%): {}", by_material(&r_true));
+            println!(
+                "        by material (%): {}",
+                by_material(&room, &camera, &r_true, &reference)
+            );
             println!(
                 "        same renderer, true materials, vs converged reference          {:6.2}",
                 e(&same_conv, &reference)
@@ -393,4 +319,51 @@ fn main() {
             );
         }
     }
+}
+
+/// The relit error by the material a block's centre ray meets: per
+/// material, the relative RMSE of `image`'s 4×4-block means against
+/// `reference`'s, the blocks, and the share of the squared error (blocks
+/// with a bulb left out).
+fn by_material(room: &RoomIgi, camera: &ViewCamera, image: &RadianceImage, reference: &RadianceImage) -> String {
+    let (ib, rb) = (block_average(image, 4), block_average(reference, 4));
+    let names = room.material_names();
+    let mut per = vec![(0.0f64, 0.0f64, 0usize); names.len() + 1];
+    for y in 0..rb.height {
+        for x in 0..rb.width {
+            let i = y * rb.width + x;
+            if rb.data[i * 3] >= 20.0 {
+                continue;
+            }
+            let ray = campanile_process::render::Ray {
+                origin: camera.position,
+                direction: camera.direction(x as f64 * 4.0 + 2.0, y as f64 * 4.0 + 2.0),
+            };
+            let m = room
+                .scene()
+                .intersect(&ray, f64::INFINITY)
+                .map_or(names.len(), |h| room.scene().triangles()[h.triangle].material as usize);
+            for c in 0..3 {
+                let (a, r) = (f64::from(ib.data[i * 3 + c]), f64::from(rb.data[i * 3 + c]));
+                per[m].0 += (a - r) * (a - r);
+                per[m].1 += r;
+                per[m].2 += 1;
+            }
+        }
+    }
+    let total: f64 = per.iter().map(|p| p.0).sum();
+    per.iter()
+        .enumerate()
+        .filter(|(_, p)| p.2 > 0)
+        .map(|(k, p)| {
+            format!(
+                "{} {:.1} % ({} blocks, {:.0} % of the squared error)",
+                names.get(k).map_or("none", String::as_str),
+                100.0 * (p.0 / p.2 as f64).sqrt() / (p.1 / p.2 as f64),
+                p.2 / 3,
+                100.0 * p.0 / total
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }
