@@ -183,3 +183,90 @@ pub fn path_radiance(scene: &Scene, points: &[PointLight], ray: Ray, events: u32
     }
     radiance
 }
+
+#[cfg(test)]
+mod tests {
+    use rand::SeedableRng;
+
+    use super::*;
+    use crate::render::Texture;
+
+    /// The twelve inward-facing triangles of the cube [0, 1]³ (material 0).
+    fn unit_cube() -> Vec<Triangle> {
+        let v = |x: f64, y: f64, z: f64| Vector3::new(x, y, z);
+        let quads = [
+            [v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.), v(0., 1., 0.)],
+            [v(0., 0., 1.), v(0., 1., 1.), v(1., 1., 1.), v(1., 0., 1.)],
+            [v(0., 0., 0.), v(0., 1., 0.), v(0., 1., 1.), v(0., 0., 1.)],
+            [v(1., 0., 0.), v(1., 0., 1.), v(1., 1., 1.), v(1., 1., 0.)],
+            [v(0., 0., 0.), v(0., 0., 1.), v(1., 0., 1.), v(1., 0., 0.)],
+            [v(0., 1., 0.), v(1., 1., 0.), v(1., 1., 1.), v(0., 1., 1.)],
+        ];
+        quads
+            .iter()
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .filter_map(|t| Triangle::new(t, 0, 0))
+            .collect()
+    }
+
+    fn material(rho: f64, emission: f64) -> Material {
+        Material {
+            name: "wall".into(),
+            albedo: Texture::Constant([rho; 3]),
+            specular: None,
+            emission: [emission; 3],
+        }
+    }
+
+    /// A point lamp of intensity I at height h over a Lambertian floor of
+    /// albedo ρ, alone in the scene: the radiance straight below it is
+    /// ρ I / (π h²) (to the rays' 1e-6 offset off the
+    /// surface), and paths find nothing else to add.
+    #[test]
+    fn a_lamp_over_a_floor_gives_its_exact_reflected_radiance() {
+        let floor: Vec<Triangle> = unit_cube().into_iter().take(2).collect();
+        let scene = Scene::new(floor, vec![material(0.6, 0.0)], vec!["floor".into()]).unwrap();
+        let lamp = PointLight {
+            position: Vector3::new(0.5, 0.5, 2.0),
+            intensity: [3.0, 2.0, 1.0],
+        };
+        let tri = scene.triangles()[0];
+        let p = Vector3::new(0.5, 0.5, 0.0);
+        let v = PathVertex::at(&scene.materials()[0], &tri, &p, Vector3::new(0.3, 0.0, 1.0).normalize());
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let l = surface_radiance(&scene, &[lamp], &v, (64, 12, true), &mut rng);
+        for c in 0..3 {
+            let want = 0.6 * lamp.intensity[c] / (std::f64::consts::PI * 4.0);
+            assert!((l[c] - want).abs() < 1e-5 * want, "channel {c}: {} vs {want}", l[c]);
+        }
+    }
+
+    /// The furnace: inside a closed box whose walls emit Le and reflect ρ
+    /// diffusely, the light arriving anywhere is Le / (1 − ρ), so a wall
+    /// reflects ρ Le / (1 − ρ) (no emission counted at the first vertex).
+    /// Russian roulette and stratification leave the estimate unbiased:
+    /// within 1 % (about three standard errors of 64 000 paths) for both
+    /// samplings.
+    #[test]
+    fn the_furnace_is_unbiased_with_roulette_and_strata() {
+        let (rho, le) = (0.7, 1.0);
+        let scene = Scene::new(unit_cube(), vec![material(rho, le)], vec!["box".into()]).unwrap();
+        let want = rho * le / (1.0 - rho);
+        let tri = scene.triangles()[0];
+        for stratified in [true, false] {
+            let mut rng = ChaCha8Rng::seed_from_u64(7);
+            let trials = 4000;
+            let mut sum = 0.0;
+            for k in 0..trials {
+                let p = Vector3::new(0.1 + 0.0002 * f64::from(k), 0.05 + 0.0001 * f64::from(k), 0.0);
+                let v = PathVertex::at(&scene.materials()[0], &tri, &p, Vector3::z());
+                sum += surface_radiance(&scene, &[], &v, (16, 60, stratified), &mut rng)[0];
+            }
+            let got = sum / f64::from(trials);
+            assert!(
+                (got / want - 1.0).abs() < 0.01,
+                "stratified {stratified}: {got} vs {want}"
+            );
+        }
+    }
+}
