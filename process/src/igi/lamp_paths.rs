@@ -230,9 +230,9 @@ mod tests {
             position: Vector3::new(0.5, 0.5, 2.0),
             intensity: [3.0, 2.0, 1.0],
         };
-        let tri = scene.triangles()[0];
+        let tri = &scene.triangles()[0];
         let p = Vector3::new(0.5, 0.5, 0.0);
-        let v = PathVertex::at(&scene.materials()[0], &tri, &p, Vector3::new(0.3, 0.0, 1.0).normalize());
+        let v = PathVertex::at(&scene.materials()[0], tri, &p, Vector3::new(0.3, 0.0, 1.0).normalize());
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let l = surface_radiance(&scene, &[lamp], &v, (64, 12, true), &mut rng);
         for c in 0..3 {
@@ -252,14 +252,14 @@ mod tests {
         let (rho, le) = (0.7, 1.0);
         let scene = Scene::new(unit_cube(), vec![material(rho, le)], vec!["box".into()]).unwrap();
         let want = rho * le / (1.0 - rho);
-        let tri = scene.triangles()[0];
+        let tri = &scene.triangles()[0];
         for stratified in [true, false] {
             let mut rng = ChaCha8Rng::seed_from_u64(7);
             let trials = 4000;
             let mut sum = 0.0;
             for k in 0..trials {
                 let p = Vector3::new(0.1 + 0.0002 * f64::from(k), 0.05 + 0.0001 * f64::from(k), 0.0);
-                let v = PathVertex::at(&scene.materials()[0], &tri, &p, Vector3::z());
+                let v = PathVertex::at(&scene.materials()[0], tri, &p, Vector3::z());
                 sum += surface_radiance(&scene, &[], &v, (16, 60, stratified), &mut rng)[0];
             }
             let got = sum / f64::from(trials);
