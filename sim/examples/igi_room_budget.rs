@@ -7,26 +7,39 @@
 //! beside the same renderer with the true materials (its noise floor).
 //! With `RELIT=0` the relighting is skipped.
 //!
+//! With `BUDGET=1`, the relit error's noise budget (each term measured by
+//! swapping one input for a converged or true one; RMSE per 4×4 block):
+//! (a) the reference render's noise (`REF_SPP`, default 32, against a
+//! converged reference of `CONV_SPP`, default 512, paths per pixel); (b)
+//! the relit render's noise (`RELIT_SPP`, default 32, against `CONV_SPP`);
+//! (c) the albedo maps' noise from the photographs' Monte Carlo noise
+//! (maps from photographs of `PHOTO_CONV`, default 256, paths per pixel);
+//! (d) the maps' noise from their indirect-irradiance estimate
+//! (`IRR_CONV`, default 1024, rays per lattice node); (e) the bias left
+//! with converged photographs, irradiance and renders (the BRDF
+//! parameters, the texels), beside the same renderer with the true
+//! materials against the converged reference (the renderer's own bias).
+//!
 //! `cargo run --release -p campanile-sim --example igi_room_budget [-- W H BOUNCES...]`
 //! (defaults 80 60 4 16); the solver's cells per edge, gather rays and ΔS
 //! passes from the environment variables `CELLS`, `GATHER`, `ITER`,
 //! `LOBE`, `SPARSE` (defaults 6, 64, 3, 16, 2500); the photographs'
 //! indirect samples per pixel from `SPP` (16), the albedo maps' rays per
 //! irradiance cell, texel and cell sides from `IRR_RAYS` (64), `TEXEL_MM`
-//! (20), `CELL_MM` (250).
+//! (20), `CELL_MM` (250), the maps' noise shrinkage from `SHRINK` (1:
+//! on); the relit render's and the reference's paths per pixel from
+//! `RELIT_SPP` and `REF_SPP` (32).
 
 use std::time::Instant;
 
+use campanile_process::camera::image::RadianceImage;
 use campanile_process::igi::albedo_map::{AlbedoMap, AlbedoMapOptions};
 use campanile_process::igi::relight::{RelightSettings, relative_rmse, relight};
 use campanile_process::igi::relit_scene::recovered_scene;
 use campanile_process::igi::table::errors;
-use campanile_process::igi::{IgiLight, IgiOptions, recover};
-use campanile_process::render::SphereLight;
-use campanile_sim::world::examples_dir;
+use campanile_process::igi::{IgiOptions, ViewCamera, recover};
 use campanile_sim::world::igi_photograph::PhotoSettings;
-use campanile_sim::world::room_igi::{CEILING_ELEVATION_DEG, RoomIgi, block_average};
-use nalgebra::Vector3;
+use campanile_sim::world::room_igi::{RoomIgi, block_average, igi_lights_of, new_lamps, relit_block_error};
 
 fn env(name: &str, default: usize) -> usize {
     std::env::var(name).ok().and_then(|v| v.parse().ok()).unwrap_or(default)
@@ -41,12 +54,9 @@ fn main() {
     } else {
         vec![4, 16]
     };
-    let station = campanile_config::document::load_station(&examples_dir().join("sim-station.ron")).unwrap();
-    let room = RoomIgi::load(&examples_dir().join("room-scene.ron"), &station.value).unwrap();
+    let room = RoomIgi::example().unwrap();
     let truth = room.true_materials().unwrap();
-    let mut cams = room.cameras(60.0, w, h);
-    cams.extend(room.highlight_cameras(20.0, w / 2));
-    cams.extend(room.ceiling_cameras(CEILING_ELEVATION_DEG, 60.0, w, h));
+    let cams = room.solver_cameras(w, h);
     for b in bounces {
         let t = Instant::now();
         let input = room.igi_input(
@@ -98,44 +108,32 @@ fn main() {
             continue;
         }
         let t = Instant::now();
-        let map = AlbedoMap::build(
-            &input,
-            &result,
-            &AlbedoMapOptions {
-                irradiance_rays: env("IRR_RAYS", 64) as u32,
-                texel_m: env("TEXEL_MM", 20) as f64 * 1e-3,
-                irradiance_cell_m: env("CELL_MM", 250) as f64 * 1e-3,
-                max_bounces: b,
-                ..AlbedoMapOptions::default()
-            },
-        )
-        .unwrap();
+        let map_options = AlbedoMapOptions {
+            irradiance_rays: env("IRR_RAYS", 64) as u32,
+            texel_m: env("TEXEL_MM", 20) as f64 * 1e-3,
+            irradiance_cell_m: env("CELL_MM", 250) as f64 * 1e-3,
+            max_bounces: b,
+            shrink_noise: env("SHRINK", 1) == 1,
+            ..AlbedoMapOptions::default()
+        };
+        let map = AlbedoMap::build(&input, &result, &map_options).unwrap();
         let map_s = t.elapsed().as_secs_f64();
         for surface in ["paint", "paper", "wood"] {
             let s = input.surfaces.iter().position(|n| n == surface).unwrap();
             let (median, n) = room.albedo_map_error(&map, s);
             println!(
-                "  albedo map {surface}: median relative error {:.2} % over {n} texels, median signed {:+.2} %",
+                "  albedo map {surface}: median relative error {:.2} % over {n} texels, median signed {:+.2} %, texture correlation {:.3}",
                 100.0 * median,
-                100.0 * room.albedo_map_bias(&map, s)
+                100.0 * room.albedo_map_bias(&map, s),
+                room.albedo_map_texture_correlation(&map, s)
             );
         }
         let scene = recovered_scene(&input, &result).unwrap();
-        let new_lamps = [
-            SphereLight::with_intensity(Vector3::new(2.0, 2.2, 2.4), 0.05, [2.5, 2.4, 2.0]),
-            SphereLight::with_intensity(Vector3::new(3.6, 2.8, 2.0), 0.05, [1.4, 1.7, 2.3]),
-        ];
-        let lights: Vec<IgiLight> = new_lamps
-            .iter()
-            .map(|l| IgiLight {
-                position: l.center,
-                radius: l.radius,
-                intensity: l.radiance.map(|v| v * std::f64::consts::PI * l.radius * l.radius),
-            })
-            .collect();
+        let new_lamps = new_lamps();
+        let lights = igi_lights_of(&new_lamps);
         let camera = cams[0].1;
         let rs = RelightSettings {
-            indirect_samples: 32,
+            indirect_samples: env("RELIT_SPP", 32) as u32,
             max_bounces: b,
             seed: 5,
         };
@@ -149,7 +147,7 @@ fn main() {
             &[],
             &camera,
             &PhotoSettings {
-                indirect_samples: 32,
+                indirect_samples: env("REF_SPP", 32) as u32,
                 max_bounces: b,
                 seed: 99,
             },
@@ -166,49 +164,7 @@ fn main() {
             100.0 * relative_rmse(&fb, &sb, keep).unwrap_or(f64::NAN),
             100.0 * (mean(&ours) / mean(&sim) - 1.0)
         );
-        {
-            // The relit error by the material a block's centre ray meets.
-            let names = room.material_names();
-            let mut per = vec![(0.0f64, 0.0f64, 0usize); names.len() + 1];
-            for y in 0..sb.height {
-                for x in 0..sb.width {
-                    let i = y * sb.width + x;
-                    if !keep(i) {
-                        continue;
-                    }
-                    let ray = campanile_process::render::Ray {
-                        origin: camera.position,
-                        direction: camera.direction(x as f64 * 4.0 + 2.0, y as f64 * 4.0 + 2.0),
-                    };
-                    let m = room
-                        .scene()
-                        .intersect(&ray, f64::INFINITY)
-                        .map_or(names.len(), |h| room.scene().triangles()[h.triangle].material as usize);
-                    for c in 0..3 {
-                        let (a, r) = (f64::from(ob.data[i * 3 + c]), f64::from(sb.data[i * 3 + c]));
-                        per[m].0 += (a - r) * (a - r);
-                        per[m].1 += r;
-                        per[m].2 += 1;
-                    }
-                }
-            }
-            let total: f64 = per.iter().map(|p| p.0).sum();
-            let line: Vec<String> = per
-                .iter()
-                .enumerate()
-                .filter(|(_, p)| p.2 > 0)
-                .map(|(k, p)| {
-                    format!(
-                        "{} {:.1} % ({} blocks, {:.0} % of the squared error)",
-                        names.get(k).map_or("none", String::as_str),
-                        100.0 * (p.0 / p.2 as f64).sqrt() / (p.1 / p.2 as f64),
-                        p.2 / 3,
-                        100.0 * p.0 / total
-                    )
-                })
-                .collect();
-            println!("  relit by material: {}", line.join("; "));
-        }
+        println!("  relit by material: {}", by_material(&room, &camera, &ours, &sim));
         if env("ASCII", 0) == 1 {
             // Per 4×4 block, relit / simulator − 1 in tens of per cent (channel sum).
             for y in 0..sb.height {
@@ -233,5 +189,181 @@ fn main() {
             "  relit with each surface's recovered ρd instead of the albedo maps: {:.2} %",
             100.0 * relative_rmse(&flat_b, &sb, keep).unwrap_or(f64::NAN)
         );
+        if env("BUDGET", 0) == 1 {
+            let conv = env("CONV_SPP", 512) as u32;
+            let e = |a: &campanile_process::camera::image::RadianceImage,
+                     r: &campanile_process::camera::image::RadianceImage| {
+                100.0 * relit_block_error(a, r).unwrap_or(f64::NAN)
+            };
+            let t = Instant::now();
+            let reference = room.photograph(
+                &new_lamps,
+                &[],
+                &camera,
+                &PhotoSettings {
+                    indirect_samples: conv,
+                    max_bounces: b,
+                    seed: 4242,
+                },
+            );
+            let conv_rs = RelightSettings {
+                indirect_samples: conv,
+                seed: 77,
+                ..rs
+            };
+            let ours_conv = relight(&scene, Some(&map), &lights, &camera, &conv_rs);
+            let same_conv = relight(room.scene(), None, &lights, &camera, &conv_rs);
+            println!(
+                "  budget: converged renders ({conv} paths per pixel) {:.1} s",
+                t.elapsed().as_secs_f64()
+            );
+            let t = Instant::now();
+            let input_conv = room.igi_input(
+                cams.clone(),
+                &PhotoSettings {
+                    indirect_samples: env("PHOTO_CONV", 256) as u32,
+                    max_bounces: b,
+                    seed: 7,
+                },
+            );
+            let map_pc = AlbedoMap::build(&input_conv, &result, &map_options).unwrap();
+            let irr = AlbedoMapOptions {
+                irradiance_rays: env("IRR_CONV", 1024) as u32,
+                ..map_options
+            };
+            let map_ic = AlbedoMap::build(&input, &result, &irr).unwrap();
+            let map_both = AlbedoMap::build(&input_conv, &result, &irr).unwrap();
+            println!(
+                "  budget: converged photographs and maps {:.1} s",
+                t.elapsed().as_secs_f64()
+            );
+            let r_pc = relight(&scene, Some(&map_pc), &lights, &camera, &conv_rs);
+            let r_ic = relight(&scene, Some(&map_ic), &lights, &camera, &conv_rs);
+            let r_both = relight(&scene, Some(&map_both), &lights, &camera, &conv_rs);
+            let r_flat = relight(&scene, None, &lights, &camera, &conv_rs);
+            // The true BRDFs in place of the recovered ones (ρd the true
+            // texture's mean): what of (e) the parameters carry.
+            let mut true_result = result.clone();
+            for (r, t) in true_result.surfaces.iter_mut().zip(&truth) {
+                r.material = Some(*t);
+            }
+            let true_scene = recovered_scene(&input, &true_result).unwrap();
+            let map_true = AlbedoMap::build(&input_conv, &true_result, &irr).unwrap();
+            let r_true = relight(&true_scene, Some(&map_true), &lights, &camera, &conv_rs);
+            for (name, m) in [
+                ("photos converged", &map_pc),
+                ("irradiance converged", &map_ic),
+                ("both converged", &map_both),
+            ] {
+                for surface in ["paint", "paper", "wood"] {
+                    let s = input.surfaces.iter().position(|n| n == surface).unwrap();
+                    println!(
+                        "    map ({name}) {surface}: median error {:.2} %, texture correlation {:.3}",
+                        100.0 * room.albedo_map_error(m, s).0,
+                        room.albedo_map_texture_correlation(m, s)
+                    );
+                }
+            }
+            println!("  budget (RMSE per 4x4 block, %):");
+            println!(
+                "    total, relit vs reference as tested          {:6.2}",
+                e(&ours, &sim)
+            );
+            println!(
+                "    total, relit vs converged reference          {:6.2}",
+                e(&ours, &reference)
+            );
+            println!(
+                "    (a) reference noise: reference vs converged  {:6.2}",
+                e(&sim, &reference)
+            );
+            println!(
+                "    (b) relit render noise: relit vs converged   {:6.2}",
+                e(&ours, &ours_conv)
+            );
+            println!(
+                "    (c) maps from photos: map vs photos-converged map (converged renders) {:6.2}",
+                e(&ours_conv, &r_pc)
+            );
+            println!(
+                "    (d) maps' irradiance: map vs irradiance-converged map              {:6.2}",
+                e(&ours_conv, &r_ic)
+            );
+            println!(
+                "    (e) bias: converged maps and renders vs converged reference        {:6.2}",
+                e(&r_both, &reference)
+            );
+            println!(
+                "        by material (%): {}",
+                by_material(&room, &camera, &r_both, &reference)
+            );
+            println!(
+                "        the same with the true BRDFs (maps from converged photographs)  {:6.2}",
+                e(&r_true, &reference)
+            );
+            println!(
+                "        by material (%): {}",
+                by_material(&room, &camera, &r_true, &reference)
+            );
+            println!(
+                "        same renderer, true materials, vs converged reference          {:6.2}",
+                e(&same_conv, &reference)
+            );
+            println!(
+                "        recovered ρd per surface (no maps), vs converged reference     {:6.2}",
+                e(&r_flat, &reference)
+            );
+            println!(
+                "        converged renders, the map as built, vs converged reference    {:6.2}",
+                e(&ours_conv, &reference)
+            );
+        }
     }
+}
+
+/// The relit error by the material a block's centre ray meets: per
+/// material, the relative RMSE of `image`'s 4×4-block means against
+/// `reference`'s, the blocks, and the share of the squared error (blocks
+/// with a bulb left out).
+fn by_material(room: &RoomIgi, camera: &ViewCamera, image: &RadianceImage, reference: &RadianceImage) -> String {
+    let (ib, rb) = (block_average(image, 4), block_average(reference, 4));
+    let names = room.material_names();
+    let mut per = vec![(0.0f64, 0.0f64, 0usize); names.len() + 1];
+    for y in 0..rb.height {
+        for x in 0..rb.width {
+            let i = y * rb.width + x;
+            if rb.data[i * 3] >= 20.0 {
+                continue;
+            }
+            let ray = campanile_process::render::Ray {
+                origin: camera.position,
+                direction: camera.direction(x as f64 * 4.0 + 2.0, y as f64 * 4.0 + 2.0),
+            };
+            let m = room
+                .scene()
+                .intersect(&ray, f64::INFINITY)
+                .map_or(names.len(), |h| room.scene().triangles()[h.triangle].material as usize);
+            for c in 0..3 {
+                let (a, r) = (f64::from(ib.data[i * 3 + c]), f64::from(rb.data[i * 3 + c]));
+                per[m].0 += (a - r) * (a - r);
+                per[m].1 += r;
+                per[m].2 += 1;
+            }
+        }
+    }
+    let total: f64 = per.iter().map(|p| p.0).sum();
+    per.iter()
+        .enumerate()
+        .filter(|(_, p)| p.2 > 0)
+        .map(|(k, p)| {
+            format!(
+                "{} {:.1} % ({} blocks, {:.0} % of the squared error)",
+                names.get(k).map_or("none", String::as_str),
+                100.0 * (p.0 / p.2 as f64).sqrt() / (p.1 / p.2 as f64),
+                p.2 / 3,
+                100.0 * p.0 / total
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }

@@ -9,16 +9,12 @@ use campanile_process::igi::light_triangulation::{BulbImage, triangulate};
 use campanile_process::igi::relight::{RelightSettings, relative_rmse, relight};
 use campanile_process::igi::relit_scene::recovered_scene;
 use campanile_process::igi::table::errors;
-use campanile_process::igi::{IgiLight, IgiOptions, SurfaceModel, ViewCamera, format_table, recover};
-use campanile_process::render::SphereLight;
-use campanile_sim::world::examples_dir;
+use campanile_process::igi::{IgiOptions, SurfaceModel, ViewCamera, format_table, recover};
 use campanile_sim::world::igi_photograph::PhotoSettings;
-use campanile_sim::world::room_igi::{CEILING_ELEVATION_DEG, ROOM_BOUNCES, RoomIgi, block_average};
-use nalgebra::Vector3;
+use campanile_sim::world::room_igi::{ROOM_BOUNCES, RoomIgi, igi_lights_of, new_lamps, relit_block_error};
 
 fn room() -> RoomIgi {
-    let station = campanile_config::document::load_station(&examples_dir().join("sim-station.ron")).unwrap();
-    RoomIgi::load(&examples_dir().join("room-scene.ron"), &station.value).unwrap()
+    RoomIgi::example().unwrap()
 }
 
 #[test]
@@ -83,9 +79,7 @@ fn the_lamps_are_triangulated_from_their_bulbs() {
 #[test]
 fn the_room_is_recovered_and_relit_under_new_lamps() {
     let room = room();
-    let mut cams = room.cameras(60.0, 80, 60);
-    cams.extend(room.highlight_cameras(20.0, 40));
-    cams.extend(room.ceiling_cameras(CEILING_ELEVATION_DEG, 60.0, 80, 60));
+    let cams = room.solver_cameras(80, 60);
     let settings = PhotoSettings {
         indirect_samples: 16,
         max_bounces: ROOM_BOUNCES,
@@ -159,55 +153,66 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
     let map = AlbedoMap::build(
         &input,
         &result,
+        // Indirect irradiance on a 12.5 cm lattice, 64 rays per node: the
+        // lattice's interpolation error outweighs its nodes' noise (25 cm
+        // with 256 rays: relit 3.72 %; 12.5 cm with 64: 3.44 % at half the
+        // cost; 10 cm with 128: 3.09 % at four times it; BENCHMARKS.md).
         &AlbedoMapOptions {
             irradiance_rays: 64,
+            irradiance_cell_m: 0.125,
             ..AlbedoMapOptions::default()
         },
     )
     .unwrap();
     // Albedo maps against the true textures: median relative error over
-    // the seen texels (tolerances from the measured run; see the README),
-    // and against a baseline that divides by the lamps' light only and
-    // keeps highlights (colour bleeding and interreflection stay in it).
+    // the seen texels, and against a baseline that divides by the lamps'
+    // light only and keeps highlights (colour bleeding and interreflection
+    // stay in it); the textured surfaces' pattern, by the correlation of
+    // map and truth over the texels. Measured (noise shrinkage, 12.5 cm
+    // irradiance lattice): paint 3.0 %, paper 12.1 % (correlation 0.70),
+    // wood 9.9 % (0.22: 3 cm stripes on 2 cm texels seen by pixels about
+    // 5 cm wide); before the shrinkage 11.4 / 15.3 / 20.1 % (bounds 15 / 20 / 25 %).
     let naive = AlbedoMap::build(
         &input,
         &result,
         &AlbedoMapOptions {
             indirect: false,
             remove_specular: false,
+            shrink_noise: false,
             ..AlbedoMapOptions::default()
         },
     )
     .unwrap();
-    for (surface, tol) in [("paint", 0.15), ("paper", 0.20), ("wood", 0.25)] {
+    for (surface, tol, min_correlation) in [
+        ("paint", 0.05, None),
+        ("paper", 0.16, Some(0.65)),
+        ("wood", 0.13, Some(0.18)),
+    ] {
         let s = input.surfaces.iter().position(|n| n == surface).unwrap();
         let (median, n) = room.albedo_map_error(&map, s);
         let (base, _) = room.albedo_map_error(&naive, s);
+        let correlation = room.albedo_map_texture_correlation(&map, s);
         eprintln!(
-            "albedo map {surface}: median relative error {:.2} % over {n} texels; baseline {:.2} %",
+            "albedo map {surface}: median relative error {:.2} % over {n} texels; baseline {:.2} %; texture correlation {correlation:.3}",
             100.0 * median,
             100.0 * base
         );
         assert!(n > 500 && median < tol, "{surface}: {median} over {n} texels");
         assert!(median < base, "{surface}: {median} not below the baseline's {base}");
+        if let Some(c) = min_correlation {
+            assert!(correlation > c, "{surface}: texture correlation {correlation}");
+        }
     }
 
     let scene = recovered_scene(&input, &result).unwrap();
-    let new_lamps = [
-        SphereLight::with_intensity(Vector3::new(2.0, 2.2, 2.4), 0.05, [2.5, 2.4, 2.0]),
-        SphereLight::with_intensity(Vector3::new(3.6, 2.8, 2.0), 0.05, [1.4, 1.7, 2.3]),
-    ];
-    let lights: Vec<IgiLight> = new_lamps
-        .iter()
-        .map(|b| IgiLight {
-            position: b.center,
-            radius: b.radius,
-            intensity: b.radiance.map(|l| l * std::f64::consts::PI * b.radius * b.radius),
-        })
-        .collect();
-    let (_, camera) = room.cameras(60.0, 80, 60).swap_remove(0);
+    let new_lamps = new_lamps();
+    let lights = igi_lights_of(&new_lamps);
+    let camera = input.views[0].camera;
+    // 256 stratified paths per pixel in both renders, so that their Monte
+    // Carlo noise (the "floor", about 1.2 % per block together) stays well
+    // below the 3 % checked.
     let rs = RelightSettings {
-        indirect_samples: 32,
+        indirect_samples: 256,
         max_bounces: ROOM_BOUNCES,
         seed: 5,
     };
@@ -218,23 +223,23 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
         &[],
         &camera,
         &PhotoSettings {
-            indirect_samples: 32,
+            indirect_samples: 256,
             max_bounces: ROOM_BOUNCES,
             seed: 99,
         },
     );
-    let (ours_b, same_b, sim_b) = (block_average(&ours, 4), block_average(&same, 4), block_average(&sim, 4));
-    let keep = |i: usize| sim_b.data[i * 3] < 20.0;
-    let relit = relative_rmse(&ours_b, &sim_b, keep).unwrap();
-    let floor = relative_rmse(&same_b, &sim_b, keep).unwrap();
+    let relit = relit_block_error(&ours, &sim).unwrap();
+    let floor = relit_block_error(&same, &sim).unwrap();
     eprintln!(
         "relit: {:.2} % (4x4 blocks); noise floor (true materials, same renderer) {:.2} %; per pixel {:.2} %",
         100.0 * relit,
         100.0 * floor,
         100.0 * relative_rmse(&ours, &sim, |i| sim.data[i * 3] < 20.0).unwrap()
     );
-    // The renderer itself agrees with the simulator within 5 %; the relit
-    // room does not yet meet the 3 % (README: status).
-    assert!(floor < 0.05, "noise floor {floor}");
-    assert!(relit < 0.12, "relit {relit}");
+    // Measured: relit 3.44 %, floor 1.40 % (256 paths per pixel in both
+    // renders; 9.5 % and 3.8 % before, at 32 paths, 64 irradiance rays on
+    // a 25 cm lattice and without the maps' noise shrinkage). The issue's
+    // 3 % is not met yet (README: status; BENCHMARKS.md: the noise budget).
+    assert!(floor < 0.02, "noise floor {floor}");
+    assert!(relit < 0.04, "relit {relit}");
 }

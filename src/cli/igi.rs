@@ -53,12 +53,16 @@ pub fn settings(quick: bool) -> (IgiOptions, AlbedoMapOptions, RelightSettings) 
         iterations: if quick { 3 } else { 4 },
         ..IgiOptions::default()
     };
+    // Stratified rays and paths (igi::lamp_paths): the maps' irradiance and
+    // the relit image's noise well below the relit error (BENCHMARKS.md,
+    // the room's noise budget).
     let map = AlbedoMapOptions {
-        irradiance_rays: if quick { 32 } else { 64 },
+        irradiance_rays: if quick { 64 } else { 128 },
+        irradiance_cell_m: 0.125,
         ..AlbedoMapOptions::default()
     };
     let relight = RelightSettings {
-        indirect_samples: if quick { 16 } else { 32 },
+        indirect_samples: if quick { 64 } else { 256 },
         ..RelightSettings::default()
     };
     (igi, map, relight)

@@ -20,24 +20,29 @@
 //!
 //! and where a texel has three or more samples the brightest is dropped
 //! (§4.6: "the brightest sample ... is likely to contain a highlight").
+//! The views' disagreement on each texel then measures the photographs'
+//! noise, and each surface's texels are shrunk toward its mean by the
+//! share of their variation that is texture (`shrink_noise`).
 //!
 //! The map is a grid of square texels per triangle over its planar texture
 //! coordinates (metres); a texel no view saw takes the mean of its seen
 //! neighbours within [`FILL_RADIUS`] texels, else its surface's recovered ρd.
 
 use nalgebra::Vector3;
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
 use super::error::IgiError;
 use super::input::IgiInput;
+use super::lamp_paths::path_radiance;
 use super::recover::IgiResult;
 use super::relit_scene::{point_lights, recovered_scene, seen_sides};
 use super::specular_albedo::SpecularAlbedo;
+use super::stratified::Strata;
 use crate::brdf::ShadingFrame;
 use crate::render::surface_bsdf::SurfaceBsdf;
-use crate::render::{Lighting, Material, PointLight, Ray, Scene, Texture, Triangle, trace};
+use crate::render::{Material, PointLight, Ray, Scene, Texture, Triangle};
 
 /// Texels searched around an unseen texel for seen ones.
 pub const FILL_RADIUS: i64 = 3;
@@ -66,6 +71,10 @@ pub struct AlbedoMapOptions {
     /// Remove the recovered specular reflection, weight by diffuse share
     /// and drop the brightest sample (false: leaves highlights in; a baseline).
     pub remove_specular: bool,
+    /// Shrink each texel toward its surface's mean by the share of the
+    /// texels' variation that is texture rather than the photographs'
+    /// noise ([`shrink_noise`]; false: the raw per-texel means).
+    pub shrink_noise: bool,
 }
 
 impl Default for AlbedoMapOptions {
@@ -79,6 +88,7 @@ impl Default for AlbedoMapOptions {
             seed: 3,
             indirect: true,
             remove_specular: true,
+            shrink_noise: true,
         }
     }
 }
@@ -338,7 +348,9 @@ impl AlbedoMap {
         }
         let mut used = 0usize;
         let mut dropped = 0usize;
-        for (grid, samples) in triangles.iter_mut().zip(per_triangle.iter_mut()) {
+        // Per texel: (triangle, texel, Σw, Σw², the weighted scatter Σw(x − m)² per channel).
+        let mut spread: Vec<(usize, usize, f64, f64, [f64; 3])> = Vec::new();
+        for (t, (grid, samples)) in triangles.iter_mut().zip(per_triangle.iter_mut()).enumerate() {
             samples.sort_by(|a, b| a.texel.cmp(&b.texel).then(b.brightness.total_cmp(&a.brightness)));
             let mut k = 0;
             while k < samples.len() {
@@ -351,20 +363,33 @@ impl AlbedoMap {
                 } else {
                     k
                 };
-                let (mut sum, mut w) = ([0.0; 3], 0.0);
+                let (mut sum, mut w, mut w2) = ([0.0; 3], 0.0, 0.0);
                 for s in &samples[start..end] {
                     for c in 0..3 {
                         sum[c] += s.weight * s.albedo[c];
                     }
                     w += s.weight;
+                    w2 += s.weight * s.weight;
                 }
                 used += end - start;
                 if w > 0.0 {
-                    grid.albedo[texel] = sum.map(|v| (v / w) as f32);
+                    let mean = sum.map(|v| v / w);
+                    let mut scatter = [0.0; 3];
+                    for s in &samples[start..end] {
+                        for c in 0..3 {
+                            scatter[c] += s.weight * (s.albedo[c] - mean[c]).powi(2);
+                        }
+                    }
+                    grid.albedo[texel] = mean.map(|v| v as f32);
                     grid.weight[texel] = w as f32;
+                    spread.push((t, texel, w, w2, scatter));
                 }
                 k = end;
             }
+        }
+        if options.shrink_noise {
+            let material: Vec<usize> = scene.triangles().iter().map(|t| t.material as usize).collect();
+            shrink_noise(&mut triangles, &spread, &material, input.surfaces.len());
         }
         Ok(AlbedoMap {
             texel_m: options.texel_m,
@@ -457,11 +482,6 @@ impl IndirectField {
         sides: &[Vector3<f64>],
         options: &AlbedoMapOptions,
     ) -> IndirectField {
-        let lighting = Lighting {
-            sky: None,
-            points,
-            spheres: &[],
-        };
         let nodes = scene
             .triangles()
             .par_iter()
@@ -483,7 +503,7 @@ impl IndirectField {
                         let third = 1.0 / 3.0;
                         let (u, v) = (third + (u - third) * 0.999, third + (v - third) * 0.999);
                         let p = tri.point(u, v);
-                        values.push(irradiance(scene, &lighting, &p, side, options, &mut rng));
+                        values.push(irradiance(scene, points, &p, side, options, &mut rng));
                     }
                 }
                 (n, values)
@@ -541,10 +561,12 @@ impl IndirectField {
 
 /// Indirect irradiance at `p` facing `normal`: π times the mean radiance
 /// of cosine-distributed paths (direct light at their first hit counts,
-/// the lamps themselves do not).
+/// the lamps themselves do not), their directions stratified
+/// ([`super::stratified`]) and each continued by
+/// [`super::lamp_paths::path_radiance`] (Russian roulette).
 fn irradiance(
     scene: &Scene,
-    lighting: &Lighting,
+    points: &[PointLight],
     p: &Vector3<f64>,
     normal: &Vector3<f64>,
     options: &AlbedoMapOptions,
@@ -553,17 +575,77 @@ fn irradiance(
     let (a, b) = tangents(normal);
     let origin = p + normal * 1e-6 * (1.0 + p.norm());
     let mut sum = [0.0; 3];
-    for _ in 0..options.irradiance_rays {
-        let (u1, u2): (f64, f64) = (rng.random(), rng.random());
+    let strata = Strata::new(options.irradiance_rays, rng);
+    for k in 0..options.irradiance_rays {
+        let [u1, u2] = strata.point(k, rng);
         let r = u1.sqrt();
         let phi = std::f64::consts::TAU * u2;
         let d = (a * (r * phi.cos()) + b * (r * phi.sin()) + normal * (1.0 - u1).max(0.0).sqrt()).normalize();
-        let l = trace(scene, lighting, Ray { origin, direction: d }, options.max_bounces, rng);
+        let l = path_radiance(scene, points, Ray { origin, direction: d }, options.max_bounces, rng);
         for c in 0..3 {
             sum[c] += l[c];
         }
     }
     sum.map(|v| std::f64::consts::PI * v / f64::from(options.irradiance_rays))
+}
+
+/// Empirical-Bayes (Wiener) shrinkage of the texels of each surface,
+/// per channel: the views that see a texel disagree by the photographs'
+/// noise (and the model's view-dependent misfit), which a per-texel mean
+/// passes into the map; on the simulated room's 16-path photographs a
+/// constant paint came back with a 10 % median texel error. With `m_t` a
+/// texel's weighted mean of its samples, `μ` the surface's mean over
+/// texels, the per-sample noise variance `σ²` pooled over the surface's
+/// texels seen at least twice (`Σ w (x − m_t)²` over `Σ w − Σ w² / Σ w`),
+/// a texel's noise variance `N_t = σ² Σ w² / (Σ w)²`, and the texture's
+/// variance `S = max(var_t(m_t) − mean_t N_t, 0)`, each texel becomes
+///
+/// m_t' = μ + S / (S + N_t) · (m_t − μ),
+///
+/// the minimum-mean-square-error estimate of a texel whose texture and
+/// noise are independent with those variances. A surface without texture
+/// (S ≈ 0) comes back flat; a high-contrast texture (S ≫ N) is kept; the
+/// pattern's correlation with the truth is unchanged by a common factor.
+fn shrink_noise(
+    triangles: &mut [TriangleTexels],
+    spread: &[(usize, usize, f64, f64, [f64; 3])],
+    material: &[usize],
+    surfaces: usize,
+) {
+    for s in 0..surfaces {
+        let texels: Vec<&(usize, usize, f64, f64, [f64; 3])> =
+            spread.iter().filter(|e| material.get(e.0) == Some(&s)).collect();
+        if texels.len() < 16 {
+            continue;
+        }
+        for c in 0..3 {
+            let (mut scatter, mut dof) = (0.0, 0.0);
+            for (_, _, w, w2, sc) in &texels {
+                let d = w - w2 / w;
+                if d > 1e-9 * w {
+                    scatter += sc[c];
+                    dof += d;
+                }
+            }
+            if dof <= 0.0 {
+                continue;
+            }
+            let sigma2 = scatter / dof;
+            let values: Vec<f64> = texels
+                .iter()
+                .map(|(t, k, ..)| f64::from(triangles[*t].albedo[*k][c]))
+                .collect();
+            let n = values.len() as f64;
+            let mu = values.iter().sum::<f64>() / n;
+            let var = values.iter().map(|v| (v - mu).powi(2)).sum::<f64>() / (n - 1.0);
+            let noise: Vec<f64> = texels.iter().map(|(_, _, w, w2, _)| sigma2 * w2 / (w * w)).collect();
+            let signal = (var - noise.iter().sum::<f64>() / n).max(0.0);
+            for ((t, k, ..), (v, nt)) in texels.iter().zip(values.iter().zip(&noise)) {
+                let gain = if signal + nt > 0.0 { signal / (signal + nt) } else { 1.0 };
+                triangles[*t].albedo[*k][c] = (mu + gain * (v - mu)) as f32;
+            }
+        }
+    }
 }
 
 fn tangents(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {

@@ -12,7 +12,9 @@
 //!   `delta_s`: the indirect specular term (§4.5.1); `ward_fit`: golden
 //!   section / downhill simplex + linear least squares (App. A);
 //!   [`highlight`]: highlight detection (Fig. 4.4); `recover`: the ΔS loop
-//!   and model choice; `stratified`: the strata of the Monte Carlo rays.
+//!   and model choice; `stratified`: the strata of the Monte Carlo rays;
+//!   [`lamp_paths`]: light paths under point lamps (relighting, albedo
+//!   maps, the simulator's photographs).
 //!
 //! Ward normalization: the solver fits the lobe in the variant
 //! [`IgiOptions::variant`] names, by default
@@ -28,6 +30,7 @@ mod error;
 mod geometry;
 pub mod highlight;
 pub mod input;
+pub mod lamp_paths;
 pub mod light_triangulation;
 mod observation;
 mod radiosity;

@@ -3,21 +3,22 @@
 //! the diffuse albedo comes from the [`AlbedoMap`] and the specular lobe
 //! from the recovered material; the lamps' light there is exact
 //! (shadow-tested), and the light from other surfaces is estimated by
-//! `indirect_samples` BRDF-sampled paths through the recovered scene
-//! (constant ρd per surface). A bulb in view shows its radiance
+//! `indirect_samples` stratified BRDF-sampled paths through the recovered
+//! scene (constant ρd per surface), with Russian roulette
+//! ([`super::lamp_paths`], the path loop the simulator's photographs use). A bulb in view shows its radiance
 //! I / (π r²).
 
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
 use super::albedo_map::{AlbedoMap, sphere_hit};
 use super::camera::ViewCamera;
 use super::input::IgiLight;
+use super::lamp_paths::{PathVertex, surface_radiance};
 use super::relit_scene::point_lights;
 use crate::camera::image::RadianceImage;
-use crate::render::surface_bsdf::SurfaceBsdf;
-use crate::render::{Lighting, Material, Ray, Scene, Texture, trace};
+use crate::render::{Material, PointLight, Ray, Scene, Texture};
 
 /// Noise against time.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -53,11 +54,6 @@ pub fn relight(
     settings: &RelightSettings,
 ) -> RadianceImage {
     let points = point_lights(lights);
-    let lighting = Lighting {
-        sky: None,
-        points: &points,
-        spheres: &[],
-    };
     let (w, h) = (camera.width, camera.height);
     let mut data = vec![0f32; w * h * 3];
     data.par_chunks_mut(w * 3).enumerate().for_each(|(y, row)| {
@@ -68,7 +64,7 @@ pub fn relight(
                 origin: camera.position,
                 direction: camera.direction(x as f64 + 0.5, y as f64 + 0.5),
             };
-            let l = pixel(scene, albedo, lights, &lighting, &ray, settings, &mut rng);
+            let l = pixel(scene, albedo, lights, &points, &ray, settings, &mut rng);
             for c in 0..3 {
                 row[x * 3 + c] = l[c] as f32;
             }
@@ -85,7 +81,7 @@ fn pixel(
     scene: &Scene,
     albedo: Option<&AlbedoMap>,
     lights: &[IgiLight],
-    lighting: &Lighting,
+    points: &[PointLight],
     ray: &Ray,
     settings: &RelightSettings,
     rng: &mut ChaCha8Rng,
@@ -112,57 +108,14 @@ fn pixel(
         },
         None => base.clone(),
     };
-    let wo = -ray.direction;
-    let normal = if tri.normal.dot(&wo) >= 0.0 {
-        tri.normal
-    } else {
-        -tri.normal
-    };
-    let bsdf = SurfaceBsdf::at(&material, tri, &hit.point, normal);
-    let origin = hit.point + normal * 1e-6 * (1.0 + hit.point.norm());
-    let mut l = [0.0; 3];
-    for light in lighting.points {
-        let to = light.position - origin;
-        let d2 = to.norm_squared();
-        let wi = to / d2.sqrt();
-        let cos = wi.dot(&normal);
-        if cos > 0.0 && !scene.occluded(&Ray { origin, direction: wi }, d2.sqrt()) {
-            let f = bsdf.eval(&wi, &wo);
-            for c in 0..3 {
-                l[c] += f[c] * light.intensity[c] * cos / d2;
-            }
-        }
-    }
-    if settings.max_bounces < 2 || settings.indirect_samples == 0 {
-        return l;
-    }
-    let mut sum = [0.0; 3];
-    for _ in 0..settings.indirect_samples {
-        let Some(s) = bsdf.sample(&wo, [rng.random(), rng.random(), rng.random()]) else {
-            continue;
-        };
-        let cos = s.direction.dot(&normal);
-        if cos <= 0.0 || s.pdf <= 0.0 {
-            continue;
-        }
-        let li = trace(
-            scene,
-            lighting,
-            Ray {
-                origin,
-                direction: s.direction,
-            },
-            settings.max_bounces - 1,
-            rng,
-        );
-        for c in 0..3 {
-            sum[c] += s.value[c] * cos / s.pdf * li[c];
-        }
-    }
-    for c in 0..3 {
-        l[c] += sum[c] / f64::from(settings.indirect_samples);
-    }
-    l
+    let v = PathVertex::at(&material, tri, &hit.point, -ray.direction);
+    surface_radiance(
+        scene,
+        points,
+        &v,
+        (settings.indirect_samples, settings.max_bounces, true),
+        rng,
+    )
 }
 
 /// Relative root-mean-square difference of `a` from `reference` over the

@@ -6,12 +6,12 @@
 //! solver evaluates its model along the same ray). There, the light
 //! arriving straight from each lamp is reflected through the true BRDF
 //! (shadow-tested, no noise); the light arriving from other surfaces is
-//! estimated by `indirect_samples` BRDF-sampled rays, each continued as a
-//! path for up to `max_bounces − 1` further scattering events, with next-
-//! event estimation to every lamp at each vertex (as the renderer's
-//! `process::render::trace` does) and Russian roulette from the second
-//! vertex on (survival probability the path's largest throughput, capped
-//! at 1; unbiased, and the deep bounces of a dim room then cost little).
+//! estimated by `indirect_samples` independent BRDF-sampled rays, each
+//! continued as a path for up to `max_bounces − 1` further scattering
+//! events, with next-event estimation to every lamp at each vertex and
+//! Russian roulette from the second vertex on: the path loop of
+//! [`campanile_process::igi::lamp_paths`], which the relighting renderer
+//! shares (unbiased, and the deep bounces of a dim room then cost little).
 //! A bulb (sphere light) seen
 //! by the camera shows its emitted radiance; its light on surfaces is that
 //! of a point at its centre with the same intensity (exact for irradiance
@@ -19,10 +19,9 @@
 
 use campanile_process::camera::image::RadianceImage;
 use campanile_process::igi::ViewCamera;
-use campanile_process::render::surface_bsdf::SurfaceBsdf;
+use campanile_process::igi::lamp_paths::{PathVertex, surface_radiance};
 use campanile_process::render::{PointLight, Ray, Scene, SphereLight};
-use nalgebra::Vector3;
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
@@ -125,134 +124,13 @@ fn pixel(
     };
     let tri = &scene.triangles()[hit.triangle];
     let material = &scene.materials()[tri.material as usize];
-    let wo = -ray.direction;
-    let normal = if tri.normal.dot(&wo) >= 0.0 {
-        tri.normal
-    } else {
-        -tri.normal
-    };
-    let bsdf = SurfaceBsdf::at(material, tri, &hit.point, normal);
-    let origin = hit.point + normal * 1e-6 * (1.0 + hit.point.norm());
-    let mut l = material.emission;
-    add_direct(scene, points, &bsdf, &origin, &normal, &wo, &[1.0; 3], &mut l);
-    if settings.max_bounces < 2 || settings.indirect_samples == 0 {
-        return l;
-    }
-    let n = settings.indirect_samples;
-    let mut sum = [0.0; 3];
-    for _ in 0..n {
-        let Some(s) = bsdf.sample(&wo, [rng.random(), rng.random(), rng.random()]) else {
-            continue;
-        };
-        let cos = s.direction.dot(&normal);
-        if cos <= 0.0 || s.pdf <= 0.0 {
-            continue;
-        }
-        let li = continue_path(
-            scene,
-            points,
-            Ray {
-                origin,
-                direction: s.direction,
-            },
-            settings.max_bounces - 1,
-            rng,
-        );
-        for c in 0..3 {
-            sum[c] += s.value[c] * cos / s.pdf * li[c];
-        }
-    }
-    for c in 0..3 {
-        l[c] += sum[c] / f64::from(n);
-    }
-    l
-}
-
-/// Adds the light of every point lamp reflected by `bsdf` at `origin`
-/// toward `wo` (shadow-tested), times `beta`, to `radiance`.
-#[allow(clippy::too_many_arguments)]
-fn add_direct(
-    scene: &Scene,
-    points: &[PointLight],
-    bsdf: &SurfaceBsdf,
-    origin: &Vector3<f64>,
-    normal: &Vector3<f64>,
-    wo: &Vector3<f64>,
-    beta: &[f64; 3],
-    radiance: &mut [f64; 3],
-) {
-    for light in points {
-        let to = light.position - origin;
-        let d2 = to.norm_squared();
-        let wi = to / d2.sqrt();
-        let cos = wi.dot(normal);
-        if cos > 0.0
-            && !scene.occluded(
-                &Ray {
-                    origin: *origin,
-                    direction: wi,
-                },
-                d2.sqrt(),
-            )
-        {
-            let f = bsdf.eval(&wi, wo);
-            for c in 0..3 {
-                radiance[c] += beta[c] * f[c] * light.intensity[c] * cos / d2;
-            }
-        }
-    }
-}
-
-/// The radiance arriving along `ray` (module doc): up to `events`
-/// scattering events, each with next-event estimation to every lamp, and
-/// Russian roulette after the first.
-fn continue_path(scene: &Scene, points: &[PointLight], ray: Ray, events: u32, rng: &mut ChaCha8Rng) -> [f64; 3] {
-    let mut radiance = [0.0; 3];
-    let mut beta = [1.0; 3];
-    let mut ray = ray;
-    for event in 0..=events {
-        let Some(hit) = scene.intersect(&ray, f64::INFINITY) else {
-            break;
-        };
-        let tri = &scene.triangles()[hit.triangle];
-        let material = &scene.materials()[tri.material as usize];
-        for c in 0..3 {
-            radiance[c] += beta[c] * material.emission[c];
-        }
-        if event == events {
-            break;
-        }
-        let wo = -ray.direction;
-        let normal = if tri.normal.dot(&wo) >= 0.0 {
-            tri.normal
-        } else {
-            -tri.normal
-        };
-        let bsdf = SurfaceBsdf::at(material, tri, &hit.point, normal);
-        let origin = hit.point + normal * 1e-6 * (1.0 + hit.point.norm());
-        add_direct(scene, points, &bsdf, &origin, &normal, &wo, &beta, &mut radiance);
-        let Some(s) = bsdf.sample(&wo, [rng.random(), rng.random(), rng.random()]) else {
-            break;
-        };
-        let cos = s.direction.dot(&normal);
-        if cos <= 0.0 || s.pdf <= 0.0 {
-            break;
-        }
-        for (b, f) in beta.iter_mut().zip(s.value) {
-            *b *= f * cos / s.pdf;
-        }
-        if event >= 1 {
-            // NaN-safe: a throughput that is not positive ends the path.
-            let survive = beta.iter().copied().fold(0.0, f64::max).min(1.0);
-            if survive.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || rng.random::<f64>() >= survive {
-                break;
-            }
-            beta = beta.map(|b| b / survive);
-        }
-        ray = Ray {
-            origin,
-            direction: s.direction,
-        };
-    }
-    radiance
+    let v = PathVertex::at(material, tri, &hit.point, -ray.direction);
+    let l = surface_radiance(
+        scene,
+        points,
+        &v,
+        (settings.indirect_samples, settings.max_bounces, false),
+        rng,
+    );
+    [0, 1, 2].map(|c| material.emission[c] + l[c])
 }

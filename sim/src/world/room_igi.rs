@@ -66,6 +66,32 @@ impl RoomIgi {
         Ok(RoomIgi { loaded, lamps })
     }
 
+    /// The example room: `examples/room-scene.ron` lit by the lamps of
+    /// `examples/sim-station.ron`.
+    pub fn example() -> Result<RoomIgi, WorldError> {
+        let path = super::scene_file::examples_dir().join("sim-station.ron");
+        let station = campanile_config::document::load_station(&path).map_err(|e| WorldError::Config {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
+        RoomIgi::load(
+            &super::scene_file::examples_dir().join("room-scene.ron"),
+            &station.value,
+        )
+    }
+
+    /// The solver's views of the room used by the test, the budget example
+    /// and the helper's runs: a wide view at each scene pose (60°,
+    /// `width` × `height`), the highlight views (20°, `width / 2` square)
+    /// and the ceiling views (60° at [`CEILING_ELEVATION_DEG`]). The first
+    /// is the wide view `wide-sw`, the relighting check's camera.
+    pub fn solver_cameras(&self, width: usize, height: usize) -> Vec<(String, ViewCamera)> {
+        let mut cams = self.cameras(60.0, width, height);
+        cams.extend(self.highlight_cameras(20.0, width / 2));
+        cams.extend(self.ceiling_cameras(CEILING_ELEVATION_DEG, 60.0, width, height));
+        cams
+    }
+
     /// The render scene with the true materials.
     pub fn scene(&self) -> &Scene {
         &self.loaded.scene
@@ -145,14 +171,8 @@ impl RoomIgi {
 
     /// The lamps as the solver takes them (true positions, radii, intensities).
     pub fn igi_lights(&self) -> Vec<IgiLight> {
-        self.lamps
-            .iter()
-            .map(|(_, b)| IgiLight {
-                position: b.center,
-                radius: b.radius,
-                intensity: b.radiance.map(|l| l * std::f64::consts::PI * b.radius * b.radius),
-            })
-            .collect()
+        let bulbs: Vec<SphereLight> = self.lamps.iter().map(|(_, b)| *b).collect();
+        igi_lights_of(&bulbs)
     }
 
     /// One photograph of the room lit by `bulbs` (visible in view) and
@@ -278,6 +298,44 @@ impl RoomIgi {
     }
 }
 
+/// Pixel side of the blocks over which relit images are compared.
+pub const RELIT_BLOCK_PX: usize = 4;
+
+/// Two lamps that no capture of the room uses (the relighting check):
+/// warm at (2.0, 2.2, 2.4) m, cool at (3.6, 2.8, 2.0) m, both 5 cm bulbs.
+pub fn new_lamps() -> [SphereLight; 2] {
+    [
+        SphereLight::with_intensity(Vector3::new(2.0, 2.2, 2.4), 0.05, [2.5, 2.4, 2.0]),
+        SphereLight::with_intensity(Vector3::new(3.6, 2.8, 2.0), 0.05, [1.4, 1.7, 2.3]),
+    ]
+}
+
+/// `bulbs` as the solver's and the relighting renderer's lights (the same
+/// position, radius and radiant intensity).
+pub fn igi_lights_of(bulbs: &[SphereLight]) -> Vec<IgiLight> {
+    bulbs
+        .iter()
+        .map(|b| IgiLight {
+            position: b.center,
+            radius: b.radius,
+            intensity: b.radiance.map(|l| l * std::f64::consts::PI * b.radius * b.radius),
+        })
+        .collect()
+}
+
+/// The relit check's error of `image` against `reference`: the relative
+/// RMSE ([`campanile_process::igi::relight::relative_rmse`]) of their
+/// [`RELIT_BLOCK_PX`]-pixel block means, over the blocks whose reference
+/// red is below 20 W sr⁻¹ m⁻² (no bulb in them); `None` when no block
+/// counts or the sizes differ.
+pub fn relit_block_error(image: &RadianceImage, reference: &RadianceImage) -> Option<f64> {
+    let (a, r) = (
+        block_average(image, RELIT_BLOCK_PX),
+        block_average(reference, RELIT_BLOCK_PX),
+    );
+    campanile_process::igi::relight::relative_rmse(&a, &r, |i| r.data[i * 3] < 20.0)
+}
+
 /// `image` averaged over `k × k` pixel blocks (a partial block at the edge
 /// is dropped): comparisons of path-traced images at the scale where
 /// their Monte Carlo noise has averaged out.
@@ -343,10 +401,52 @@ impl RoomIgi {
         map: &campanile_process::igi::albedo_map::AlbedoMap,
         surface: usize,
     ) -> Vec<f64> {
+        self.albedo_map_pairs(map, surface)
+            .into_iter()
+            .map(|(got, want)| got / want - 1.0)
+            .collect()
+    }
+
+    /// Whether the albedo map keeps the true texture on solver surface
+    /// `surface`: the Pearson correlation over seen texels between the
+    /// map's and the true texture's mean over channels (1: the texture's
+    /// pattern kept up to a scale; `NaN` for a texture without variation,
+    /// or fewer than two texels).
+    pub fn albedo_map_texture_correlation(
+        &self,
+        map: &campanile_process::igi::albedo_map::AlbedoMap,
+        surface: usize,
+    ) -> f64 {
+        let pairs = self.albedo_map_pairs(map, surface);
+        let n = pairs.len() as f64;
+        if pairs.len() < 2 {
+            return f64::NAN;
+        }
+        let (ma, mb) = (
+            pairs.iter().map(|p| p.0).sum::<f64>() / n,
+            pairs.iter().map(|p| p.1).sum::<f64>() / n,
+        );
+        let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+        for (a, b) in &pairs {
+            sab += (a - ma) * (b - mb);
+            saa += (a - ma) * (a - ma);
+            sbb += (b - mb) * (b - mb);
+        }
+        // A constant texture's f32 round-off is no variation.
+        if saa > 0.0 && sbb > 1e-9 * n * mb * mb {
+            sab / (saa * sbb).sqrt()
+        } else {
+            f64::NAN
+        }
+    }
+
+    /// Per seen texel of solver surface `surface`: the map's and the true
+    /// texture's albedo (at the texel centre), each the mean over channels.
+    fn albedo_map_pairs(&self, map: &campanile_process::igi::albedo_map::AlbedoMap, surface: usize) -> Vec<(f64, f64)> {
         let Some(appearance) = self.loaded.appearances.get(surface) else {
             return Vec::new();
         };
-        let mut errs = Vec::new();
+        let mut out = Vec::new();
         for (tri, texels) in self.loaded.scene.triangles().iter().zip(&map.triangles) {
             if tri.material as usize != surface {
                 continue;
@@ -362,13 +462,13 @@ impl RoomIgi {
                         texels.origin[1] + (j as f64 + 0.5) * map.texel_m,
                     ];
                     let t = appearance.albedo.albedo(st);
-                    let got: f64 = texels.albedo[k].iter().map(|v| f64::from(*v)).sum::<f64>();
-                    let want: f64 = t.iter().sum();
-                    errs.push(got / want - 1.0);
+                    let got: f64 = texels.albedo[k].iter().map(|v| f64::from(*v)).sum::<f64>() / 3.0;
+                    let want: f64 = t.iter().sum::<f64>() / 3.0;
+                    out.push((got, want));
                 }
             }
         }
-        errs
+        out
     }
 }
 

@@ -11,15 +11,12 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Result, anyhow};
-use campanile_process::igi::relight::relative_rmse;
+use campanile_process::igi::format_table;
 use campanile_process::igi::table::errors;
-use campanile_process::igi::{IgiLight, format_table};
-use campanile_process::render::SphereLight;
 use campanile_process::report::{Figure, Section, Table, false_colour_png, tonemapped_png};
 use campanile_sim::world::examples_dir;
 use campanile_sim::world::igi_photograph::PhotoSettings;
-use campanile_sim::world::room_igi::{ROOM_BOUNCES, RoomIgi, block_average};
-use nalgebra::Vector3;
+use campanile_sim::world::room_igi::{ROOM_BOUNCES, RoomIgi, igi_lights_of, new_lamps, relit_block_error};
 
 use crate::cli::igi::{write_albedo_maps, write_exr};
 use crate::cli::process;
@@ -45,14 +42,6 @@ pub struct RoomRun {
     pub recover_s: f64,
     /// See `photograph_s`.
     pub relight_s: f64,
-}
-
-/// The lamps of the relit image (not in the capture).
-pub fn new_lamps() -> [SphereLight; 2] {
-    [
-        SphereLight::with_intensity(Vector3::new(2.0, 2.2, 2.4), 0.05, [2.5, 2.4, 2.0]),
-        SphereLight::with_intensity(Vector3::new(3.6, 2.8, 2.0), 0.05, [1.4, 1.7, 2.3]),
-    ]
 }
 
 fn rel(got: f64, truth: f64) -> f64 {
@@ -186,14 +175,7 @@ pub fn room(dir: &Path, quick: bool) -> Result<RoomRun> {
 
     // Relit under new lamps, beside the simulator.
     let bulbs = new_lamps();
-    let lights: Vec<IgiLight> = bulbs
-        .iter()
-        .map(|b| IgiLight {
-            position: b.center,
-            radius: b.radius,
-            intensity: b.radiance.map(|l| l * std::f64::consts::PI * b.radius * b.radius),
-        })
-        .collect();
+    let lights = igi_lights_of(&bulbs);
     let t = Instant::now();
     let relit = r.relight(&lights, RELIT_CAMERA, quick)?;
     let relight_s = t.elapsed().as_secs_f64();
@@ -203,7 +185,10 @@ pub fn room(dir: &Path, quick: bool) -> Result<RoomRun> {
         .iter()
         .find(|(n, _)| n == RELIT_CAMERA)
         .ok_or_else(|| anyhow!("no camera {RELIT_CAMERA}"))?;
-    let samples = if quick { 16 } else { 32 };
+    // The reference with as many stratified paths per pixel as the relit
+    // image (crate::cli::igi::settings), so that the two renders' noise
+    // (the floor) stays well below the relit error.
+    let samples = crate::cli::igi::settings(quick).2.indirect_samples;
     let sim = world.photograph(
         &bulbs,
         &[],
@@ -228,14 +213,8 @@ pub fn room(dir: &Path, quick: bool) -> Result<RoomRun> {
     );
     write_exr(&relit, &out.join("relit.exr"))?;
     write_exr(&sim, &out.join("simulator.exr"))?;
-    let (rb, sb, fb) = (
-        block_average(&relit, 4),
-        block_average(&sim, 4),
-        block_average(&same, 4),
-    );
-    let keep = |i: usize| sb.data[i * 3] < 20.0;
-    let relit_rmse = relative_rmse(&rb, &sb, keep).ok_or_else(|| anyhow!("the simulator's render is black"))?;
-    let noise_floor_rmse = relative_rmse(&fb, &sb, keep).ok_or_else(|| anyhow!("the simulator's render is black"))?;
+    let relit_rmse = relit_block_error(&relit, &sim).ok_or_else(|| anyhow!("the simulator's render is black"))?;
+    let noise_floor_rmse = relit_block_error(&same, &sim).ok_or_else(|| anyhow!("the simulator's render is black"))?;
     let (w, h) = (sim.width, sim.height);
     let mut sorted: Vec<f32> = sim.data.iter().copied().filter(|v| *v < 20.0).collect();
     sorted.sort_by(f32::total_cmp);
