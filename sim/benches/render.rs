@@ -85,6 +85,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         samples_per_pixel: spp,
         max_bounces: 4,
         seed,
+        ..RenderSettings::default()
     };
     for spp in [1, 4, 16, 64, 256] {
         let t0 = Instant::now();

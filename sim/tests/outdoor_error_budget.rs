@@ -21,7 +21,8 @@ use campanile_sim::world::{World, examples_dir, load_scene};
 use chrono::{DateTime, Utc};
 
 /// Photo size and samples: small, so the test stays fast (≈ 16 s in the dev
-/// profile); a 2 m cell sees ~10 pixels per photo.
+/// profile before path splitting, about twice that with its 4 branches); a
+/// 2 m cell sees ~10 pixels per photo.
 const WIDTH: usize = 128;
 const HEIGHT: usize = 96;
 const SPP: u32 = 64;
@@ -174,11 +175,14 @@ fn errors(day: &Day) -> (Vec<f64>, Vec<f64>) {
 }
 
 /// With the light known and the walls of constant albedo, what is left is
-/// the solver's own error and the photos' noise (64 samples per pixel):
-/// the pseudo-albedos of every seen cell (solved or filled) within 2%
-/// (median) and 10% (p95), both pseudo-BRDFs. Measured: ρ_se 1.75% / 8.6%,
-/// ρ_sun 1.04% / 5.6% (at 256 samples per pixel: 1.2% / 5.0% and 0.6% /
-/// 3.2%; BENCHMARKS.md, "Outdoor error budget"). Before the footprint test,
+/// the solver's own error and the photos' noise (64 samples per pixel, 4
+/// branches at the first surface): the pseudo-albedos of every seen cell
+/// (solved or filled) within 1.5% (median; issue 9 asks 2%) and 8% (p95),
+/// both pseudo-BRDFs.
+/// Measured: ρ_se 1.12% / 4.4%, ρ_sun 0.55% / 2.7% (before path splitting
+/// 1.75% / 8.6% and 1.04% / 5.6%; the old renderer at 256 samples per
+/// pixel: 1.2% / 5.0% and 0.6% / 3.2%; BENCHMARKS.md, "Outdoor error
+/// budget" and "Path splitting at the first surface"). Before the footprint test,
 /// the amplification test and the fitted-value weights: 2.5% / 46% and
 /// 1.8% / 370% at 256 samples.
 #[test]
@@ -198,15 +202,15 @@ fn with_the_light_known_pseudo_albedos_are_within_two_percent() {
         day.refl.sampling
     );
     assert!(seen >= 300, "{seen} cells seen");
-    assert!(ms <= 0.02 && mu <= 0.02, "medians ρ_se {ms}, ρ_sun {mu}");
-    assert!(ps <= 0.10 && pu <= 0.10, "p95 ρ_se {ps}, ρ_sun {pu}");
+    assert!(ms <= 0.015 && mu <= 0.015, "medians ρ_se {ms}, ρ_sun {mu}");
+    assert!(ps <= 0.08 && pu <= 0.08, "p95 ρ_se {ps}, ρ_sun {pu}");
     assert!(day.refl.photos.iter().all(|p| !p.outlier), "{:?}", day.refl.photos);
 }
 
 /// The held-out time re-rendered from those pseudo-albedos, against the
 /// simulator's photographs of three views (64 samples per pixel), per
-/// 4 × 4-pixel block (about one 2 m cell): ≤ 3% (measured 2.1%, 0.8%, 1.9%;
-/// two 64-sample renders differ by 1–2% per block).
+/// 4 × 4-pixel block (about one 2 m cell): ≤ 3% (measured 2.05%, 0.54%,
+/// 1.27%; before path splitting 2.1%, 0.8%, 1.9%).
 #[test]
 fn with_the_light_known_the_held_out_time_is_within_three_percent() {
     let day = flat_day();
@@ -230,8 +234,8 @@ fn with_the_light_known_the_held_out_time_is_within_three_percent() {
 /// A pixel straddling the tower's corner sees a sunlit and a shaded wall at
 /// once; without the footprint test the corner cells came out up to twice
 /// too bright and their ρ_sun wrong tenfold (p95 of |error| 3.7 before).
-/// The worst cell of the four walls is now within 30% (measured 24%, a
-/// cell under the belfry seen by four pixels).
+/// The worst cell of the four walls is now within 20% (measured 14%, a
+/// cell under the belfry seen by four pixels; 24% before path splitting).
 #[test]
 fn corner_cells_are_not_polluted_by_the_next_wall() {
     let day = flat_day();
@@ -258,7 +262,7 @@ fn corner_cells_are_not_polluted_by_the_next_wall() {
         day.refl.grid.cells[which].centre.as_slice(),
         day.refl.cells[which]
     );
-    assert!(worst <= 0.30, "worst wall cell {worst}");
+    assert!(worst <= 0.20, "worst wall cell {worst}");
 }
 
 fn textured_day() -> &'static Day {
@@ -267,14 +271,15 @@ fn textured_day() -> &'static Day {
 }
 
 /// The simulated day itself, brick texture and all, with the light known
-/// (64 samples per pixel): the pseudo-albedos of every seen cell against
-/// the texture averaged over each cell, and the texture kept (correlation
-/// of recovered and true cell albedos over the sunlit walls). Measured:
-/// ρ_se 2.2% median (p95 9.2%), ρ_sun 1.6% (7.1%), correlation 0.35–0.48
-/// (2 m cells average ~5 bricks of ±12%, so cell means vary by only ~3%,
-/// about the photos' noise here); at 256 samples per pixel 1.6% / 1.2%
-/// (`outdoor_budget`, line "bricks"). The 2% median of issue 9 is reached
-/// for ρ_sun here and for both at 256 samples.
+/// (64 samples per pixel, 4 branches at the first surface): the
+/// pseudo-albedos of every seen cell against the texture averaged over
+/// each cell, and the texture kept (correlation of recovered and true cell
+/// albedos over the sunlit walls). Measured: ρ_se 1.54% median (p95 5.6%),
+/// ρ_sun 1.27% (4.5%), correlation 0.53–0.61 (2 m cells average ~5 bricks
+/// of ±12%, so cell means vary by only ~3%). Before path splitting: 2.2%
+/// (9.2%), 1.6% (7.1%), correlation 0.35–0.48; the old renderer at 256
+/// samples per pixel 1.6% / 1.2% (`outdoor_budget`, line "bricks"). Issue
+/// 9's 2% median is met for both.
 #[test]
 fn the_textured_day_with_the_light_known() {
     let day = textured_day();
@@ -303,7 +308,7 @@ fn the_textured_day_with_the_light_known() {
     eprintln!(
         "textured: ρ_se median {ms:.4} p95 {ps:.4}; ρ_sun median {mu:.4} p95 {pu:.4}; texture correlation S/E/W {corr:.3?}"
     );
-    assert!(ms <= 0.025 && mu <= 0.02, "medians ρ_se {ms}, ρ_sun {mu}");
-    assert!(ps <= 0.10 && pu <= 0.10, "p95 ρ_se {ps}, ρ_sun {pu}");
-    assert!(corr.iter().all(|&r| r >= 0.3), "texture correlation {corr:?}");
+    assert!(ms <= 0.02 && mu <= 0.02, "medians ρ_se {ms}, ρ_sun {mu}");
+    assert!(ps <= 0.08 && pu <= 0.08, "p95 ρ_se {ps}, ρ_sun {pu}");
+    assert!(corr.iter().all(|&r| r >= 0.45), "texture correlation {corr:?}");
 }

@@ -7,6 +7,36 @@
 //! (next-event estimation) and only there, so BRDF-sampled rays that meet
 //! the disc or a bulb add nothing: every light path is counted once. The sky
 //! (without the disc) and emitting surfaces are found by BRDF-sampled rays.
+//!
+//! The first surface a camera ray meets (the one the pixel shows) gathers
+//! the light arriving over its hemisphere through
+//! [`RenderSettings::split_rays`] branches instead of one continuation
+//! (path splitting; the reflection equation, thesis eq. 5.1, is the
+//! BRDF-weighted integral of what arrives, estimated by their mean):
+//!
+//! - the branches' directions are BRDF-sampled on a randomly shifted 2-D
+//!   lattice, so each is distributed as the BRDF sampler's own draw
+//!   (unbiased) while together they cover the hemisphere evenly;
+//! - each branch that escapes adds the sky; each that meets a surface adds
+//!   that surface's emission, its direct light (sun and lamps, sampled as
+//!   at any vertex) and its sky (one BRDF-sampled occlusion ray, kept if it
+//!   escapes), all weighted by the branch's `f cos / pdf` over their number;
+//! - the light that surface reflects from other surfaces (the third
+//!   scattering event on) is carried by one path continued from one branch
+//!   chosen uniformly, weighted by that branch's `f cos / pdf` (the choice
+//!   probability cancels the mean's 1/K); that path's first ray adds no sky
+//!   if it escapes (counted by the occlusion ray).
+//!
+//! On a shaded wall lit by the sky and the sunlit ground, the pixel's
+//! noise is mostly which of its few continuation rays met the bright ground
+//! and which the sky: the branches average it out while the camera ray and
+//! its direct light are traced once. Splitting only the sky off (occlusion
+//! rays for the sky, one continuation for the surfaces that adds nothing
+//! when it escapes) was measured first and made that noise *worse*: the
+//! continuation then scores 0 or the ground instead of the sky or the
+//! ground, two values much closer together (BENCHMARKS.md, "Path splitting
+//! at the first surface"). With `split_rays` 0 the path is traced as
+//! before, one continuation per vertex.
 
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
@@ -16,7 +46,7 @@ use rayon::prelude::*;
 use super::camera::CameraRig;
 use super::light::{PointLight, SphereLight};
 use super::mesh::Ray;
-use super::scene::Scene;
+use super::scene::{Scene, SurfaceHit};
 use super::sky::{Sky, SolarDisc};
 use super::surface_bsdf::SurfaceBsdf;
 use crate::camera::image::RadianceImage;
@@ -32,7 +62,16 @@ pub struct RenderSettings {
     /// Seed of every random choice; the same seed gives the same image on
     /// any number of threads.
     pub seed: u64,
+    /// Branches per path at the first surface a camera ray meets (see the
+    /// module's doc): 0 continues the path with one ray, as a plain path
+    /// tracer does. Default [`DEFAULT_SPLIT_RAYS`].
+    pub split_rays: u32,
 }
+
+/// Branches per path at the camera-visible surface, by default: chosen by
+/// measured time against noise on the campanile (BENCHMARKS.md, "Path
+/// splitting at the first surface").
+pub const DEFAULT_SPLIT_RAYS: u32 = 4;
 
 impl Default for RenderSettings {
     fn default() -> Self {
@@ -40,6 +79,7 @@ impl Default for RenderSettings {
             samples_per_pixel: 16,
             max_bounces: 2,
             seed: 0,
+            split_rays: DEFAULT_SPLIT_RAYS,
         }
     }
 }
@@ -91,99 +131,297 @@ fn sample_cone(axis: &Vector3<f64>, cos_max: f64, u1: f64, u2: f64) -> Vector3<f
     (a * (sin_t * phi.cos()) + b * (sin_t * phi.sin()) + axis * cos_t).normalize()
 }
 
-/// One path's estimate of the radiance arriving along `ray` (toward its origin).
+/// One path's estimate of the radiance arriving along `ray` (toward its
+/// origin), one continuation per vertex (no splitting).
 pub fn trace(scene: &Scene, lighting: &Lighting, ray: Ray, max_bounces: u32, rng: &mut impl Rng) -> [f64; 3] {
-    path(scene, lighting, ray, 0, max_bounces, rng)
+    let gather = Gathering {
+        disc_seen: true,
+        split_rays: 0,
+    };
+    path(scene, lighting, ray, 0, max_bounces, gather, rng)
 }
 
-/// The radiance along `ray` for a path that has already scattered `bounce`
-/// times: the disc and the bulbs count only for camera rays (`bounce == 0`),
-/// since every later vertex samples them explicitly.
-fn path(scene: &Scene, lighting: &Lighting, ray: Ray, bounce: u32, max_bounces: u32, rng: &mut impl Rng) -> [f64; 3] {
-    path_seeing_disc(scene, lighting, ray, bounce, max_bounces, true, rng)
-}
-
-/// [`path`], with the solar disc seen by a camera ray only if `disc_seen`
-/// (the renderer adds the disc of pixels near the sun exactly instead).
-fn path_seeing_disc(
-    scene: &Scene,
-    lighting: &Lighting,
-    ray: Ray,
-    bounce: u32,
-    max_bounces: u32,
+/// How a path gathers the light of its first surface.
+#[derive(Debug, Clone, Copy)]
+struct Gathering {
+    /// Whether a camera ray that meets the solar disc adds it (the renderer
+    /// adds the disc of pixels near the sun exactly instead).
     disc_seen: bool,
-    rng: &mut impl Rng,
-) -> [f64; 3] {
-    let mut radiance = [0.0; 3];
-    let mut beta = [1.0; 3];
-    let mut ray = ray;
-    let mut bounce = bounce;
-    loop {
-        // The nearest of the scene's surfaces and the lamps' bulbs.
-        let surface = scene.intersect(&ray, f64::INFINITY);
-        let limit = surface.map_or(f64::INFINITY, |h| h.t);
-        let bulb = lighting
-            .spheres
-            .iter()
-            .filter_map(|s| s.intersect(&ray.origin, &ray.direction, 0.0, limit).map(|t| (t, s)))
-            .min_by(|a, b| a.0.total_cmp(&b.0));
-        if let Some((_, lamp)) = bulb {
-            if bounce == 0 {
-                add_scaled(&mut radiance, &beta, &lamp.radiance, 1.0);
-            }
-            break;
-        }
-        let Some(hit) = surface else {
-            if let Some(sky) = lighting.sky {
-                add_scaled(&mut radiance, &beta, &sky.radiance(&ray.direction), 1.0);
-                if bounce == 0
-                    && disc_seen
-                    && let Some(sun) = sky.sun().filter(|s| s.contains(&ray.direction))
-                {
-                    add_scaled(&mut radiance, &beta, &sun.radiance, 1.0);
-                }
-            }
-            break;
-        };
+    /// Branches at the path's first surface (see the module's doc); 0: one
+    /// continuation.
+    split_rays: u32,
+}
+
+/// What a ray meets first.
+#[derive(Debug, Clone, Copy)]
+enum Arrival<'a> {
+    /// Nothing: the sky.
+    Sky,
+    /// A lamp's bulb, before any surface.
+    Bulb(&'a SphereLight),
+    /// A surface of the scene.
+    Surface(SurfaceHit),
+}
+
+/// The nearest of the scene's surfaces and the lamps' bulbs along `ray`.
+fn arrival<'a>(scene: &Scene, bulbs: &'a [SphereLight], ray: &Ray) -> Arrival<'a> {
+    let surface = scene.intersect(ray, f64::INFINITY);
+    let limit = surface.map_or(f64::INFINITY, |h| h.t);
+    let bulb = bulbs
+        .iter()
+        .filter_map(|s| s.intersect(&ray.origin, &ray.direction, 0.0, limit).map(|t| (t, s)))
+        .min_by(|a, b| a.0.total_cmp(&b.0));
+    match (bulb, surface) {
+        (Some((_, lamp)), _) => Arrival::Bulb(lamp),
+        (None, Some(hit)) => Arrival::Surface(hit),
+        (None, None) => Arrival::Sky,
+    }
+}
+
+/// A scattering vertex: where a ray arriving along `direction` meets `hit`.
+struct Vertex {
+    bsdf: SurfaceBsdf,
+    /// The face normal on the side the ray came from (surfaces are two-sided).
+    normal: Vector3<f64>,
+    /// Where rays leave from: the hit, moved off the surface.
+    origin: Vector3<f64>,
+    /// Toward where the light leaves: back along the arriving ray.
+    wo: Vector3<f64>,
+}
+
+impl Vertex {
+    fn at(scene: &Scene, hit: &SurfaceHit, direction: &Vector3<f64>) -> Vertex {
         let tri = &scene.triangles()[hit.triangle];
         let material = &scene.materials()[tri.material as usize];
-        add_scaled(&mut radiance, &beta, &material.emission, 1.0);
-        if bounce == max_bounces {
-            break;
-        }
-        bounce += 1;
-        let wo = -ray.direction;
-        // Two-sided surfaces: shade on the side the ray came from.
+        let wo = -direction;
         let normal = if tri.normal.dot(&wo) >= 0.0 {
             tri.normal
         } else {
             -tri.normal
         };
-        let bsdf = SurfaceBsdf::at(material, tri, &hit.point, normal);
-        let origin = hit.point + normal * SURFACE_OFFSET * (1.0 + hit.point.norm() * 1e-3);
+        Vertex {
+            bsdf: SurfaceBsdf::at(material, tri, &hit.point, normal),
+            normal,
+            origin: hit.point + normal * SURFACE_OFFSET * (1.0 + hit.point.norm() * 1e-3),
+            wo,
+        }
+    }
 
-        direct(scene, lighting, &bsdf, &origin, &normal, &wo, &beta, &mut radiance, rng);
-
-        // Continue the path.
-        let Some(sample) = bsdf.sample(&wo, [rng.random(), rng.random(), rng.random()]) else {
-            break;
-        };
-        let cos = sample.direction.dot(&normal);
+    /// A BRDF-sampled direction from uniform numbers `u` and its weight
+    /// `f cos / pdf` per channel; `None` below the surface or with no density.
+    fn scatter(&self, u: [f64; 3]) -> Option<(Vector3<f64>, [f64; 3])> {
+        let sample = self.bsdf.sample(&self.wo, u)?;
+        let cos = sample.direction.dot(&self.normal);
         if cos <= 0.0 || sample.pdf <= 0.0 {
+            return None;
+        }
+        Some((sample.direction, sample.value.map(|f| f * cos / sample.pdf)))
+    }
+}
+
+fn emission(scene: &Scene, hit: &SurfaceHit) -> [f64; 3] {
+    let tri = &scene.triangles()[hit.triangle];
+    scene.materials()[tri.material as usize].emission
+}
+
+/// The radiance along `ray` for a path that has already scattered `bounce`
+/// times: the disc and the bulbs count only for camera rays (`bounce == 0`),
+/// since every later vertex samples them explicitly.
+fn path(
+    scene: &Scene,
+    lighting: &Lighting,
+    ray: Ray,
+    bounce: u32,
+    max_bounces: u32,
+    gather: Gathering,
+    rng: &mut impl Rng,
+) -> [f64; 3] {
+    let mut radiance = [0.0; 3];
+    let mut beta = [1.0; 3];
+    let mut direction = ray.direction;
+    let mut bounce = bounce;
+    let mut split_rays = gather.split_rays;
+    let mut arrived = arrival(scene, lighting.spheres, &ray);
+    // The surface arrived at had its emission and direct light counted by
+    // the split vertex before it, and the ray leaving it its sky.
+    let (mut vertex_counted, mut sky_counted) = (false, false);
+    loop {
+        let hit = match arrived {
+            Arrival::Bulb(lamp) => {
+                if bounce == 0 {
+                    add_scaled(&mut radiance, &beta, &lamp.radiance, 1.0);
+                }
+                break;
+            }
+            Arrival::Sky => {
+                if let Some(sky) = lighting.sky {
+                    if !sky_counted {
+                        add_scaled(&mut radiance, &beta, &sky.radiance(&direction), 1.0);
+                    }
+                    if bounce == 0
+                        && gather.disc_seen
+                        && let Some(sun) = sky.sun().filter(|s| s.contains(&direction))
+                    {
+                        add_scaled(&mut radiance, &beta, &sun.radiance, 1.0);
+                    }
+                }
+                break;
+            }
+            Arrival::Surface(hit) => hit,
+        };
+        if !vertex_counted {
+            add_scaled(&mut radiance, &beta, &emission(scene, &hit), 1.0);
+        }
+        if bounce == max_bounces {
             break;
         }
-        for (b, f) in beta.iter_mut().zip(sample.value) {
-            *b *= f * cos / sample.pdf;
+        bounce += 1;
+        let vertex = Vertex::at(scene, &hit, &direction);
+        if !vertex_counted {
+            direct(scene, lighting, &vertex, &beta, &mut radiance, rng);
+        }
+
+        if split_rays > 0 && !vertex_counted {
+            // Branches over this vertex's hemisphere; the path goes on from one.
+            let Some((weight, next_direction, next)) = split(
+                scene,
+                lighting,
+                &vertex,
+                bounce < max_bounces,
+                split_rays,
+                &beta,
+                &mut radiance,
+                rng,
+            ) else {
+                break;
+            };
+            split_rays = 0;
+            for (b, w) in beta.iter_mut().zip(weight) {
+                *b *= w;
+            }
+            direction = next_direction;
+            arrived = Arrival::Surface(next);
+            vertex_counted = true;
+            sky_counted = false;
+            continue;
+        }
+
+        // Continue the path.
+        let Some((next_direction, weight)) = vertex.scatter([rng.random(), rng.random(), rng.random()]) else {
+            break;
+        };
+        for (b, w) in beta.iter_mut().zip(weight) {
+            *b *= w;
         }
         if beta.iter().all(|b| *b == 0.0) {
             break;
         }
-        ray = Ray {
-            origin,
-            direction: sample.direction,
-        };
+        direction = next_direction;
+        arrived = arrival(
+            scene,
+            lighting.spheres,
+            &Ray {
+                origin: vertex.origin,
+                direction,
+            },
+        );
+        // The sky of a vertex reached by a split branch was counted there.
+        sky_counted = vertex_counted && lighting.sky.is_some();
+        vertex_counted = false;
     }
     radiance
+}
+
+/// The fractional part of the golden ratio: the generator of the 2-D
+/// lattice the branches are stratified on.
+const GOLDEN_FRACTION: f64 = 0.618_033_988_749_894_8;
+
+/// The `rays` branches of a split vertex (see the module's doc), adding
+/// to `radiance` (through the path's throughput `beta`) everything they
+/// find up to their surfaces' direct light and sky, the surfaces scattering
+/// only if `can_scatter`. The `k`-th branch is BRDF-sampled from the
+/// lattice point `((k + s₁)/rays, frac(k φ⁻¹ + s₂))` in the sampler's two
+/// direction coordinates (s₁, s₂ uniform: each point uniform on the square),
+/// the lobe choice independent. Returns the branch the path continues
+/// from, chosen uniformly, as its weight `f cos / pdf`, its direction and
+/// the surface it met; `None` when that branch met no surface, left the
+/// hemisphere, or `!can_scatter`.
+#[allow(clippy::too_many_arguments)]
+fn split(
+    scene: &Scene,
+    lighting: &Lighting,
+    vertex: &Vertex,
+    can_scatter: bool,
+    rays: u32,
+    beta: &[f64; 3],
+    radiance: &mut [f64; 3],
+    rng: &mut impl Rng,
+) -> Option<([f64; 3], Vector3<f64>, SurfaceHit)> {
+    let (s1, s2): (f64, f64) = (rng.random(), rng.random());
+    let chosen = rng.random_range(0..rays);
+    let mut next = None;
+    for k in 0..rays {
+        let u1 = (f64::from(k) + s1) / f64::from(rays);
+        let u2 = (f64::from(k) * GOLDEN_FRACTION + s2).fract();
+        let Some((direction, weight)) = vertex.scatter([rng.random(), u1, u2]) else {
+            continue;
+        };
+        let mut wb = [0.0; 3];
+        for c in 0..3 {
+            wb[c] = beta[c] * weight[c] / f64::from(rays);
+        }
+        let ray = Ray {
+            origin: vertex.origin,
+            direction,
+        };
+        match arrival(scene, lighting.spheres, &ray) {
+            Arrival::Bulb(_) => {}
+            Arrival::Sky => {
+                if let Some(sky) = lighting.sky {
+                    add_scaled(radiance, &wb, &sky.radiance(&direction), 1.0);
+                }
+            }
+            Arrival::Surface(hit) => {
+                add_scaled(radiance, &wb, &emission(scene, &hit), 1.0);
+                if can_scatter {
+                    let far = Vertex::at(scene, &hit, &direction);
+                    direct(scene, lighting, &far, &wb, radiance, rng);
+                    if let Some(sky) = lighting.sky {
+                        let l = skylight(scene, lighting.spheres, sky, &far, rng);
+                        add_scaled(radiance, &wb, &l, 1.0);
+                    }
+                    if k == chosen {
+                        next = Some((weight, direction, hit));
+                    }
+                }
+            }
+        }
+    }
+    next
+}
+
+/// One BRDF-sampled estimate of the skylight `vertex` reflects,
+/// `∫_sky f(wi, wo) L_sky(wi) cos θi dωi` over the directions that escape
+/// the scene and miss every bulb (thesis eq. 5.1 restricted to the sky):
+/// an occlusion test, cheaper than a nearest hit. The solar disc is not
+/// part of the sky here: [`direct`] samples it.
+fn skylight(scene: &Scene, bulbs: &[SphereLight], sky: &dyn Sky, vertex: &Vertex, rng: &mut impl Rng) -> [f64; 3] {
+    let Some((direction, weight)) = vertex.scatter([rng.random(), rng.random(), rng.random()]) else {
+        return [0.0; 3];
+    };
+    let ray = Ray {
+        origin: vertex.origin,
+        direction,
+    };
+    if scene.occluded(&ray, f64::INFINITY)
+        || bulbs
+            .iter()
+            .any(|b| b.intersect(&ray.origin, &ray.direction, 0.0, f64::INFINITY).is_some())
+    {
+        return [0.0; 3];
+    }
+    let l = sky.radiance(&direction);
+    [0, 1, 2].map(|c| weight[c] * l[c])
 }
 
 /// Samples per pixel for pixels within a few pixels of the solar disc.
@@ -294,7 +532,11 @@ pub fn render(scene: &Scene, camera: &CameraRig, lighting: &Lighting, settings: 
                 let v = y as f64 + (f64::from(sy) + rng.random::<f64>()) / f64::from(side);
                 if let Some(ray) = caster.ray(u, v) {
                     // Near the sun the disc itself is added exactly below.
-                    let l = path_seeing_disc(scene, lighting, ray, 0, settings.max_bounces, !near, &mut rng);
+                    let gather = Gathering {
+                        disc_seen: !near,
+                        split_rays: settings.split_rays,
+                    };
+                    let l = path(scene, lighting, ray, 0, settings.max_bounces, gather, &mut rng);
                     (0..3).for_each(|c| sum[c] += l[c]);
                 }
             }
@@ -346,7 +588,11 @@ pub fn render_latlong(
                     origin: *position,
                     direction: Vector3::new(d[0], d[1], d[2]),
                 };
-                let l = trace(scene, lighting, ray, settings.max_bounces, &mut rng);
+                let gather = Gathering {
+                    disc_seen: true,
+                    split_rays: settings.split_rays,
+                };
+                let l = path(scene, lighting, ray, 0, settings.max_bounces, gather, &mut rng);
                 (0..3).for_each(|c| sum[c] += l[c]);
             }
             for c in 0..3 {
@@ -382,22 +628,30 @@ pub fn irradiance(
     let n = samples.max(1);
     let mut sum = [0.0; 3];
     // A white Lambertian probe: its BRDF is 1/π, so π × its NEE is the irradiance.
-    let probe = SurfaceBsdf::white_probe(normal);
+    let probe = Vertex {
+        bsdf: SurfaceBsdf::white_probe(normal),
+        normal,
+        origin,
+        wo: normal,
+    };
     for _ in 0..n {
         let mut e = [0.0; 3];
-        direct(
+        direct(scene, lighting, &probe, &[1.0; 3], &mut e, &mut rng);
+        let d = sample_cosine(&normal, rng.random(), rng.random());
+        // The probe's sky and the scene's light through one cosine ray.
+        let gather = Gathering {
+            disc_seen: true,
+            split_rays: 0,
+        };
+        let l = path(
             scene,
             lighting,
-            &probe,
-            &origin,
-            &normal,
-            &(normal),
-            &[1.0; 3],
-            &mut e,
+            Ray { origin, direction: d },
+            1,
+            max_bounces,
+            gather,
             &mut rng,
         );
-        let d = sample_cosine(&normal, rng.random(), rng.random());
-        let l = path(scene, lighting, Ray { origin, direction: d }, 1, max_bounces, &mut rng);
         for c in 0..3 {
             sum[c] += e[c] * std::f64::consts::PI + l[c] * std::f64::consts::PI;
         }
@@ -414,21 +668,17 @@ fn sample_cosine(normal: &Vector3<f64>, u1: f64, u2: f64) -> Vector3<f64> {
 }
 
 /// Next-event estimation at a surface vertex: light arriving directly from
-/// the solar disc, the point lights and the lamps, reflected toward `wo`,
-/// weighted by the path throughput `beta`, added to `radiance`.
-#[allow(clippy::too_many_arguments)]
+/// the solar disc, the point lights and the lamps, reflected toward the
+/// vertex's `wo`, weighted by the path throughput `beta`, added to `radiance`.
 fn direct(
     scene: &Scene,
     lighting: &Lighting,
-    bsdf: &SurfaceBsdf,
-    origin: &Vector3<f64>,
-    normal: &Vector3<f64>,
-    wo: &Vector3<f64>,
+    vertex: &Vertex,
     beta: &[f64; 3],
     radiance: &mut [f64; 3],
     rng: &mut impl Rng,
 ) {
-    let (origin, normal, wo) = (*origin, *normal, *wo);
+    let (origin, normal, wo, bsdf) = (vertex.origin, vertex.normal, vertex.wo, &vertex.bsdf);
     // The sun.
     if let Some(sun) = lighting.sky.and_then(|s| s.sun()) {
         let wi = sample_cone(&sun.direction, sun.angular_radius_rad.cos(), rng.random(), rng.random());

@@ -21,7 +21,7 @@ pub mod surface_bsdf;
 pub mod texture;
 
 pub use camera::CameraRig;
-pub use integrator::{Lighting, RenderSettings, irradiance, render, render_latlong, trace};
+pub use integrator::{DEFAULT_SPLIT_RAYS, Lighting, RenderSettings, irradiance, render, render_latlong, trace};
 pub use light::{PointLight, SphereLight};
 pub use material::Material;
 pub use mesh::{Ray, Triangle};

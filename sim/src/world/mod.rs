@@ -153,6 +153,7 @@ impl World {
                 samples_per_pixel: 16,
                 max_bounces: 2,
                 seed: 0,
+                ..RenderSettings::default()
             },
         }
     }

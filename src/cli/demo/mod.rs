@@ -117,7 +117,11 @@ pub fn run(args: DemoArgs) -> Result<()> {
     let t = Instant::now();
     // Three bounces: the light the ground reflects onto shaded walls,
     // which the pseudo-albedo model includes (one bounce would omit it).
-    capture_simulated(&plan, &station, &session, &["--sim-bounces", "3"])?;
+    // Four paths per pixel, each splitting into 4 branches at the surface
+    // it shows: the photographs' noise was the largest term of the
+    // pseudo-albedo and held-out errors (BENCHMARKS.md, "Path splitting at
+    // the first surface"); the capture is a small part of the demo's time.
+    capture_simulated(&plan, &station, &session, &["--sim-samples", "4", "--sim-bounces", "3"])?;
     let capture_s = t.elapsed().as_secs_f64();
 
     // 3. Process.
