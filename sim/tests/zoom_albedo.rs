@@ -120,6 +120,23 @@ fn light_at<'a>(day: &'a campanile_process::sky::Daylight, t: &str) -> Illuminat
 }
 
 /// The middle of the south wall (about 40 m up), sunlit at T0 and at T1.
+/// The zoom view re-rendered at `T1` from the grid's pseudo-albedos and
+/// from the zoom's per-pixel ones, each against the simulator's render:
+/// relative RMSE (grid, high-res) over the zoom's used pixels.
+fn rerender_errors(w: &World, refl: &Reflectance, zoom: &ZoomAlbedo, rig: &CameraRig) -> (f64, f64) {
+    let day1 = w.daylight(time(T1)).unwrap().unwrap();
+    let l1 = light_at(&day1, T1);
+    let reference = w.render(time(T1), rig, &[], 9).unwrap();
+    let settings = RerenderSettings::default();
+    let (low, _) = rerender(&w.scene.scene, refl, rig, &l1, &settings);
+    let high = rerender_zoom(&w.scene.scene, refl, zoom, &l1, &settings);
+    let mask = zoom.valid();
+    (
+        relative_rmse(&low, &reference, &mask).unwrap(),
+        relative_rmse(&high, &reference, &mask).unwrap(),
+    )
+}
+
 const WALL: [f64; 3] = [0.0, -5.5, 40.0];
 
 /// Eq. (5.16) in isolation: with the world's true cell means as `ρ̃`
@@ -158,17 +175,7 @@ fn eq_5_16_recovers_the_sub_cell_texture_from_true_cell_means() {
     assert!(e.high_corr >= 0.9, "high-res correlation {}", e.high_corr);
     assert!(e.low_corr <= 0.4, "low-res correlation {}", e.low_corr);
 
-    let day1 = w.daylight(time(T1)).unwrap().unwrap();
-    let l1 = light_at(&day1, T1);
-    let reference = w.render(time(T1), &rig, &[], 9).unwrap();
-    let settings = RerenderSettings::default();
-    let (low, _) = rerender(&w.scene.scene, &refl, &rig, &l1, &settings);
-    let high = rerender_zoom(&w.scene.scene, &refl, &zoom, &l1, &settings);
-    let mask = zoom.valid();
-    let (rl, rh) = (
-        relative_rmse(&low, &reference, &mask).unwrap(),
-        relative_rmse(&high, &reference, &mask).unwrap(),
-    );
+    let (rl, rh) = rerender_errors(&w, &refl, &zoom, &rig);
     eprintln!("re-rendered at {T1}: relative RMSE {rh:.4} (high-res) against {rl:.4} (grid)");
     assert!(rh <= 0.06, "high-res re-render {rh}");
     assert!(rl >= 0.10, "grid re-render {rl}");
@@ -348,17 +355,7 @@ fn eq_5_16_on_recovered_cell_albedos() {
         "recovered ρ̃: {} pixels: high-res median {:.4}, correlation {:.3}; low-res median {:.4}, correlation {:.3}",
         e.pixels, e.high_median, e.high_corr, e.low_median, e.low_corr
     );
-    let day1 = w.daylight(time(T1)).unwrap().unwrap();
-    let l1 = light_at(&day1, T1);
-    let reference = w.render(time(T1), &rig, &[], 9).unwrap();
-    let rs = RerenderSettings::default();
-    let (low, _) = rerender(&w.scene.scene, &refl, &rig, &l1, &rs);
-    let high = rerender_zoom(&w.scene.scene, &refl, &zoom, &l1, &rs);
-    let mask = zoom.valid();
-    let (rl, rh) = (
-        relative_rmse(&low, &reference, &mask).unwrap(),
-        relative_rmse(&high, &reference, &mask).unwrap(),
-    );
+    let (rl, rh) = rerender_errors(&w, &refl, &zoom, &rig);
     eprintln!("recovered ρ̃, re-rendered at {T1}: relative RMSE {rh:.4} (high-res) against {rl:.4} (grid)");
     assert!(e.high_median <= 0.04 && e.high_median <= 0.5 * e.low_median);
     assert!(e.high_corr >= 0.85);
