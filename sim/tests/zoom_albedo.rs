@@ -120,6 +120,20 @@ fn light_at<'a>(day: &'a campanile_process::sky::Daylight, t: &str) -> Illuminat
 }
 
 /// The middle of the south wall (about 40 m up), sunlit at T0 and at T1.
+/// Eq. 5.16 on the simulator's photo of `rig` at `t` (seed `seed`), under
+/// the world's daylight then, with the default settings.
+fn zoom_of(w: &World, rig: &CameraRig, refl: &Reflectance, t: &str, seed: u64) -> ZoomAlbedo {
+    let day = w.daylight(time(t)).unwrap().unwrap();
+    zoom_albedo(
+        &w.scene.scene,
+        refl,
+        &photo(w, rig, t, seed),
+        &light_at(&day, t),
+        &ZoomSettings::default(),
+    )
+    .unwrap()
+}
+
 /// The zoom view re-rendered at `T1` from the grid's pseudo-albedos and
 /// from the zoom's per-pixel ones, each against the simulator's render:
 /// relative RMSE (grid, high-res) over the zoom's used pixels.
@@ -150,15 +164,7 @@ fn eq_5_16_recovers_the_sub_cell_texture_from_true_cell_means() {
     let w = world();
     let rig = zoom_rig(&w, POSITION, WALL, ZOOM, WIDTH, HEIGHT);
     let refl = true_cells(&w, &rig);
-    let day0 = w.daylight(time(T0)).unwrap().unwrap();
-    let zoom = zoom_albedo(
-        &w.scene.scene,
-        &refl,
-        &photo(&w, &rig, T0, 1),
-        &light_at(&day0, T0),
-        &ZoomSettings::default(),
-    )
-    .unwrap();
+    let zoom = zoom_of(&w, &rig, &refl, T0, 1);
     eprintln!("{}", zoom.report);
     let truth = pixel_albedo_truth(&w, &refl.grid, &rig, 4);
     let e = errors(&zoom, &truth, |_| true);
@@ -204,15 +210,7 @@ fn a_view_half_in_shadow_counts_its_shadow_edge() {
     // 256 samples: the shadowed part is lit by sky and bounce light only,
     // which the path tracer samples with more noise than the sun.
     w.quality.samples_per_pixel = 256;
-    let day = w.daylight(time(t)).unwrap().unwrap();
-    let zoom = zoom_albedo(
-        &w.scene.scene,
-        &refl,
-        &photo(&w, &rig, t, 2),
-        &light_at(&day, t),
-        &ZoomSettings::default(),
-    )
-    .unwrap();
+    let zoom = zoom_of(&w, &rig, &refl, t, 2);
     let targets = zoom.hits.iter().flatten().count();
     let lit = zoom.hits.iter().flatten().filter(|h| h.sunlit).count();
     eprintln!("{lit} of {targets} target pixels sunlit; {}", zoom.report);
@@ -340,15 +338,7 @@ fn eq_5_16_on_recovered_cell_albedos() {
     let (refl, _) = recover_reflectance(&w.scene.scene, &targets, &photos, &lights, &settings).unwrap();
 
     let rig = zoom_rig(&w, POSITION, WALL, ZOOM, WIDTH, HEIGHT);
-    let day0 = w.daylight(time(T0)).unwrap().unwrap();
-    let zoom = zoom_albedo(
-        &w.scene.scene,
-        &refl,
-        &photo(&w, &rig, T0, 1),
-        &light_at(&day0, T0),
-        &ZoomSettings::default(),
-    )
-    .unwrap();
+    let zoom = zoom_of(&w, &rig, &refl, T0, 1);
     let truth = pixel_albedo_truth(&w, &refl.grid, &rig, 4);
     let e = errors(&zoom, &truth, |_| true);
     eprintln!(
