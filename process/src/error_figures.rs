@@ -39,9 +39,41 @@ pub fn block_relative_rmse(image: &RadianceImage, reference: &RadianceImage, mas
     if den > 0.0 { (num / den).sqrt() } else { f64::NAN }
 }
 
+/// Pearson correlation of `a` with `b` (paired): whether a recovered texture
+/// follows the true one, not just its mean. NaN when fewer than two pairs
+/// or either side is constant.
+pub fn correlation(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    if n < 2 {
+        return f64::NAN;
+    }
+    let (a, b) = (&a[..n], &b[..n]);
+    let (ma, mb) = (a.iter().sum::<f64>() / n as f64, b.iter().sum::<f64>() / n as f64);
+    let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
+    let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
+    let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
+    if va > 0.0 && vb > 0.0 {
+        cov / (va * vb).sqrt()
+    } else {
+        f64::NAN
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// b = 2a + 1 correlates at 1, b = −a at −1; a symmetric pairing whose
+    /// covariance cancels at 0; one pair or a constant side is NaN.
+    #[test]
+    fn correlation_of_known_pairings() {
+        let a = [1.0, 2.0, 3.0, 4.0];
+        assert!((correlation(&a, &[3.0, 5.0, 7.0, 9.0]) - 1.0).abs() < 1e-12);
+        assert!((correlation(&a, &[-1.0, -2.0, -3.0, -4.0]) + 1.0).abs() < 1e-12);
+        assert!(correlation(&[-1.0, 0.0, 1.0], &[1.0, 0.0, 1.0]).abs() < 1e-12);
+        assert!(correlation(&[1.0], &[2.0]).is_nan());
+        assert!(correlation(&a, &[2.0; 4]).is_nan());
+    }
 
     #[test]
     fn quantiles_by_nearest_rank() {

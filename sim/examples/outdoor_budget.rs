@@ -21,30 +21,17 @@ use campanile_process::error_figures::{block_relative_rmse, quantile};
 use campanile_process::outdoor::observation::Footprint;
 use campanile_process::outdoor::rerender::{relative_rmse, target_mask};
 use campanile_process::outdoor::{
-    CellStatus, Illumination, Photo, Reflectance, ReflectanceSettings, RerenderSettings, recover_reflectance, rerender,
+    CellStatus, Illumination, Photo, ReflectanceSettings, RerenderSettings, recover_reflectance, rerender,
 };
-use campanile_process::pose::HeadPose;
-use campanile_process::render::{CameraRig, Scene, Texture};
-use campanile_process::sky::{Daylight, SkySample, angle_between, direction, fit_sky};
-use campanile_sim::world::{World, examples_dir, load_scene};
+use campanile_process::render::CameraRig;
+use campanile_process::sky::Daylight;
+use campanile_sim::world::campanile_day::{
+    CampanileDay, HELD_OUT_VIEWS, TOWER, fitted_skies, flattened, held_out_time, illuminations, training_times,
+};
 use chrono::{DateTime, Utc};
 
-/// Sub-samples per cell side for a cell's true albedo. The mortar joints
-/// are 5 cm wide and 12% of the wall: an 8 × 8 grid over a 2 m cell (25 cm
-/// apart) aliases with the 0.6 m courses and put 0–25% of its points on
-/// mortar, a ±3% error in the "truth" itself (measured: it was the whole
-/// texture term of the budget).
+/// Sub-samples per cell side for a cell's true albedo (see `CampanileDay::cell_truth`).
 const TRUTH_PER_SIDE: usize = 64;
-
-const TRAINING: [&str; 4] = [
-    "2026-08-29T15:48:00Z",
-    "2026-08-29T20:10:00Z",
-    "2026-08-29T22:42:00Z",
-    "2026-08-30T01:38:00Z",
-];
-const HELD_OUT: &str = "2026-08-29T20:30:00Z";
-const VIEWS: [&str; 4] = ["view-se", "view-sw", "view-nw", "view-ne"];
-const TOWER: [&str; 6] = ["south-face", "east-face", "north-face", "west-face", "pillars", "roof"];
 
 /// One line of the budget.
 #[derive(Clone)]
@@ -192,87 +179,13 @@ fn arg(name: &str) -> Option<String> {
         .and_then(|i| args.get(i + 1).cloned())
 }
 
-fn time(s: &str) -> DateTime<Utc> {
-    s.parse().expect("a valid time")
-}
-
-fn rig(w: &World, station: &campanile_config::Station, name: &str, width: usize) -> CameraRig {
-    let pose = w.scene.description.pose(name).expect("a pose of the scene");
-    let (pan, tilt) = station
-        .head
-        .reach(pose.azimuth_deg, pose.elevation_deg)
-        .expect("a reachable pose");
-    let head = HeadPose {
-        pan_rad: pan.to_radians(),
-        tilt_rad: tilt.to_radians(),
-    };
-    let (x, y, z) = pose.position_m;
-    w.rig(head, [x, y, z], width, width * 3 / 4)
-}
-
-/// `scene` with the materials for which `flatten` says so given their mean albedo.
-fn flattened(scene: &Scene, flatten: impl Fn(&str) -> bool) -> Scene {
-    let materials = scene
-        .materials()
-        .iter()
-        .map(|m| {
-            let mut m = m.clone();
-            if flatten(&m.name) {
-                m.albedo = Texture::Constant(m.albedo.mean_albedo());
-            }
-            m
-        })
-        .collect();
-    Scene::new(scene.triangles().to_vec(), materials, scene.surfaces().to_vec()).expect("the same scene")
-}
-
-/// Truth per cell: the mean of the world's albedo over the cell.
-fn truth(w: &World, refl: &Reflectance) -> Vec<[f64; 3]> {
-    (0..refl.grid.cells.len())
-        .map(|c| {
-            let pts = refl.grid.cell_points(&w.scene.scene, c, TRUTH_PER_SIDE);
-            let tri = refl.grid.cells[c].triangle;
-            let mut s = [0.0; 3];
-            for p in &pts {
-                let a = w.pseudo_albedos(tri, [p.x, p.y, p.z]).sun;
-                for ch in 0..3 {
-                    s[ch] += a[ch] / pts.len() as f64;
-                }
-            }
-            s
-        })
-        .collect()
-}
-
 /// The daylight the solver is given at `t`: the truth, or skies fitted to
 /// ±2% samples of it (the disc unchanged), with the sun scaled by `sun_scale`.
-fn given_daylight(w: &World, t: DateTime<Utc>, fitted: bool, sun_scale: f64, salt: u64) -> Daylight {
-    let day = w.daylight(t).unwrap().unwrap();
-    let mut out = day;
+fn given_daylight(day: &CampanileDay, t: DateTime<Utc>, fitted: bool, sun_scale: f64, salt: u64) -> Daylight {
+    let mut out = day.daylight(t).expect("daylight");
     if fitted {
-        let sun = day.sun_direction;
-        let zs = sun[2].acos();
-        let mut k = salt * 1000;
-        out.sky = [0, 1, 2].map(|c| {
-            let mut samples = Vec::new();
-            for i in 0..9 {
-                for j in 0..24 {
-                    let d = direction((5.0 + 9.5 * i as f64).to_radians(), (15.0 * j as f64).to_radians());
-                    let gamma = angle_between(d, sun);
-                    if gamma < 0.02 {
-                        continue;
-                    }
-                    k += 1;
-                    let noise = 1.0 + 0.02 * ((k as f64 * 12.9898).sin() * 43758.5453).fract().mul_add(2.0, -1.0);
-                    samples.push(SkySample {
-                        xi: d[2].acos(),
-                        gamma,
-                        radiance: day.sky_radiance(d)[c] * noise,
-                    });
-                }
-            }
-            fit_sky(&samples, zs).expect("a sky fit").model
-        });
+        let mut counter = salt * 1000;
+        out.sky = fitted_skies(&out, t, &mut counter).expect("a sky fit");
         out.overcast = None;
     }
     out.sun_radiance = out.sun_radiance.map(|v| v * sun_scale);
@@ -284,29 +197,9 @@ type PhotoKey = (bool, u32, u32, usize);
 fn main() {
     let wanted: Option<Vec<String>> = arg("--cases").map(|s| s.split(',').map(str::to_string).collect());
     let reference_spp: u32 = arg("--reference-spp").map_or(256, |v| v.parse().expect("--reference-spp N"));
-    let station = campanile_config::document::load_station(&examples_dir().join("sim-station.ron"))
-        .expect("the example station")
-        .value;
-    let base = World::new(
-        &station,
-        load_scene(&examples_dir().join("campanile-scene.ron")).expect("the example scene"),
-    );
-    let tower_materials: Vec<String> = TOWER
-        .iter()
-        .map(|s| base.scene.scene.surface_index(s).expect("a surface"))
-        .flat_map(|s| {
-            base.scene
-                .scene
-                .triangles()
-                .iter()
-                .filter(move |t| t.surface as usize == s)
-                .map(|t| base.scene.scene.materials()[t.material as usize].name.clone())
-        })
-        .collect();
-    let targets: Vec<usize> = TOWER
-        .iter()
-        .map(|s| base.scene.scene.surface_index(s).expect("a surface"))
-        .collect();
+    let base = CampanileDay::load(256, 2).expect("the example station and scene");
+    let tower_materials = base.tower_materials().expect("the tower's surfaces");
+    let targets = base.targets().expect("the tower's surfaces");
     let mut photo_cache: HashMap<PhotoKey, Vec<Photo>> = HashMap::new();
     let mut reference_cache: HashMap<(bool, u32, usize), Vec<(CameraRig, RadianceImage)>> = HashMap::new();
     println!(
@@ -318,52 +211,37 @@ fn main() {
             continue;
         }
         let t0 = Instant::now();
-        let mut w = base.clone();
+        let mut day = base.clone();
         if !case.textured {
-            w.scene.scene = flattened(&base.scene.scene, |m| tower_materials.iter().any(|t| t == m));
+            day.flatten_tower().expect("the tower's materials");
         }
-        w.quality.samples_per_pixel = case.spp;
-        w.quality.max_bounces = case.bounces;
+        day.world.quality.samples_per_pixel = case.spp;
+        day.world.quality.max_bounces = case.bounces;
+        let w = &day.world;
+        let height = case.width * 3 / 4;
         let key = (case.textured, case.spp, case.bounces, case.width);
         let photos = photo_cache.entry(key).or_insert_with(|| {
-            let mut out = Vec::new();
-            for (i, t) in TRAINING.iter().enumerate() {
-                for (j, v) in VIEWS.iter().enumerate() {
-                    let r = rig(&w, &station, v, case.width);
-                    out.push(Photo {
-                        label: format!("{t} {v}"),
-                        image: w.render(time(t), &r, &[], 100 + (i * 4 + j) as u64).unwrap(),
-                        rig: r,
-                        time: time(t),
-                        mask: None,
-                    });
-                }
-            }
-            out
+            day.photographs(&training_times(), case.width, height)
+                .expect("the photographs")
         });
         let solver_scene = if case.mean_environment {
             flattened(&w.scene.scene, |m| !tower_materials.iter().any(|t| t == m))
         } else {
             w.scene.scene.clone()
         };
-        let days: Vec<(DateTime<Utc>, Daylight)> = TRAINING
-            .iter()
+        let days: Vec<(DateTime<Utc>, Daylight)> = training_times()
+            .into_iter()
             .enumerate()
-            .map(|(i, t)| {
-                (
-                    time(t),
-                    given_daylight(&w, time(t), case.fitted_sky, case.sun_scale, i as u64),
-                )
-            })
+            .map(|(i, t)| (t, given_daylight(&day, t, case.fitted_sky, case.sun_scale, i as u64)))
             .collect();
-        let lights: Vec<Illumination> = days.iter().map(|(t, d)| Illumination { time: *t, sky: d }).collect();
+        let lights = illuminations(&days);
         let settings = ReflectanceSettings {
             spacing_m: case.spacing_m,
             footprint: case.footprint,
             ..ReflectanceSettings::default()
         };
         let (refl, _) = recover_reflectance(&solver_scene, &targets, photos, &lights, &settings).expect("recovery");
-        let tr = truth(&w, &refl);
+        let tr = day.cell_truth(&refl.grid, TRUTH_PER_SIDE);
         let (mut es, mut eu, mut ss, mut su) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         for c in 0..tr.len() {
             if refl.cells[c].status == CellStatus::Unseen {
@@ -466,7 +344,7 @@ fn main() {
                     };
                     let probe = w
                         .irradiance(
-                            time(TRAINING[o.time]),
+                            training_times()[o.time],
                             [cell.centre.x, cell.centre.y, cell.centre.z],
                             [cell.normal.x, cell.normal.y, cell.normal.z],
                             &[],
@@ -495,21 +373,21 @@ fn main() {
             .or_insert_with(|| {
                 let mut fine = w.clone();
                 fine.quality.samples_per_pixel = reference_spp;
-                ["view-se", "view-sw", "view-nw"]
+                HELD_OUT_VIEWS
                     .iter()
                     .map(|v| {
-                        let r = rig(&w, &station, v, case.width);
-                        let img = fine.render(time(HELD_OUT), &r, &[], 7).unwrap();
+                        let r = day.view_rig(v, case.width, height).expect("a view");
+                        let img = fine.render(held_out_time(), &r, &[], 7).expect("a render");
                         (r, img)
                     })
                     .collect()
             });
-        let held = given_daylight(&w, time(HELD_OUT), case.fitted_sky, case.sun_scale, 9);
+        let held = given_daylight(&day, held_out_time(), case.fitted_sky, case.sun_scale, 9);
         let (mut px, mut bl) = (0.0f64, 0.0f64);
         for (r, reference) in references.iter() {
             let mask = target_mask(&solver_scene, &refl, r);
             let light = Illumination {
-                time: time(HELD_OUT),
+                time: held_out_time(),
                 sky: &held,
             };
             let (img, _) = rerender(&solver_scene, &refl, r, &light, &RerenderSettings::default());

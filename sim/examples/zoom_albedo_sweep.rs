@@ -11,53 +11,34 @@
 
 use std::time::Instant;
 
-use campanile_process::error_figures::quantile;
+use campanile_process::error_figures::{correlation, quantile};
 use campanile_process::outdoor::rerender::relative_rmse;
 use campanile_process::outdoor::zoom_albedo::PixelFate;
 use campanile_process::outdoor::{
     Grid, Illumination, Photo, RerenderSettings, ZoomSettings, rerender, rerender_zoom, zoom_albedo,
 };
+use campanile_sim::world::campanile_day::{CampanileDay, held_out_time};
 use campanile_sim::world::zoom_truth::{cell_mean_reflectance, pixel_albedo_truth, zoom_rig};
-use campanile_sim::world::{World, examples_dir, load_scene};
 use chrono::{DateTime, Utc};
 
-fn correlation(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len() as f64;
-    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-    let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
-    let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
-    let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
-    cov / (va * vb).sqrt()
-}
-
 fn main() {
-    let station = campanile_config::document::load_station(&examples_dir().join("sim-station.ron"))
-        .expect("examples/sim-station.ron")
-        .value;
-    let mut w = World::new(
-        &station,
-        load_scene(&examples_dir().join("campanile-scene.ron")).expect("examples/campanile-scene.ron"),
-    );
-    w.quality.samples_per_pixel = 64;
-    w.quality.max_bounces = 2;
-    let t0: DateTime<Utc> = "2026-08-29T20:30:00Z".parse().unwrap();
+    let day = CampanileDay::load(64, 2).expect("the example station and scene");
+    let w = &day.world;
+    let t0 = held_out_time();
     let t1: DateTime<Utc> = "2026-08-29T22:42:00Z".parse().unwrap();
     let (d0, d1) = (w.daylight(t0).unwrap().unwrap(), w.daylight(t1).unwrap().unwrap());
     let (l0, l1) = (Illumination { time: t0, sky: &d0 }, Illumination { time: t1, sky: &d1 });
-    let targets: Vec<usize> = ["south-face", "east-face", "north-face", "west-face", "pillars", "roof"]
-        .iter()
-        .map(|s| w.scene.scene.surface_index(s).unwrap())
-        .collect();
+    let targets = day.targets().expect("the tower's surfaces");
     let position = [0.0, -60.0, 1.5];
     let grid = Grid::new(&w.scene.scene, &targets, 2.0, &[position.into()]).unwrap();
-    let refl = cell_mean_reflectance(&w, grid, 64);
+    let refl = cell_mean_reflectance(w, grid, 64);
     println!(
         "| size | window px | zoom_albedo s | rerender_zoom s | used px | ρ median high / low | correlation high / low | re-render RMSE high / low |"
     );
     println!("|---|---|---|---|---|---|---|---|");
     for (width, height) in [(64, 48), (128, 96), (256, 192), (512, 384)] {
         // The same 6° field of view at every size.
-        let rig = zoom_rig(&w, position, [0.0, -5.5, 40.0], 10.0, width, height);
+        let rig = zoom_rig(w, position, [0.0, -5.5, 40.0], 10.0, width, height);
         let photo = Photo {
             label: format!("zoom {width}×{height}"),
             image: w.render(t0, &rig, &[], 1).unwrap(),
@@ -75,7 +56,7 @@ fn main() {
         let (low, _) = rerender(&w.scene.scene, &refl, &rig, &l1, &settings);
         let reference = w.render(t1, &rig, &[], 9).unwrap();
         let mask = zoom.valid();
-        let truth = pixel_albedo_truth(&w, &refl.grid, &rig, 4);
+        let truth = pixel_albedo_truth(w, &refl.grid, &rig, 4);
         let (mut eh, mut el, mut t, mut h, mut l) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
         for (i, tr) in truth.iter().enumerate() {
             let Some(tr) = tr else { continue };

@@ -13,12 +13,11 @@ use std::sync::OnceLock;
 use campanile_process::error_figures::{block_relative_rmse, quantile};
 use campanile_process::outdoor::rerender::target_mask;
 use campanile_process::outdoor::{
-    CellStatus, Illumination, Photo, Reflectance, ReflectanceSettings, RerenderSettings, recover_reflectance, rerender,
+    CellStatus, Illumination, Reflectance, ReflectanceSettings, RerenderSettings, recover_reflectance, rerender,
 };
-use campanile_process::pose::HeadPose;
-use campanile_process::render::{CameraRig, Scene, Texture};
-use campanile_sim::world::{World, examples_dir, load_scene};
-use chrono::{DateTime, Utc};
+use campanile_sim::world::campanile_day::{
+    CampanileDay, HELD_OUT_VIEWS, held_out_time, illuminations, texture_correlation, training_times,
+};
 
 /// Photo size and samples: small, so the test stays fast (≈ 16 s in the dev
 /// profile before path splitting, about twice that with its 4 branches); a
@@ -35,121 +34,37 @@ const SPACING_M: f64 = 2.0;
 /// texture term of the budget).
 const TRUTH_PER_SIDE: usize = 64;
 
-const TRAINING: [&str; 4] = [
-    "2026-08-29T15:48:00Z",
-    "2026-08-29T20:10:00Z",
-    "2026-08-29T22:42:00Z",
-    "2026-08-30T01:38:00Z",
-];
-const HELD_OUT: &str = "2026-08-29T20:30:00Z";
-const VIEWS: [&str; 4] = ["view-se", "view-sw", "view-nw", "view-ne"];
-const TOWER: [&str; 6] = ["south-face", "east-face", "north-face", "west-face", "pillars", "roof"];
-
-fn time(s: &str) -> DateTime<Utc> {
-    s.parse().unwrap()
-}
-
-fn station() -> campanile_config::Station {
-    campanile_config::document::load_station(&examples_dir().join("sim-station.ron"))
-        .unwrap()
-        .value
-}
-
-/// The world, with the tower's materials flattened to their mean albedo
-/// unless `textured`.
-fn world(textured: bool) -> World {
-    let mut w = World::new(
-        &station(),
-        load_scene(&examples_dir().join("campanile-scene.ron")).unwrap(),
-    );
-    w.quality.samples_per_pixel = SPP;
-    w.quality.max_bounces = 2;
-    if !textured {
-        let scene = &w.scene.scene;
-        let tower: Vec<u32> = TOWER.iter().map(|s| scene.surface_index(s).unwrap() as u32).collect();
-        let tower_materials: Vec<u32> = scene
-            .triangles()
-            .iter()
-            .filter(|t| tower.contains(&t.surface))
-            .map(|t| t.material)
-            .collect();
-        let materials = scene
-            .materials()
-            .iter()
-            .enumerate()
-            .map(|(i, m)| {
-                let mut m = m.clone();
-                if tower_materials.contains(&(i as u32)) {
-                    m.albedo = Texture::Constant(m.albedo.mean_albedo());
-                }
-                m
-            })
-            .collect();
-        w.scene.scene = Scene::new(scene.triangles().to_vec(), materials, scene.surfaces().to_vec()).unwrap();
-    }
-    w
-}
-
-fn rig(w: &World, name: &str) -> CameraRig {
-    let station = station();
-    let pose = w.scene.description.pose(name).unwrap();
-    let (pan, tilt) = station.head.reach(pose.azimuth_deg, pose.elevation_deg).unwrap();
-    let head = HeadPose {
-        pan_rad: pan.to_radians(),
-        tilt_rad: tilt.to_radians(),
-    };
-    let (x, y, z) = pose.position_m;
-    w.rig(head, [x, y, z], WIDTH, HEIGHT)
-}
-
 struct Day {
-    world: World,
+    day: CampanileDay,
     refl: Reflectance,
     /// Truth per cell: the world's albedo averaged over the cell.
     truth: Vec<[f64; 3]>,
 }
 
+/// The day with the light known, the tower's materials flattened to their
+/// mean albedo unless `textured`.
 fn recover_day(textured: bool) -> Day {
-    let w = world(textured);
-    let mut photos = Vec::new();
-    for (i, t) in TRAINING.iter().enumerate() {
-        for (j, v) in VIEWS.iter().enumerate() {
-            let r = rig(&w, v);
-            photos.push(Photo {
-                label: format!("{t} {v}"),
-                image: w.render(time(t), &r, &[], 100 + (i * 4 + j) as u64).unwrap(),
-                rig: r,
-                time: time(t),
-                mask: None,
-            });
-        }
+    let mut day = CampanileDay::load(SPP, 2).unwrap();
+    if !textured {
+        day.flatten_tower().unwrap();
     }
-    let days: Vec<_> = TRAINING
-        .iter()
-        .map(|t| (time(t), w.daylight(time(t)).unwrap().unwrap()))
-        .collect();
-    let lights: Vec<Illumination> = days.iter().map(|(t, d)| Illumination { time: *t, sky: d }).collect();
-    let targets: Vec<usize> = TOWER.iter().map(|s| w.scene.scene.surface_index(s).unwrap()).collect();
+    let times = training_times();
+    let photos = day.photographs(&times, WIDTH, HEIGHT).unwrap();
+    let days = day.daylights(&times).unwrap();
     let settings = ReflectanceSettings {
         spacing_m: SPACING_M,
         ..ReflectanceSettings::default()
     };
-    let (refl, _) = recover_reflectance(&w.scene.scene, &targets, &photos, &lights, &settings).unwrap();
-    let truth = (0..refl.grid.cells.len())
-        .map(|c| {
-            let pts = refl.grid.cell_points(&w.scene.scene, c, TRUTH_PER_SIDE);
-            let tri = refl.grid.cells[c].triangle;
-            let mut s = [0.0; 3];
-            for p in &pts {
-                let a = w.pseudo_albedos(tri, [p.x, p.y, p.z]).sun;
-                for ch in 0..3 {
-                    s[ch] += a[ch] / pts.len() as f64;
-                }
-            }
-            s
-        })
-        .collect();
-    Day { world: w, refl, truth }
+    let (refl, _) = recover_reflectance(
+        &day.world.scene.scene,
+        &day.targets().unwrap(),
+        &photos,
+        &illuminations(&days),
+        &settings,
+    )
+    .unwrap();
+    let truth = day.cell_truth(&refl.grid, TRUTH_PER_SIDE);
+    Day { day, refl, truth }
 }
 
 fn flat_day() -> &'static Day {
@@ -214,15 +129,15 @@ fn with_the_light_known_pseudo_albedos_are_within_two_percent() {
 #[test]
 fn with_the_light_known_the_held_out_time_is_within_three_percent() {
     let day = flat_day();
-    let w = &day.world;
-    let held = w.daylight(time(HELD_OUT)).unwrap().unwrap();
+    let w = &day.day.world;
+    let held = day.day.daylight(held_out_time()).unwrap();
     let light = Illumination {
-        time: time(HELD_OUT),
+        time: held_out_time(),
         sky: &held,
     };
-    for v in ["view-se", "view-sw", "view-nw"] {
-        let r = rig(w, v);
-        let reference = w.render(time(HELD_OUT), &r, &[], 7).unwrap();
+    for v in HELD_OUT_VIEWS {
+        let r = day.day.view_rig(v, WIDTH, HEIGHT).unwrap();
+        let reference = w.render(held_out_time(), &r, &[], 7).unwrap();
         let (image, _) = rerender(&w.scene.scene, &day.refl, &r, &light, &RerenderSettings::default());
         let mask = target_mask(&w.scene.scene, &day.refl, &r);
         let block = block_relative_rmse(&image, &reference, &mask, 4);
@@ -243,7 +158,7 @@ fn corner_cells_are_not_polluted_by_the_next_wall() {
     let mut which = 0;
     for (c, t) in day.truth.iter().enumerate() {
         let e = &day.refl.cells[c];
-        let surface = &day.world.scene.scene.surfaces()[day.refl.grid.cells[c].surface];
+        let surface = &day.day.world.scene.scene.surfaces()[day.refl.grid.cells[c].surface];
         if e.status == CellStatus::Unseen || !surface.ends_with("-face") {
             continue;
         }
@@ -290,21 +205,11 @@ fn the_textured_day_with_the_light_known() {
         quantile(&mut sun, 0.5),
         quantile(&mut sun, 0.95),
     );
-    let mut corr = Vec::new();
-    for name in ["south-face", "east-face", "west-face"] {
-        let s = day.world.scene.scene.surface_index(name).unwrap();
-        let ids: Vec<usize> = (0..day.truth.len())
-            .filter(|&c| day.refl.grid.cells[c].surface == s && day.refl.cells[c].status != CellStatus::Unseen)
-            .collect();
-        let a: Vec<f64> = ids.iter().map(|&c| day.refl.cells[c].rho_se[1]).collect();
-        let b: Vec<f64> = ids.iter().map(|&c| day.truth[c][1]).collect();
-        let n = a.len() as f64;
-        let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-        let cov: f64 = a.iter().zip(&b).map(|(x, y)| (x - ma) * (y - mb)).sum();
-        let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
-        let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
-        corr.push(cov / (va * vb).sqrt());
-    }
+    let scene = &day.day.world.scene.scene;
+    let corr: Vec<f64> = ["south-face", "east-face", "west-face"]
+        .iter()
+        .map(|name| texture_correlation(&day.refl, &day.truth, scene.surface_index(name).unwrap()))
+        .collect();
     eprintln!(
         "textured: ρ_se median {ms:.4} p95 {ps:.4}; ρ_sun median {mu:.4} p95 {pu:.4}; texture correlation S/E/W {corr:.3?}"
     );

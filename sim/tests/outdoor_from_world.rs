@@ -6,120 +6,33 @@
 // Channel loops index several arrays at once; they read better with an index.
 #![allow(clippy::needless_range_loop)]
 
+use std::sync::OnceLock;
+
 use campanile_process::error_figures::{block_relative_rmse, quantile};
 use campanile_process::outdoor::rerender::{relative_rmse, target_mask};
 use campanile_process::outdoor::{
     CellStatus, Illumination, Photo, Reflectance, ReflectanceSettings, RerenderSettings, recover_reflectance, rerender,
 };
-use campanile_process::pose::HeadPose;
-use campanile_process::render::CameraRig;
-use campanile_process::sky::Daylight;
-use campanile_sim::world::{World, examples_dir, load_scene};
+use campanile_sim::world::campanile_day::{
+    CampanileDay, HELD_OUT_VIEWS, held_out_time, illuminations, texture_correlation, training_times,
+};
 use chrono::{DateTime, Utc};
 
 const WIDTH: usize = 128;
 const HEIGHT: usize = 96;
 
-fn station() -> campanile_config::Station {
-    campanile_config::document::load_station(&examples_dir().join("sim-station.ron"))
-        .unwrap()
-        .value
-}
-
-fn world() -> World {
-    let mut w = World::new(
-        &station(),
-        load_scene(&examples_dir().join("campanile-scene.ron")).unwrap(),
-    );
-    w.quality.samples_per_pixel = 16;
-    w.quality.max_bounces = 2;
-    w
-}
-
-/// The training triggers' times, from `campanile plan check examples/campanile-day.ron`.
-const TRAINING: [&str; 4] = [
-    "2026-08-29T15:48:00Z",
-    "2026-08-29T20:10:00Z",
-    "2026-08-29T22:42:00Z",
-    "2026-08-30T01:38:00Z",
-];
-const HELD_OUT: &str = "2026-08-29T20:30:00Z";
-
-fn time(s: &str) -> DateTime<Utc> {
-    s.parse().unwrap()
-}
-
-/// The camera at the scene's pose `name`.
-fn rig(w: &World, name: &str) -> CameraRig {
-    let station = station();
-    let pose = w.scene.description.pose(name).unwrap();
-    let (pan, tilt) = station.head.reach(pose.azimuth_deg, pose.elevation_deg).unwrap();
-    let head = HeadPose {
-        pan_rad: pan.to_radians(),
-        tilt_rad: tilt.to_radians(),
-    };
-    let (x, y, z) = pose.position_m;
-    w.rig(head, [x, y, z], WIDTH, HEIGHT)
-}
-
 /// Grid spacing of the tests, metres (about three pixels of the 128-px photos).
 const SPACING_M: f64 = 2.0;
 
-const VIEWS: [&str; 4] = ["view-se", "view-sw", "view-nw", "view-ne"];
-
-/// The tower's surfaces: the four faces, the pillars and the roof.
-fn targets(w: &World) -> Vec<usize> {
-    ["south-face", "east-face", "north-face", "west-face", "pillars", "roof"]
-        .iter()
-        .map(|s| w.scene.scene.surface_index(s).unwrap())
-        .collect()
+/// The day at 16 samples per pixel, 2 bounces, set up once for all tests of this file.
+fn day() -> &'static CampanileDay {
+    static DAY: OnceLock<CampanileDay> = OnceLock::new();
+    DAY.get_or_init(|| CampanileDay::load(16, 2).unwrap())
 }
 
-/// The world's photos of the tower from the four views at `times`.
-fn photos(w: &World, times: &[&str]) -> Vec<Photo> {
-    let mut out = Vec::new();
-    for (i, t) in times.iter().enumerate() {
-        for (j, v) in VIEWS.iter().enumerate() {
-            let r = rig(w, v);
-            let image = w.render(time(t), &r, &[], 100 + (i * 4 + j) as u64).unwrap();
-            out.push(Photo {
-                label: format!("{t} {v}"),
-                image,
-                rig: r,
-                time: time(t),
-                mask: None,
-            });
-        }
-    }
-    out
-}
-
-fn daylights(w: &World, times: &[&str]) -> Vec<(DateTime<Utc>, Daylight)> {
-    times
-        .iter()
-        .map(|t| (time(t), w.daylight(time(t)).unwrap().unwrap()))
-        .collect()
-}
-
-/// The true pseudo-albedo of each cell: the mean over the cell of the
-/// world's per-point truth (ρ_sun = ρ_se in the simulator).
-fn truth(w: &World, refl: &Reflectance) -> Vec<[f64; 3]> {
-    (0..refl.grid.cells.len())
-        .map(|c| {
-            // 64 × 64 sub-samples: the 5 cm mortar joints alias with an
-            // 8 × 8 grid (±3% in the truth itself, tests/outdoor_error_budget.rs).
-            let pts = refl.grid.cell_points(&w.scene.scene, c, 64);
-            let tri = refl.grid.cells[c].triangle;
-            let mut s = [0.0; 3];
-            for p in &pts {
-                let a = w.pseudo_albedos(tri, [p.x, p.y, p.z]).sun;
-                for ch in 0..3 {
-                    s[ch] += a[ch] / pts.len() as f64;
-                }
-            }
-            s
-        })
-        .collect()
+/// The true pseudo-albedo of each cell (64 × 64 points per cell).
+fn truth(refl: &Reflectance) -> Vec<[f64; 3]> {
+    day().cell_truth(&refl.grid, 64)
 }
 
 /// Relative errors of ρ_sun and ρ_se per cell and channel (cells with `keep`).
@@ -137,26 +50,10 @@ fn errors(refl: &Reflectance, truth: &[[f64; 3]], keep: impl Fn(usize) -> bool) 
     (sun, se)
 }
 
-/// Correlation between recovered and true albedos over the cells of one
-/// surface (green channel): the texture, not just the mean.
-fn texture_correlation(refl: &Reflectance, truth: &[[f64; 3]], surface: usize) -> f64 {
-    let ids: Vec<usize> = (0..truth.len())
-        .filter(|&c| refl.grid.cells[c].surface == surface && refl.cells[c].status != CellStatus::Unseen)
-        .collect();
-    let a: Vec<f64> = ids.iter().map(|&c| refl.cells[c].rho_se[1]).collect();
-    let b: Vec<f64> = ids.iter().map(|&c| truth[c][1]).collect();
-    let n = a.len() as f64;
-    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-    let cov: f64 = a.iter().zip(&b).map(|(x, y)| (x - ma) * (y - mb)).sum();
-    let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
-    let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
-    cov / (va * vb).sqrt()
-}
-
 /// The training day's photos, rendered once for all tests of this file.
-fn training_photos(w: &World) -> &'static [Photo] {
-    static PHOTOS: std::sync::OnceLock<Vec<Photo>> = std::sync::OnceLock::new();
-    PHOTOS.get_or_init(|| photos(w, &TRAINING))
+fn training_photos() -> &'static [Photo] {
+    static PHOTOS: OnceLock<Vec<Photo>> = OnceLock::new();
+    PHOTOS.get_or_init(|| day().photographs(&training_times(), WIDTH, HEIGHT).unwrap())
 }
 
 fn median_signed(refl: &Reflectance, truth: &[[f64; 3]], surface: usize, sun: bool) -> f64 {
@@ -170,16 +67,22 @@ fn median_signed(refl: &Reflectance, truth: &[[f64; 3]], surface: usize, sun: bo
     quantile(&mut v, 0.5)
 }
 
-fn recover(w: &World, photos: &[Photo], times: &[&str]) -> Reflectance {
-    let days = daylights(w, times);
-    let lights: Vec<Illumination> = days.iter().map(|(t, d)| Illumination { time: *t, sky: d }).collect();
+fn recover(photos: &[Photo], times: &[DateTime<Utc>]) -> Reflectance {
+    let days = day().daylights(times).unwrap();
     let settings = ReflectanceSettings {
         spacing_m: SPACING_M,
         ..ReflectanceSettings::default()
     };
-    recover_reflectance(&w.scene.scene, &targets(w), photos, &lights, &settings)
-        .unwrap()
-        .0
+    let scene = &day().world.scene.scene;
+    recover_reflectance(
+        scene,
+        &day().targets().unwrap(),
+        photos,
+        &illuminations(&days),
+        &settings,
+    )
+    .unwrap()
+    .0
 }
 
 /// Thesis §5.4 on the simulated day: pseudo-albedos from the four training
@@ -197,10 +100,10 @@ fn recover(w: &World, photos: &[Photo], times: &[&str]) -> Reflectance {
 /// between two 64-spp seeds is 4–9% per pixel, 1–2% per block.
 #[test]
 fn pseudo_albedos_and_the_held_out_time_match_the_world() {
-    let w = world();
-    let photos = training_photos(&w);
-    let refl = recover(&w, photos, &TRAINING);
-    let tr = truth(&w, &refl);
+    let w = &day().world;
+    let photos = training_photos();
+    let refl = recover(photos, &training_times());
+    let tr = truth(&refl);
     let solved = |c: usize| refl.cells[c].status == CellStatus::Solved;
     // 688 of 927 seen cells are solved alone since pixels straddling two
     // faces are dropped and grazing-sun cells are filled (973 before, many
@@ -234,16 +137,16 @@ fn pseudo_albedos_and_the_held_out_time_match_the_world() {
     }
 
     // The held-out time, with the true sun and sky.
-    let held = daylights(&w, &[HELD_OUT]);
+    let held = day().daylight(held_out_time()).unwrap();
     let light = Illumination {
-        time: held[0].0,
-        sky: &held[0].1,
+        time: held_out_time(),
+        sky: &held,
     };
     let mut fine = w.clone();
     fine.quality.samples_per_pixel = 64;
-    for v in ["view-se", "view-sw", "view-nw"] {
-        let r = rig(&w, v);
-        let reference = fine.render(time(HELD_OUT), &r, &[], 7).unwrap();
+    for v in HELD_OUT_VIEWS {
+        let r = day().view_rig(v, WIDTH, HEIGHT).unwrap();
+        let reference = fine.render(held_out_time(), &r, &[], 7).unwrap();
         let (image, _) = rerender(&w.scene.scene, &refl, &r, &light, &RerenderSettings::default());
         let mask = target_mask(&w.scene.scene, &refl, &r);
         let pixel = relative_rmse(&image, &reference, &mask).unwrap();
@@ -259,11 +162,10 @@ fn pseudo_albedos_and_the_held_out_time_match_the_world() {
 /// neighbours: within 10% of the truth (median), ρ_se as good as elsewhere.
 #[test]
 fn a_face_never_sunlit_is_reported_and_filled() {
-    let w = world();
-    let photos: Vec<Photo> = training_photos(&w)[4..12].to_vec();
-    let times = &TRAINING[1..3];
-    let refl = recover(&w, &photos, times);
-    let tr = truth(&w, &refl);
+    let w = &day().world;
+    let photos: Vec<Photo> = training_photos()[4..12].to_vec();
+    let refl = recover(&photos, &training_times()[1..3]);
+    let tr = truth(&refl);
     let north = w.scene.scene.surface_index("north-face").unwrap();
     let shaft = refl
         .grid
@@ -306,12 +208,11 @@ fn a_face_never_sunlit_is_reported_and_filled() {
 /// kept and the estimates stay as good as without it.
 #[test]
 fn a_photo_with_a_wrong_exposure_is_rejected() {
-    let w = world();
-    let mut photos: Vec<Photo> = training_photos(&w).to_vec();
+    let mut photos: Vec<Photo> = training_photos().to_vec();
     for v in photos[5].image.data.iter_mut() {
         *v *= 2.0;
     }
-    let refl = recover(&w, &photos, &TRAINING);
+    let refl = recover(&photos, &training_times());
     let flagged: Vec<usize> = (0..photos.len()).filter(|&k| refl.photos[k].outlier).collect();
     eprintln!(
         "flagged {flagged:?}; {:?}",
@@ -319,7 +220,7 @@ fn a_photo_with_a_wrong_exposure_is_rejected() {
     );
     assert_eq!(flagged, vec![5]);
     assert!(refl.photos[5].median_log_ratio > 0.4, "{:?}", refl.photos[5]);
-    let tr = truth(&w, &refl);
+    let tr = truth(&refl);
     let (mut sun, mut se) = errors(&refl, &tr, |c| refl.cells[c].status == CellStatus::Solved);
     let (ms, me) = (quantile(&mut sun, 0.5), quantile(&mut se, 0.5));
     assert!(ms < 0.08 && me < 0.08, "ρ_sun {ms}, ρ_se {me}");
@@ -330,10 +231,9 @@ fn a_photo_with_a_wrong_exposure_is_rejected() {
 /// at least 80% of the errors lie within three stated standard deviations.
 #[test]
 fn a_missing_time_degrades_with_stated_uncertainty() {
-    let w = world();
-    let photos: Vec<Photo> = training_photos(&w)[..12].to_vec();
-    let refl = recover(&w, &photos, &TRAINING[..3]);
-    let tr = truth(&w, &refl);
+    let photos: Vec<Photo> = training_photos()[..12].to_vec();
+    let refl = recover(&photos, &training_times()[..3]);
+    let tr = truth(&refl);
     let seen: Vec<usize> = (0..tr.len())
         .filter(|&c| refl.cells[c].status != CellStatus::Unseen)
         .collect();

@@ -8,7 +8,7 @@
 // Channel loops index several arrays at once; they read better with an index.
 #![allow(clippy::needless_range_loop)]
 
-use campanile_process::error_figures::quantile;
+use campanile_process::error_figures::{correlation, quantile};
 use campanile_process::outdoor::rerender::relative_rmse;
 use campanile_process::outdoor::zoom_albedo::{PixelFate, ZoomAlbedo};
 use campanile_process::outdoor::{
@@ -16,8 +16,9 @@ use campanile_process::outdoor::{
     zoom_albedo,
 };
 use campanile_process::render::CameraRig;
+use campanile_sim::world::World;
+use campanile_sim::world::campanile_day::{CampanileDay, TOWER, illuminations, training_times};
 use campanile_sim::world::zoom_truth::{cell_mean_reflectance, pixel_albedo_truth, zoom_rig};
-use campanile_sim::world::{World, examples_dir, load_scene};
 use chrono::{DateTime, Utc};
 
 const WIDTH: usize = 128;
@@ -32,23 +33,13 @@ const ZOOM: f64 = 10.0;
 const T0: &str = "2026-08-29T20:30:00Z";
 /// A new time to re-render at (15:42 PDT, the sun low in the south-west).
 const T1: &str = "2026-08-29T22:42:00Z";
-const TOWER: [&str; 6] = ["south-face", "east-face", "north-face", "west-face", "pillars", "roof"];
 
 fn time(s: &str) -> DateTime<Utc> {
     s.parse().unwrap()
 }
 
 fn world() -> World {
-    let station = campanile_config::document::load_station(&examples_dir().join("sim-station.ron"))
-        .unwrap()
-        .value;
-    let mut w = World::new(
-        &station,
-        load_scene(&examples_dir().join("campanile-scene.ron")).unwrap(),
-    );
-    w.quality.samples_per_pixel = SPP;
-    w.quality.max_bounces = 2;
-    w
+    CampanileDay::load(SPP, 2).unwrap().world
 }
 
 /// The grid over the tower and the world's true cell means as `ρ̃`.
@@ -77,15 +68,6 @@ struct Errors {
     high_corr: f64,
     low_corr: f64,
     pixels: usize,
-}
-
-fn correlation(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len() as f64;
-    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-    let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
-    let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
-    let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
-    cov / (va * vb).sqrt()
 }
 
 fn errors(zoom: &ZoomAlbedo, truth: &[Option<[f64; 3]>], keep: impl Fn(usize) -> bool) -> Errors {
@@ -155,10 +137,12 @@ const WALL: [f64; 3] = [0.0, -5.5, 40.0];
 
 /// Eq. (5.16) in isolation: with the world's true cell means as `ρ̃`
 /// (64-sample photo), the pixel pseudo-albedos follow the sub-cell brick
-/// texture. Measured over 12 288 pixels (green): median |error| 1.9%
-/// (ρ^sun and ρ^se), correlation with the truth 0.97; the interpolated
+/// texture. Measured over 12 288 pixels (green): median |error| 1.6%
+/// (ρ^sun and ρ^se), correlation with the truth 0.98; the interpolated
 /// cell means alone 9.1% and 0.14. Re-rendered at T1 against the world's
-/// 64-sample render: relative RMSE 3.8% against 13.5% from the grid.
+/// 64-sample render: relative RMSE 2.4% against 13.3% from the grid
+/// (1.9%, 0.97 and 3.8% before the simulator split paths at the first
+/// surface).
 #[test]
 fn eq_5_16_recovers_the_sub_cell_texture_from_true_cell_means() {
     let w = world();
@@ -193,9 +177,10 @@ fn eq_5_16_recovers_the_sub_cell_texture_from_true_cell_means() {
 /// edge are counted and keep `ρ̃`, windows near it average only their own
 /// sun status, and nothing is NaN. Measured (256-sample photo): 6 970 of
 /// 10 877 target pixels sunlit, 246 at the shadow edge, 1 669 windows cut
-/// to their status. Sunlit pixels: high-res median 2.4% (correlation 0.94)
-/// against 8.8% (0.17) for the cell means. Shadowed pixels: 6.6% (0.70)
-/// against 8.0% (0.15) — eq. (5.16)'s premise, a lighting smooth within a
+/// to their status. Sunlit pixels: high-res median 2.2% (correlation 0.94)
+/// against 8.8% (0.17) for the cell means. Shadowed pixels: 5.1% (0.75)
+/// against 8.0% (0.15; 6.6% and 0.70 before path splitting) — eq.
+/// (5.16)'s premise, a lighting smooth within a
 /// cell, fails in the recess: the sky seen past the pillars and roof and
 /// the light bounced off the sunlit part change within a metre. (At 64
 /// samples the shadowed pixels' noise makes it 10.3% (0.57), worse than the
@@ -295,57 +280,39 @@ fn no_target_is_an_error_and_bad_pixels_are_refused() {
 /// The whole chain: `ρ̃` recovered from the simulated day (four training
 /// times × four views, 128 × 96, 64 samples, the light known, as in
 /// `outdoor_error_budget.rs`), then eq. (5.16) on the zoom photo.
-/// Measured: high-res median 2.2% (correlation 0.96) against 8.8% (0.08)
+/// Measured: high-res median 1.6% (correlation 0.98) against 8.4% (0.14)
 /// for the recovered cells interpolated; re-rendered at T1, relative RMSE
-/// 3.7% against 13.5% (≈ 24 s in the dev profile).
+/// 2.1% against 13.3% (2.2%, 0.96 and 3.7% before path splitting; ≈ 24 s
+/// in the dev profile).
 #[test]
 fn eq_5_16_on_recovered_cell_albedos() {
     use campanile_process::outdoor::{ReflectanceSettings, recover_reflectance};
-    const TRAINING: [&str; 4] = [
-        "2026-08-29T15:48:00Z",
-        "2026-08-29T20:10:00Z",
-        "2026-08-29T22:42:00Z",
-        "2026-08-30T01:38:00Z",
-    ];
-    let w = world();
-    let station = campanile_config::document::load_station(&examples_dir().join("sim-station.ron"))
-        .unwrap()
-        .value;
-    let mut photos = Vec::new();
-    for (i, t) in TRAINING.iter().enumerate() {
-        for (j, v) in ["view-se", "view-sw", "view-nw", "view-ne"].iter().enumerate() {
-            let pose = w.scene.description.pose(v).unwrap();
-            let (pan, tilt) = station.head.reach(pose.azimuth_deg, pose.elevation_deg).unwrap();
-            let (x, y, z) = pose.position_m;
-            let head = campanile_process::pose::HeadPose {
-                pan_rad: pan.to_radians(),
-                tilt_rad: tilt.to_radians(),
-            };
-            let rig = w.rig(head, [x, y, z], WIDTH, HEIGHT);
-            photos.push(photo(&w, &rig, t, 100 + (i * 4 + j) as u64));
-        }
-    }
-    let days: Vec<_> = TRAINING
-        .iter()
-        .map(|t| (time(t), w.daylight(time(t)).unwrap().unwrap()))
-        .collect();
-    let lights: Vec<Illumination> = days.iter().map(|(t, d)| Illumination { time: *t, sky: d }).collect();
-    let targets: Vec<usize> = TOWER.iter().map(|s| w.scene.scene.surface_index(s).unwrap()).collect();
+    let day = CampanileDay::load(SPP, 2).unwrap();
+    let w = &day.world;
+    let photos = day.photographs(&training_times(), WIDTH, HEIGHT).unwrap();
+    let days = day.daylights(&training_times()).unwrap();
     let settings = ReflectanceSettings {
         spacing_m: SPACING_M,
         ..ReflectanceSettings::default()
     };
-    let (refl, _) = recover_reflectance(&w.scene.scene, &targets, &photos, &lights, &settings).unwrap();
+    let (refl, _) = recover_reflectance(
+        &w.scene.scene,
+        &day.targets().unwrap(),
+        &photos,
+        &illuminations(&days),
+        &settings,
+    )
+    .unwrap();
 
-    let rig = zoom_rig(&w, POSITION, WALL, ZOOM, WIDTH, HEIGHT);
-    let zoom = zoom_of(&w, &rig, &refl, T0, 1);
-    let truth = pixel_albedo_truth(&w, &refl.grid, &rig, 4);
+    let rig = zoom_rig(w, POSITION, WALL, ZOOM, WIDTH, HEIGHT);
+    let zoom = zoom_of(w, &rig, &refl, T0, 1);
+    let truth = pixel_albedo_truth(w, &refl.grid, &rig, 4);
     let e = errors(&zoom, &truth, |_| true);
     eprintln!(
         "recovered ρ̃: {} pixels: high-res median {:.4}, correlation {:.3}; low-res median {:.4}, correlation {:.3}",
         e.pixels, e.high_median, e.high_corr, e.low_median, e.low_corr
     );
-    let (rl, rh) = rerender_errors(&w, &refl, &zoom, &rig);
+    let (rl, rh) = rerender_errors(w, &refl, &zoom, &rig);
     eprintln!("recovered ρ̃, re-rendered at {T1}: relative RMSE {rh:.4} (high-res) against {rl:.4} (grid)");
     assert!(e.high_median <= 0.04 && e.high_median <= 0.5 * e.low_median);
     assert!(e.high_corr >= 0.85);

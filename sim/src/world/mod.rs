@@ -6,6 +6,7 @@
 //! (CIE clear sky per channel, extinction, reddening, optional clouds).
 //! Everything the solvers should recover is exposed here as ground truth.
 
+pub mod campanile_day;
 pub mod cube_room;
 pub mod igi_photograph;
 pub mod rig;
