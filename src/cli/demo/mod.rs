@@ -151,7 +151,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
 
     // Outdoors: pseudo-albedos, the held-out time, the day.
     eprintln!("recovering pseudo-albedos and re-rendering the held-out time …");
-    let outdoor = process::outdoor_stages(&processed)?;
+    let outdoor = process::outdoor_stages(&processed, &Default::default())?;
     let mut albedo_figures = None;
     let mut held_out_rmse = Vec::new();
     if let Some(o) = &outdoor {

@@ -119,6 +119,21 @@ pub struct ProcessArgs {
     /// radiosity cells, rays and ΔS iterations).
     #[arg(long)]
     quick: bool,
+    /// Outdoor sessions: the side of the pseudo-albedo grid's cells on the
+    /// scene's surfaces, metres (thesis §5.4). Finer cells see fewer pixels
+    /// of each photo (noisier); coarser ones average light that varies
+    /// over the cell. BENCHMARKS.md sweeps it.
+    #[arg(long, value_name = "M", default_value_t = campanile_process::outdoor::ReflectanceSettings::default().spacing_m, value_parser = grid_spacing)]
+    grid_spacing: f64,
+}
+
+fn grid_spacing(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
+    if (0.1..=50.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{v} m: expected a cell side in [0.1, 50] m"))
+    }
 }
 
 fn room_scale(s: &str) -> Result<f64, String> {
@@ -243,7 +258,11 @@ pub fn run(args: ProcessArgs) -> Result<()> {
         Some((args.env_rows, args.env_cols)),
     )?;
     write_outputs(&processed, &out)?;
-    let outdoor = outdoor_stages(&processed)?;
+    let settings = campanile_process::outdoor::ReflectanceSettings {
+        spacing_m: args.grid_spacing,
+        ..Default::default()
+    };
+    let outdoor = outdoor_stages(&processed, &settings)?;
     let mut sections = stage_sections(&processed, None)?;
     if let Some(o) = &outdoor {
         write_outdoor(o, &out)?;
@@ -505,7 +524,10 @@ pub struct Outdoor {
 /// ground, the landscape), which light the targets as environment, take the
 /// albedo the scene's materials give them (through the simulator's scene
 /// loader, the only loader of scene files with materials so far).
-pub fn outdoor_stages(p: &Processed) -> Result<Option<Outdoor>> {
+pub fn outdoor_stages(
+    p: &Processed,
+    settings: &campanile_process::outdoor::ReflectanceSettings,
+) -> Result<Option<Outdoor>> {
     let Some(geometry) = p.inputs.geometry()? else {
         return Ok(None);
     };
@@ -519,11 +541,7 @@ pub fn outdoor_stages(p: &Processed) -> Result<Option<Outdoor>> {
     let scene = campanile_sim::world::from_description(description, &geometry)
         .with_context(|| format!("loading the scene geometry {}", geometry.display()))?;
     let b = bar(1, "pseudo-albedos");
-    let products = outdoor_stage::outdoor(
-        p,
-        &scene.scene,
-        &campanile_process::outdoor::ReflectanceSettings::default(),
-    )?;
+    let products = outdoor_stage::outdoor(p, &scene.scene, settings)?;
     b.finish_and_clear();
     Ok(Some(Outdoor { scene, products }))
 }
@@ -557,6 +575,7 @@ pub fn write_outdoor(o: &Outdoor, out: &Path) -> Result<()> {
         .map(|c| serde_json::json!({"photo": c.label, "observations": c.observations, "trimmed_mean_log_ratio": c.median_log_ratio, "outlier": c.outlier}))
         .collect();
     let json = serde_json::json!({
+        "grid_spacing_m": refl.grid.spacing_m,
         "cells": refl.cells.len(),
         "photos": photos,
         "pixels": {"used": refl.sampling.used, "shadow_edge": refl.sampling.shadow_edge, "mirror": refl.sampling.mirror, "grazing": refl.sampling.grazing, "invalid": refl.sampling.invalid, "mixed": refl.sampling.mixed},
