@@ -99,7 +99,7 @@ fn photo_of(p: &Processed, g: &MergedGroup, time: DateTime<Utc>) -> Photo {
 }
 
 /// 4×4-block relative RMSE over blocks with at least half their pixels in the mask.
-fn block_rmse(a: &RadianceImage, b: &RadianceImage, mask: &[bool], k: usize) -> Option<f64> {
+pub fn block_rmse(a: &RadianceImage, b: &RadianceImage, mask: &[bool], k: usize) -> Option<f64> {
     let (mut num, mut den) = (0.0, 0.0);
     for by in 0..a.height / k {
         for bx in 0..a.width / k {
