@@ -99,6 +99,82 @@ fn true_reflectance(scene: &Scene, refl: &Reflectance, world: &World) -> Reflect
     out
 }
 
+/// The rig of held-out view `g`, as the stage re-rendered it.
+fn rig_of(p: &Processed, g: &campanile_process::pipeline::MergedGroup) -> CameraRig {
+    CameraRig {
+        pinhole: g.pinhole,
+        mount: p.optics.mount,
+        head: g.head,
+        position: Vector3::from(g.position_m),
+        width: g.map.width,
+        height: g.map.height,
+    }
+}
+
+/// The simulator's render of `rig` at `time` with `spp` paths per pixel.
+fn simulate(
+    world: &World,
+    rig: &CameraRig,
+    time: chrono::DateTime<chrono::Utc>,
+    spp: u32,
+    bounces: u32,
+    seed: u64,
+) -> Result<RadianceImage> {
+    let daylight = world
+        .daylight(time)
+        .map_err(|e| anyhow!("{e}"))?
+        .ok_or_else(|| anyhow!("the world has no daylight"))?;
+    let lighting = campanile_process::render::Lighting {
+        sky: Some(&daylight),
+        points: &[],
+        spheres: &[],
+    };
+    Ok(render(
+        &world.scene.scene,
+        rig,
+        &lighting,
+        &RenderSettings {
+            samples_per_pixel: spp,
+            max_bounces: bounces,
+            seed,
+            ..RenderSettings::default()
+        },
+    ))
+}
+
+/// The floor of the held-out comparison: the relative RMSE (per pixel, per
+/// 4 × 4 block, over the comparison's mask) of one simulated photograph's
+/// Monte Carlo noise at the capture's `photo_spp` and `bounces`, from two
+/// renders of each held-out view with other seeds (their difference / √2).
+/// A real camera has no such noise; no re-render can beat it here.
+pub fn photo_floor(p: &Processed, o: &Outdoor, world: &World, photo_spp: u32, bounces: u32) -> Result<Vec<Term>> {
+    o.products
+        .held_out
+        .iter()
+        .map(|v| {
+            let g = p
+                .merged
+                .iter()
+                .find(|g| g.key == v.label)
+                .ok_or_else(|| anyhow!("held-out view {} not among the merged groups", v.label))?;
+            let rig = rig_of(p, g);
+            let a = simulate(world, &rig, g.time, photo_spp, bounces, 0xA11CE)?;
+            let b = simulate(world, &rig, g.time, photo_spp, bounces, 0xB0B)?;
+            Ok(term(
+                &v.label,
+                &format!("photo noise: two {photo_spp}-spp simulator renders, /√2"),
+                &a,
+                &b,
+                &v.mask,
+                std::f64::consts::FRAC_1_SQRT_2,
+            ))
+        })
+        .collect()
+}
+
+/// Per view, the least-squares gauge of the HDR map against the simulator's radiance.
+pub type Gauges = Vec<(String, f64)>;
+
 /// The budget of every held-out view. `photo_spp` and `bounces` are the
 /// capture's; `reference_spp` the reference's samples per pixel.
 pub fn budget(
@@ -108,7 +184,7 @@ pub fn budget(
     photo_spp: u32,
     bounces: u32,
     reference_spp: u32,
-) -> Result<(Vec<Term>, Vec<(String, f64)>)> {
+) -> Result<(Vec<Term>, Gauges)> {
     let scene = &o.scene.scene;
     let refl = &o.products.reflectance;
     let truth_refl = true_reflectance(scene, refl, world);
@@ -120,40 +196,23 @@ pub fn budget(
             .iter()
             .find(|g| g.key == v.label)
             .ok_or_else(|| anyhow!("held-out view {} not among the merged groups", v.label))?;
-        let rig = CameraRig {
-            pinhole: g.pinhole,
-            mount: p.optics.mount,
-            head: g.head,
-            position: Vector3::from(g.position_m),
-            width: g.map.width,
-            height: g.map.height,
-        };
+        let rig = rig_of(p, g);
         let daylight = world
             .daylight(g.time)
             .map_err(|e| anyhow!("{e}"))?
             .ok_or_else(|| anyhow!("the world has no daylight"))?;
-        let lighting = campanile_process::render::Lighting {
-            sky: Some(&daylight),
-            points: &[],
-            spheres: &[],
-        };
-        let sim = |spp: u32, seed: u64| {
-            render(
-                &world.scene.scene,
-                &rig,
-                &lighting,
-                &RenderSettings {
-                    samples_per_pixel: spp,
-                    max_bounces: bounces,
-                    seed,
-                    ..RenderSettings::default()
-                },
-            )
-        };
+        let sim = |spp: u32, seed: u64| simulate(world, &rig, g.time, spp, bounces, seed);
         let mask = &v.mask;
         let name = v.label.as_str();
-        terms.push(term(name, "reported: re-render (predicted light) vs HDR photo", &v.rendered, &v.measured, mask, 1.0));
-        let (a, b) = (sim(photo_spp, 0xA11CE), sim(photo_spp, 0xB0B));
+        terms.push(term(
+            name,
+            "reported: re-render (predicted light, photos' texture) vs HDR photo",
+            &v.rendered,
+            &v.measured,
+            mask,
+            1.0,
+        ));
+        let (a, b) = (sim(photo_spp, 0xA11CE)?, sim(photo_spp, 0xB0B)?);
         terms.push(term(
             name,
             &format!("photo noise: two {photo_spp}-spp simulator renders, /√2"),
@@ -162,7 +221,7 @@ pub fn budget(
             mask,
             std::f64::consts::FRAC_1_SQRT_2,
         ));
-        let reference = sim(reference_spp, 0xC0FFEE);
+        let reference = sim(reference_spp, 0xC0FFEE)?;
         let s = gauge(&v.measured, &reference, mask);
         gauges.push((name.to_owned(), s));
         let gauge_ref = scaled(&reference, s);
@@ -176,8 +235,29 @@ pub fn budget(
         ));
         terms.push(term(
             name,
-            "re-render (predicted light) vs reference × gauge",
+            "re-render (predicted light, photos' texture) vs reference × gauge",
             &v.rendered,
+            &gauge_ref,
+            mask,
+            1.0,
+        ));
+        let (grid_only, _) = rerender(
+            scene,
+            refl,
+            &rig,
+            &Illumination {
+                time: g.time,
+                sky: &predicted_sky(
+                    &p.light,
+                    &sun_position(g.time, &p.optics.observer, p.optics.delta_t_s).map_err(|e| anyhow!("{e}"))?,
+                )?,
+            },
+            &RerenderSettings::default(),
+        );
+        terms.push(term(
+            name,
+            "re-render (predicted light, grid alone) vs reference × gauge",
+            &grid_only,
             &gauge_ref,
             mask,
             1.0,
@@ -206,35 +286,40 @@ pub fn budget(
             mask,
             1.0,
         ));
-        if let Some(light) = p.light.iter().find(|l| l.occurrence == g.occurrence) {
-            if let Ok(mut own) = measured_sky(light) {
-                own.sun_direction = sun.direction();
-                let (r, _) = rerender(
-                    scene,
-                    refl,
-                    &rig,
-                    &Illumination {
-                        time: g.time,
-                        sky: &own,
-                    },
-                    &RerenderSettings::default(),
-                );
-                terms.push(term(
-                    name,
-                    "re-render (held-out time's measured light) vs reference × gauge",
-                    &r,
-                    &gauge_ref,
-                    mask,
-                    1.0,
-                ));
-            }
+        if let Some(Ok(mut own)) = p.light.iter().find(|l| l.occurrence == g.occurrence).map(measured_sky) {
+            own.sun_direction = sun.direction();
+            let (r, _) = rerender(
+                scene,
+                refl,
+                &rig,
+                &Illumination {
+                    time: g.time,
+                    sky: &own,
+                },
+                &RerenderSettings::default(),
+            );
+            terms.push(term(
+                name,
+                "re-render (held-out time's measured light) vs reference × gauge",
+                &r,
+                &gauge_ref,
+                mask,
+                1.0,
+            ));
         }
         let true_light = Illumination {
             time: g.time,
             sky: &daylight,
         };
         let (r, _) = rerender(scene, refl, &rig, &true_light, &RerenderSettings::default());
-        terms.push(term(name, "re-render (true light) vs reference", &r, &reference, mask, 1.0));
+        terms.push(term(
+            name,
+            "re-render (true light) vs reference",
+            &r,
+            &reference,
+            mask,
+            1.0,
+        ));
         let (r, _) = rerender(scene, &truth_refl, &rig, &true_light, &RerenderSettings::default());
         terms.push(term(
             name,
@@ -271,6 +356,42 @@ pub fn section(terms: &[Term], gauges: &[(String, f64)]) -> Section {
                         t.term.clone(),
                         format!("{:.2}%", 100.0 * t.pixel),
                         format!("{:.2}%", 100.0 * t.block),
+                    ]
+                })
+                .collect(),
+        }],
+        figures: Vec::new(),
+    }
+}
+
+/// The held-out comparison beside its floor, as a report section.
+pub fn floor_section(o: &Outdoor, floor: &[Term]) -> Section {
+    Section {
+        title: "Held-out comparison against its floor".into(),
+        paragraphs: vec![
+            "The floor is one simulated photograph's own Monte Carlo noise (two renders of the view with other seeds at the capture's samples per pixel, their difference / √2), over the comparison's mask: the simulator's artefact, which a real camera does not have, and which no re-render can beat.".into(),
+        ],
+        tables: vec![Table {
+            caption: "Relative RMSE of the re-render against the HDR photograph, and the floor".into(),
+            header: vec![
+                "view".into(),
+                "re-render, per pixel".into(),
+                "floor, per pixel".into(),
+                "re-render, per 4×4 block".into(),
+                "floor, per 4×4 block".into(),
+            ],
+            rows: o
+                .products
+                .held_out
+                .iter()
+                .zip(floor)
+                .map(|(v, f)| {
+                    vec![
+                        v.label.clone(),
+                        format!("{:.2}%", 100.0 * v.rmse_pixel),
+                        format!("{:.2}%", 100.0 * f.pixel),
+                        format!("{:.2}%", 100.0 * v.rmse_block),
+                        format!("{:.2}%", 100.0 * f.block),
                     ]
                 })
                 .collect(),

@@ -70,6 +70,9 @@ struct Figures {
     albedo_sun_median: Option<f64>,
     albedo_sun_p95: Option<f64>,
     held_out_rmse_pixel_block: Vec<(f64, f64)>,
+    /// Per held-out view, the floor: one simulated photograph's own Monte
+    /// Carlo noise (per pixel, per 4 × 4 block) over the same mask.
+    held_out_floor_pixel_block: Vec<(f64, f64)>,
 }
 
 /// Parses a `capture` command line, as the user would type it.
@@ -167,6 +170,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
     let outdoor = process::outdoor_stages(&processed)?;
     let mut albedo_figures = None;
     let mut held_out_rmse = Vec::new();
+    let mut held_out_floor = Vec::new();
     if let Some(o) = &outdoor {
         process::write_outdoor(o, &products)?;
         let truth_albedo = |triangle: usize, point: [f64; 3]| world.pseudo_albedos(triangle, point).sky_environment;
@@ -180,6 +184,10 @@ pub fn run(args: DemoArgs) -> Result<()> {
             .iter()
             .map(|v| (v.rmse_pixel, v.rmse_block))
             .collect();
+        // The floor: the held-out photographs' own noise (a real camera has none).
+        let floor = held_out_budget::photo_floor(&processed, o, &world, spp.parse()?, 3)?;
+        held_out_floor = floor.iter().map(|t| (t.pixel, t.block)).collect();
+        sections.push(held_out_budget::floor_section(o, &floor));
         if args.held_out_budget {
             let t = Instant::now();
             let (terms, gauges) = held_out_budget::budget(&processed, o, &world, spp.parse()?, 3, 64)?;
@@ -251,6 +259,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
         albedo_sun_median: albedo_figures.map(|f| f.2),
         albedo_sun_p95: albedo_figures.map(|f| f.3),
         held_out_rmse_pixel_block: held_out_rmse,
+        held_out_floor_pixel_block: held_out_floor,
     };
     let json = serde_json::to_vec_pretty(&figures)?;
     std::fs::write(args.out.join("demo-figures.json"), json)
