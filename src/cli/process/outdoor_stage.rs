@@ -11,7 +11,7 @@ use campanile_config::scene::MaterialModel;
 use campanile_process::camera::image::RadianceImage;
 use campanile_process::outdoor::rerender::Reference;
 use campanile_process::outdoor::rerender::{relative_rmse, target_mask};
-use campanile_process::outdoor::texture_transfer::{TextureSource, texture_sources, transfer_texture};
+use campanile_process::outdoor::texture_transfer::{MIN_REFERENCES, TextureSource, texture_sources, transfer_texture};
 use campanile_process::outdoor::{
     Illumination, Photo, Reflectance, ReflectanceSettings, RerenderSettings, recover_reflectance, rerender,
 };
@@ -229,7 +229,7 @@ pub fn outdoor(p: &Processed, scene: &Scene, settings: &ReflectanceSettings) -> 
             same
         };
         let references = chosen.len();
-        let (rendered, _) = transfer_texture(scene, &reflectance, &rig, &grid_only, &chosen);
+        let (rendered, _) = transfer_texture(scene, &reflectance, &rig, &grid_only, &chosen, MIN_REFERENCES);
         let measured = RadianceImage {
             width: g.map.width,
             height: g.map.height,
