@@ -1,7 +1,9 @@
 //! Stages 3–5 of `process` outdoors: irradiance and pseudo-albedos from the
 //! training views under the measured light (thesis §5.2, §5.4), then the
-//! held-out views re-rendered under the *predicted* light (§5.5) and
-//! compared with what the camera saw.
+//! held-out views re-rendered under the *predicted* light (§5.5), with the
+//! texture finer than the grid that the training photographs show (§5.6.4,
+//! eq. 5.16, [`campanile_process::outdoor::texture_transfer`]), and
+//! compared with what the camera saw (the grid-only figure is reported too).
 
 use std::collections::BTreeMap;
 use std::time::Instant;
