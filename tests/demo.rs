@@ -100,7 +100,11 @@ fn the_quick_demo_runs_end_to_end_and_its_figures_match_the_simulator() {
     // it shows): the pseudo-albedo medians within 5% (measured 2.5% and
     // 2.1% against the truth averaged over 64×64 points per cell; 5.2% and
     // 3.7% at 2 samples without splitting) and the held-out views within
-    // 11% per 4×4 block (measured 8.5% and 8.7%; were 9.2% and 9.0%).
+    // 9.5% per 4×4 block (measured 8.5% and 8.4%; were 8.5% and 8.7%, 9.2%
+    // and 9.0%): with two training times the predicted light carries it
+    // (8.3–8.6% against a noise-free render; 2.5–2.9% under the held-out
+    // time's measured light, `demo --quick --held-out-budget`). The floor,
+    // one 4-spp photograph's own noise, is 2.2–2.4% per block.
     // Issue 9's 2% / 3% are met on less noisy photographs with the light
     // known (sim/tests/outdoor_error_budget.rs); BENCHMARKS "Path splitting
     // at the first surface".
@@ -111,10 +115,18 @@ fn the_quick_demo_runs_end_to_end_and_its_figures_match_the_simulator() {
     }
     let held = figures["held_out_rmse_pixel_block"].as_array().unwrap();
     assert!(!held.is_empty(), "no held-out view was compared");
-    for v in held {
+    let floor = figures["held_out_floor_pixel_block"].as_array().unwrap();
+    assert_eq!(floor.len(), held.len(), "one floor per held-out view");
+    for (v, f) in held.iter().zip(floor) {
         let block = v[1].as_f64().unwrap_or(f64::NAN);
-        println!("held-out view: {:.1}% per 4×4 block", 100.0 * block);
-        assert!(block < 0.11, "held-out block RMSE {block}");
+        let floor_block = f[1].as_f64().unwrap_or(f64::NAN);
+        println!(
+            "held-out view: {:.1}% per 4×4 block (floor {:.1}%)",
+            100.0 * block,
+            100.0 * floor_block
+        );
+        assert!(block < 0.095, "held-out block RMSE {block}");
+        assert!((0.01..0.04).contains(&floor_block), "held-out floor {floor_block}");
     }
 
     // `campanile process` on the demo's session, finding the scene's

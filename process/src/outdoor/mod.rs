@@ -37,6 +37,7 @@ pub mod observation;
 pub mod photo;
 pub mod photograph;
 pub mod rerender;
+pub mod texture_transfer;
 pub mod zoom_albedo;
 
 use chrono::{DateTime, Utc};

@@ -1,6 +1,7 @@
 //! `campanile demo`: the whole station on the simulated hardware, in one
 //! command: capture a day at the campanile, process it, write a report.
 
+mod held_out_budget;
 mod indoor;
 mod room;
 
@@ -43,6 +44,16 @@ pub struct DemoArgs {
     /// A smaller, faster run (two training times, fewer views): what the tests use.
     #[arg(long)]
     quick: bool,
+    /// Diagnostic: after the held-out comparison, measure where its error
+    /// comes from, term by term, against the simulator (renders the held-out
+    /// views again at many samples per pixel; adds a report section and
+    /// OUT/held-out-budget.json).
+    #[arg(long)]
+    held_out_budget: bool,
+    /// Development: reuse OUT/campanile-session if it is there instead of
+    /// capturing the day again (the capture is most of the demo's time).
+    #[arg(long)]
+    reuse_session: bool,
 }
 
 /// The demo's headline figures (besides campanile-processed/summary.json), for tests.
@@ -59,6 +70,9 @@ struct Figures {
     albedo_sun_median: Option<f64>,
     albedo_sun_p95: Option<f64>,
     held_out_rmse_pixel_block: Vec<(f64, f64)>,
+    /// Per held-out view, the floor: one simulated photograph's own Monte
+    /// Carlo noise (per pixel, per 4 × 4 block) over the same mask.
+    held_out_floor_pixel_block: Vec<(f64, f64)>,
 }
 
 /// Parses a `capture` command line, as the user would type it.
@@ -123,7 +137,9 @@ pub fn run(args: DemoArgs) -> Result<()> {
     // "Path splitting at the first surface"; 8 against 4 paths: medians
     // 1.9 % / 2.0 % against 2.3 % / 2.2 %, for 14 s more of a 133 s demo).
     let spp = if args.quick { "4" } else { "8" };
-    capture_simulated(&plan, &station, &session, &["--sim-samples", spp, "--sim-bounces", "3"])?;
+    if !(args.reuse_session && session.is_dir()) {
+        capture_simulated(&plan, &station, &session, &["--sim-samples", spp, "--sim-bounces", "3"])?;
+    }
     let capture_s = t.elapsed().as_secs_f64();
 
     // 3. Process.
@@ -154,6 +170,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
     let outdoor = process::outdoor_stages(&processed, &Default::default())?;
     let mut albedo_figures = None;
     let mut held_out_rmse = Vec::new();
+    let mut held_out_floor = Vec::new();
     if let Some(o) = &outdoor {
         process::write_outdoor(o, &products)?;
         let truth_albedo = |triangle: usize, point: [f64; 3]| world.pseudo_albedos(triangle, point).sky_environment;
@@ -167,6 +184,30 @@ pub fn run(args: DemoArgs) -> Result<()> {
             .iter()
             .map(|v| (v.rmse_pixel, v.rmse_block))
             .collect();
+        // The floor: the held-out photographs' own noise (a real camera has none).
+        let floor = held_out_budget::photo_floor(&processed, o, &world, spp.parse()?, 3)?;
+        held_out_floor = floor.iter().map(|t| (t.pixel, t.block)).collect();
+        sections.push(held_out_budget::floor_section(o, &floor));
+        if args.held_out_budget {
+            let t = Instant::now();
+            let (terms, gauges) = held_out_budget::budget(&processed, o, &world, spp.parse()?, 3, 64)?;
+            for term in &terms {
+                eprintln!(
+                    "held-out budget {:>12} {:<70} pixel {:6.2}%  block {:5.2}%",
+                    term.view,
+                    term.term,
+                    100.0 * term.pixel,
+                    100.0 * term.block
+                );
+            }
+            eprintln!("held-out budget gauges {gauges:?} ({:.1} s)", t.elapsed().as_secs_f64());
+            std::fs::write(
+                args.out.join("held-out-budget.json"),
+                serde_json::to_vec_pretty(&serde_json::json!({"terms": terms, "gauges": gauges}))?,
+            )
+            .with_context(|| format!("{}: cannot write", args.out.display()))?;
+            sections.push(held_out_budget::section(&terms, &gauges));
+        }
         for (stage, s) in &o.products.seconds {
             speed.tables[0].rows.push(vec![stage.clone(), format!("{s:.2}")]);
         }
@@ -218,6 +259,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
         albedo_sun_median: albedo_figures.map(|f| f.2),
         albedo_sun_p95: albedo_figures.map(|f| f.3),
         held_out_rmse_pixel_block: held_out_rmse,
+        held_out_floor_pixel_block: held_out_floor,
     };
     let json = serde_json::to_vec_pretty(&figures)?;
     std::fs::write(args.out.join("demo-figures.json"), json)

@@ -276,10 +276,12 @@ pub fn run(args: ProcessArgs) -> Result<()> {
         }
         for v in &o.products.held_out {
             println!(
-                "  held out {:<32} relative RMSE {:.2}% per pixel, {:.2}% per 4×4 block",
+                "  held out {:<32} relative RMSE {:.2}% per pixel, {:.2}% per 4×4 block ({} training photos' texture; grid alone {:.2}%)",
                 v.label,
                 100.0 * v.rmse_pixel,
-                100.0 * v.rmse_block
+                100.0 * v.rmse_block,
+                v.references,
+                100.0 * v.rmse_block_grid
             );
         }
     }
@@ -566,7 +568,7 @@ pub fn write_outdoor(o: &Outdoor, out: &Path) -> Result<()> {
         .products
         .held_out
         .iter()
-        .map(|v| serde_json::json!({"view": v.label, "rmse_pixel": v.rmse_pixel, "rmse_block_4x4": v.rmse_block}))
+        .map(|v| serde_json::json!({"view": v.label, "rmse_pixel": v.rmse_pixel, "rmse_block_4x4": v.rmse_block, "texture_references": v.references, "rmse_block_4x4_grid_only": v.rmse_block_grid}))
         .collect();
     let refl = &o.products.reflectance;
     let photos: Vec<serde_json::Value> = refl

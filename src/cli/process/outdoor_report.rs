@@ -152,6 +152,8 @@ pub fn held_out_section(out: &OutdoorProducts) -> Result<Section, ReportError> {
             "pixels compared".into(),
             "relative RMSE per pixel".into(),
             "per 4×4 block".into(),
+            "training photos lending texture (eq. 5.16)".into(),
+            "per 4×4 block, grid pseudo-albedos alone".into(),
         ],
         rows: Vec::new(),
     };
@@ -161,6 +163,8 @@ pub fn held_out_section(out: &OutdoorProducts) -> Result<Section, ReportError> {
             v.mask.iter().filter(|&&m| m).count().to_string(),
             format!("{:.2}%", 100.0 * v.rmse_pixel),
             format!("{:.2}%", 100.0 * v.rmse_block),
+            v.references.to_string(),
+            format!("{:.2}%", 100.0 * v.rmse_block_grid),
         ]);
         let (w, h) = (v.measured.width, v.measured.height);
         let mut lum: Vec<f64> = v.measured.data.chunks(3).map(|p| f64::from(p[1])).collect();
