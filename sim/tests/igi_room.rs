@@ -108,25 +108,25 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
         );
     }
     // Tolerances (percent; γ in degrees) stated from the measured run
-    // (ρd, ρs, αx, αy, γ): the shiny boards and floor, seen in their
-    // highlight views, are recovered; the matte paint and paper, whose
-    // flagged "highlights" a lobe cannot explain, stay diffuse; the metal
-    // sphere's faceted highlight falls in no view, so it must come back
-    // diffuse-only with that reason.
+    // (ρd, ρs, αx, αy, γ): the shiny boards, floor and spheres, seen in
+    // their highlight views, are recovered (the metal sphere's from the
+    // free-position views of `RoomIgi::mirror_cameras`: no scene pose sees
+    // its faceted highlight; the case of a highlight in no view is
+    // `igi_hard_cases.rs`'s); the matte paint and paper, whose flagged
+    // "highlights" a lobe cannot explain, stay diffuse.
     // Measured (photographs with 12 scattering events, BENCHMARKS.md):
-    // wood 3.7, 40.1, 2.2, 2.2; brushed 2.1, 0.7, 2.0, 5.2, 0.3°;
-    // plastic 3.0, 0.0, 2.3, 2.3; paint 1.2; paper 0.7.
+    // wood 3.3, 35.6, 2.6, 2.6; brushed 0.6, 1.9, 2.1, 3.3, 0.2°;
+    // plastic 3.2, 3.7, 1.4, 1.4; metal 3.4, 2.2, 2.3, 2.3; paint 0.4;
+    // paper 0.7 (before the metal's views: wood 3.7, 40.1, 2.2; brushed
+    // 2.1, 0.7, 2.0, 5.2, 0.3°; plastic 3.0, 0.0, 2.3; paint 1.2; the
+    // metal diffuse-only, its ρd 15 times the truth).
     let expect: [(&str, SurfaceModel, [f64; 5]); 6] = [
         ("wood", SurfaceModel::Isotropic, [20.0, 45.0, 8.0, 8.0, 0.1]),
         ("brushed", SurfaceModel::Anisotropic, [6.0, 8.0, 8.0, 6.0, 2.0]),
         ("plastic", SurfaceModel::Isotropic, [25.0, 20.0, 18.0, 18.0, 0.1]),
         ("paint", SurfaceModel::DiffuseOnly, [3.0, 0.0, 0.0, 0.0, 0.0]),
         ("paper", SurfaceModel::DiffuseOnly, [3.0, 0.0, 0.0, 0.0, 0.0]),
-        (
-            "metal",
-            SurfaceModel::DiffuseOnly,
-            [f64::INFINITY, 100.1, 0.0, 0.0, 0.0],
-        ),
+        ("metal", SurfaceModel::Isotropic, [8.0, 6.0, 6.0, 6.0, 0.1]),
     ];
     for (name, model, tol) in expect {
         let s = result.surfaces.iter().position(|r| r.name == name).unwrap();
@@ -143,8 +143,6 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
             }
         }
     }
-    let metal = result.surfaces.iter().find(|r| r.name == "metal").unwrap();
-    assert!(metal.reason.contains("mirror direction"), "{}", metal.reason);
     for name in ["paint", "paper"] {
         let r = result.surfaces.iter().find(|r| r.name == name).unwrap();
         assert!(r.reason.contains("of the diffuse fit's residual"), "{}", r.reason);
@@ -157,9 +155,12 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
         // lattice's interpolation error outweighs its nodes' noise (25 cm
         // with 256 rays: relit 3.72 %; 12.5 cm with 64: 3.44 % at half the
         // cost; 10 cm with 128: 3.09 % at four times it; BENCHMARKS.md).
+        // 1 cm texels: 2 cm ones mix the posters' 5 cm stripes (true
+        // texels' box means on 2 cm: paper 4.4 % per block; on 1 cm: 2.0 %).
         &AlbedoMapOptions {
             irradiance_rays: 64,
             irradiance_cell_m: 0.125,
+            texel_m: 0.01,
             ..AlbedoMapOptions::default()
         },
     )
@@ -176,6 +177,7 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
         &input,
         &result,
         &AlbedoMapOptions {
+            texel_m: 0.01,
             indirect: false,
             remove_specular: false,
             shrink_noise: false,
