@@ -127,11 +127,14 @@ fn igi_recovers_the_simulated_room_from_its_scene_file_and_relights_it() {
     let (a, b) = (block_average(&relit, 4), block_average(&sim, 4));
     let rmse = relative_rmse(&a, &b, |i| b.data[i * 3] < 20.0).unwrap();
     eprintln!("relit against the simulator: {:.2} % (4x4 blocks)", 100.0 * rmse);
-    // Measured 3.96 % (64 stratified paths per pixel and the albedo maps'
-    // noise shrinkage; 7.1 % before), against a reference of 32
-    // independent paths whose own noise is part of it; the goal of
-    // 3 % is not met yet (README).
-    assert!(rmse < 0.06, "{rmse}");
+    // Measured 3.57 % (64 stratified paths per pixel, the albedo maps'
+    // noise shrinkage aware of the gather's noise, ΔS traced along the
+    // lobe, 1 cm texels; 3.96 % before those three, 7.1 % before the
+    // shrinkage), against a reference of 32 independent paths whose own
+    // noise is part of it. The scene file has no view of the metal
+    // sphere's highlight, so its lobe stays unrecovered here
+    // (sim/tests/igi_room.rs meets 3 % with one: BENCHMARKS.md).
+    assert!(rmse < 0.05, "{rmse}");
 
     // `campanile render --igi` writes the same relit image.
     let rendered = dir.path().join("render");

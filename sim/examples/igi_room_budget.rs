@@ -27,8 +27,18 @@
 //! indirect samples per pixel from `SPP` (16), the albedo maps' rays per
 //! irradiance cell, texel and cell sides from `IRR_RAYS` (64), `TEXEL_MM`
 //! (20), `CELL_MM` (250), the maps' noise shrinkage from `SHRINK` (1:
-//! on); the relit render's and the reference's paths per pixel from
-//! `RELIT_SPP` and `REF_SPP` (32).
+//! on), the rays sampled from the lobe for ΔS from `SPEC_RAYS` (8; 0:
+//! the uniform-light approximation); the relit render's and the
+//! reference's paths per pixel from `RELIT_SPP` and `REF_SPP` (32).
+//!
+//! With `ORACLE` (a sum of bits), the maps' and the materials' share of the
+//! relit error, each input swapped for the truth through the same renders
+//! against the same reference: 1, maps of the true textures on 20, 10 and
+//! 5 mm texels (at each texel's centre, or its box mean); 2, the map as
+//! built with one surface's texels made true; 4, the scene the paths
+//! bounce through (true, recovered, or the map's means as ρd; each
+//! recovered lobe in turn among true BRDFs) and `PASSES` (2) rebuilds of
+//! the map gathered through the previous map's means.
 
 use std::time::Instant;
 
