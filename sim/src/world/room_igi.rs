@@ -82,9 +82,13 @@ impl RoomIgi {
 
     /// The solver's views of the room used by the test, the budget example
     /// and the helper's runs: a wide view at each scene pose (60°,
-    /// `width` × `height`), the highlight views (20°, `width / 2` square)
-    /// and the ceiling views (60° at [`CEILING_ELEVATION_DEG`]). The first
-    /// is the wide view `wide-sw`, the relighting check's camera.
+    /// `width` × `height`), the highlight views (20°, `width / 2` square),
+    /// the ceiling views (60° at [`CEILING_ELEVATION_DEG`]) and, last (so
+    /// that the earlier views' photographs keep their seeds), the
+    /// highlight views from free positions of [`RoomIgi::mirror_cameras`]
+    /// (the metal sphere's). The first is the wide view `wide-sw`, the
+    /// relighting check's camera. ([`RoomIgi::write_scene_file`] and the
+    /// demo's capture have no free-position views.)
     pub fn solver_cameras(&self, width: usize, height: usize) -> Vec<(String, ViewCamera)> {
         let mut cams = self.cameras(60.0, width, height);
         cams.extend(self.highlight_cameras(20.0, width / 2));
