@@ -87,8 +87,8 @@ impl RoomIgi {
     /// that the earlier views' photographs keep their seeds), the
     /// highlight views from free positions of [`RoomIgi::mirror_cameras`]
     /// (the metal sphere's). The first is the wide view `wide-sw`, the
-    /// relighting check's camera. ([`RoomIgi::write_scene_file`] and the
-    /// demo's capture have no free-position views.)
+    /// relighting check's camera. ([`RoomIgi::write_scene_file`] writes
+    /// the free-position views too, last; the demo's capture has none.)
     pub fn solver_cameras(&self, width: usize, height: usize) -> Vec<(String, ViewCamera)> {
         let mut cams = self.cameras(60.0, width, height);
         cams.extend(self.highlight_cameras(20.0, width / 2));
@@ -619,8 +619,8 @@ fn write_exr(image: &RadianceImage, path: &Path) -> Result<(), WorldError> {
 impl RoomIgi {
     /// Photographs the room and writes a `campanile igi` scene file
     /// (`dir/scene.ron`, the OBJ beside it, EXR images under `dir/images`):
-    /// every lamp on, seen from the scene's poses, the highlight views and
-    /// the ceiling views; each lamp given by three HDR images of its bulb (lit alone),
+    /// every lamp on, seen from the scene's poses, the highlight views,
+    /// the ceiling views and the free-position highlight views; each lamp given by three HDR images of its bulb (lit alone),
     /// from the first three pose positions, to be triangulated. Returns the
     /// scene file's path.
     pub fn write_scene_file(&self, dir: &Path, shot: &SceneFileShot) -> Result<std::path::PathBuf, WorldError> {
@@ -642,6 +642,7 @@ impl RoomIgi {
             shot.wide_px.0,
             shot.wide_px.1,
         ));
+        cams.extend(self.mirror_cameras(shot.highlight.0, shot.highlight.1, MIRROR_CAMERA_DISTANCE_M));
         let mut text = String::from(
             "// Written by the simulator: the room with every lamp on.\nIgiScene(\n    geometry: \"room.obj\",\n    surfaces: [\n",
         );
