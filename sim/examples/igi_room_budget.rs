@@ -27,8 +27,18 @@
 //! indirect samples per pixel from `SPP` (16), the albedo maps' rays per
 //! irradiance cell, texel and cell sides from `IRR_RAYS` (64), `TEXEL_MM`
 //! (20), `CELL_MM` (250), the maps' noise shrinkage from `SHRINK` (1:
-//! on); the relit render's and the reference's paths per pixel from
-//! `RELIT_SPP` and `REF_SPP` (32).
+//! on), the rays sampled from the lobe for ΔS from `SPEC_RAYS` (8; 0:
+//! the uniform-light approximation); the relit render's and the
+//! reference's paths per pixel from `RELIT_SPP` and `REF_SPP` (32).
+//!
+//! With `ORACLE` (a sum of bits), the maps' and the materials' share of the
+//! relit error, each input swapped for the truth through the same renders
+//! against the same reference: 1, maps of the true textures on 20, 10 and
+//! 5 mm texels (at each texel's centre, or its box mean); 2, the map as
+//! built with one surface's texels made true; 4, the scene the paths
+//! bounce through (true, recovered, or the map's means as ρd; each
+//! recovered lobe in turn among true BRDFs) and `PASSES` (2) rebuilds of
+//! the map gathered through the previous map's means.
 
 use std::time::Instant;
 
@@ -114,6 +124,7 @@ fn main() {
             irradiance_cell_m: env("CELL_MM", 250) as f64 * 1e-3,
             max_bounces: b,
             shrink_noise: env("SHRINK", 1) == 1,
+            specular_rays: env("SPEC_RAYS", 8) as u32,
             ..AlbedoMapOptions::default()
         };
         let map = AlbedoMap::build(&input, &result, &map_options).unwrap();
@@ -189,6 +200,135 @@ fn main() {
             "  relit with each surface's recovered ρd instead of the albedo maps: {:.2} %",
             100.0 * relative_rmse(&flat_b, &sb, keep).unwrap_or(f64::NAN)
         );
+        if env("ORACLE", 0) > 0 {
+            let oracle = env("ORACLE", 0);
+            // The maps' reconstruction alone: texel maps filled with the
+            // true texture (at each texel's centre, or its box mean), the
+            // recovered lobes, through the same renders.
+            for texel_mm in if oracle & 1 != 0 { vec![20usize, 10, 5] } else { vec![] } {
+                for boxed in [false, true] {
+                    let m = truth_map(&room, texel_mm as f64 * 1e-3, boxed);
+                    let r = relight(&scene, Some(&m), &lights, &camera, &rs);
+                    println!(
+                        "  oracle: true texels {texel_mm} mm ({}) relit {:.2} %; by material: {}",
+                        if boxed { "box mean" } else { "centre" },
+                        100.0 * relit_block_error(&r, &sim).unwrap_or(f64::NAN),
+                        by_material(&room, &camera, &r, &sim)
+                    );
+                }
+            }
+            // The bounces: the first vertex's albedo from a map, the
+            // further vertices from a scene with each surface's constant ρd
+            // taken from the truth, the recovered material or the map's mean.
+            if oracle & 4 != 0 {
+                let exact = truth_map(&room, map_options.texel_m, true);
+                let with_rho = |rho: &dyn Fn(usize) -> [f64; 3]| {
+                    let mut r = result.clone();
+                    for (s, sr) in r.surfaces.iter_mut().enumerate() {
+                        if let Some(m) = sr.material.as_mut() {
+                            m.rho_d = rho(s);
+                        }
+                    }
+                    r
+                };
+                let mut true_all = result.clone();
+                for (r, t) in true_all.surfaces.iter_mut().zip(&truth) {
+                    r.material = Some(*t);
+                }
+                let true_flat = recovered_scene(&input, &true_all).unwrap();
+                for (label, sc, m) in [
+                    ("true scene, no map", room.scene(), None),
+                    ("true scene, true texels", room.scene(), Some(&exact)),
+                    ("true BRDFs flat, no map", &true_flat, None),
+                    ("true BRDFs flat, true texels", &true_flat, Some(&exact)),
+                ] {
+                    let im = relight(sc, m, &lights, &camera, &rs);
+                    println!(
+                        "  oracle: {label}: relit {:.2} %; {}",
+                        100.0 * relit_block_error(&im, &sim).unwrap_or(f64::NAN),
+                        by_material(&room, &camera, &im, &sim)
+                    );
+                }
+                for (s, name) in input.surfaces.iter().enumerate() {
+                    let mut r = true_all.clone();
+                    r.surfaces[s].material = result.surfaces[s].material.map(|mut m| {
+                        m.rho_d = truth[s].rho_d;
+                        m
+                    });
+                    let sc = recovered_scene(&input, &r).unwrap();
+                    let im = relight(&sc, Some(&exact), &lights, &camera, &rs);
+                    println!(
+                        "  oracle: true BRDFs but {name}'s recovered lobe, true texels: relit {:.2} %; {}",
+                        100.0 * relit_block_error(&im, &sim).unwrap_or(f64::NAN),
+                        by_material(&room, &camera, &im, &sim)
+                    );
+                }
+                let true_rho = with_rho(&|s| truth[s].rho_d);
+                let map_means: Vec<[f64; 3]> = (0..input.surfaces.len()).map(|s| map_mean(&room, &map, s)).collect();
+                let map_rho = with_rho(&|s| map_means[s]);
+                for (label, r) in [
+                    ("true ρd", &true_rho),
+                    ("map means", &map_rho),
+                    ("recovered ρd", &result),
+                ] {
+                    let sc = recovered_scene(&input, r).unwrap();
+                    for (mlabel, m) in [("true texels", &exact), ("built map", &map)] {
+                        let im = relight(&sc, Some(m), &lights, &camera, &rs);
+                        println!(
+                            "  oracle: first vertex {mlabel}, bounces {label}: relit {:.2} %; {}",
+                            100.0 * relit_block_error(&im, &sim).unwrap_or(f64::NAN),
+                            by_material(&room, &camera, &im, &sim)
+                        );
+                    }
+                }
+                println!(
+                    "  map means vs truth (%): {}",
+                    (0..input.surfaces.len())
+                        .map(|s| format!(
+                            "{} {:+.1}/{:+.1}/{:+.1}",
+                            input.surfaces[s],
+                            100.0 * (map_means[s][0] / truth[s].rho_d[0] - 1.0),
+                            100.0 * (map_means[s][1] / truth[s].rho_d[1] - 1.0),
+                            100.0 * (map_means[s][2] / truth[s].rho_d[2] - 1.0)
+                        ))
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                );
+                // The map rebuilt with the indirect light gathered through the
+                // scene of the first map's means (one fixed-point step).
+                let mut m2 = map.clone();
+                let mut r2 = map_rho.clone();
+                for pass in 1..=env("PASSES", 2) {
+                    m2 = AlbedoMap::build(&input, &r2, &map_options).unwrap();
+                    let means: Vec<[f64; 3]> = (0..input.surfaces.len()).map(|s| map_mean(&room, &m2, s)).collect();
+                    let sc = recovered_scene(&input, &r2).unwrap();
+                    let im = relight(&sc, Some(&m2), &lights, &camera, &rs);
+                    println!(
+                        "  oracle: map pass {pass} (gathered through the previous map's means): relit {:.2} %; {}",
+                        100.0 * relit_block_error(&im, &sim).unwrap_or(f64::NAN),
+                        by_material(&room, &camera, &im, &sim)
+                    );
+                    r2 = with_rho(&|s| means[s]);
+                }
+                let _ = m2;
+            }
+            // The map as built, with one surface at a time replaced by its
+            // true texels (centre, the map's texel size).
+            let exact = truth_map(&room, map_options.texel_m, false);
+            for (s, name) in input.surfaces.iter().enumerate().filter(|_| oracle & 2 != 0) {
+                let mut m = map.clone();
+                for (k, tri) in room.scene().triangles().iter().enumerate() {
+                    if tri.material as usize == s {
+                        m.triangles[k] = exact.triangles[k].clone();
+                    }
+                }
+                let r = relight(&scene, Some(&m), &lights, &camera, &rs);
+                println!(
+                    "  oracle: the map with {name}'s texels true: relit {:.2} %",
+                    100.0 * relit_block_error(&r, &sim).unwrap_or(f64::NAN)
+                );
+            }
+        }
         if env("BUDGET", 0) == 1 {
             let conv = env("CONV_SPP", 512) as u32;
             let e = |a: &campanile_process::camera::image::RadianceImage,
@@ -318,6 +458,82 @@ fn main() {
                 e(&ours_conv, &reference)
             );
         }
+    }
+}
+
+/// The seen texels' mean albedo of solver surface `surface` in `map`
+/// (unweighted; the recovered fallback when none was seen).
+fn map_mean(room: &RoomIgi, map: &AlbedoMap, surface: usize) -> [f64; 3] {
+    let (mut sum, mut n) = ([0.0; 3], 0.0);
+    for (tri, texels) in room.scene().triangles().iter().zip(&map.triangles) {
+        if tri.material as usize != surface {
+            continue;
+        }
+        for (a, w) in texels.albedo.iter().zip(&texels.weight) {
+            if *w > 0.0 {
+                for c in 0..3 {
+                    sum[c] += f64::from(a[c]);
+                }
+                n += 1.0;
+            }
+        }
+    }
+    if n > 0.0 {
+        sum.map(|v| v / n)
+    } else {
+        map.fallback[surface]
+    }
+}
+
+/// An albedo map of the true textures on `texel_m` texels (the map's own
+/// grid per triangle), each texel the texture at its centre or (`boxed`)
+/// its mean over 8 × 8 points.
+fn truth_map(room: &RoomIgi, texel_m: f64, boxed: bool) -> AlbedoMap {
+    use campanile_process::igi::albedo_map::TriangleTexels;
+    let scene = room.scene();
+    let appearances = &room.loaded.appearances;
+    let triangles = scene
+        .triangles()
+        .iter()
+        .map(|tri| {
+            let st: Vec<[f64; 2]> = tri.vertices.iter().map(|v| tri.texture_coordinates(v)).collect();
+            let lo = [0, 1].map(|k| st.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min));
+            let hi = [0, 1].map(|k| st.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max));
+            let size = [0, 1].map(|k| (((hi[k] - lo[k]) / texel_m).ceil() as usize).clamp(1, 4096));
+            let tex = &appearances[tri.material as usize].albedo;
+            let mut albedo = Vec::with_capacity(size[0] * size[1]);
+            for j in 0..size[1] {
+                for i in 0..size[0] {
+                    let n = if boxed { 8 } else { 1 };
+                    let mut sum = [0.0; 3];
+                    for b in 0..n {
+                        for a in 0..n {
+                            let p = [
+                                lo[0] + (i as f64 + (a as f64 + 0.5) / n as f64) * texel_m,
+                                lo[1] + (j as f64 + (b as f64 + 0.5) / n as f64) * texel_m,
+                            ];
+                            let v = tex.albedo(p);
+                            for c in 0..3 {
+                                sum[c] += v[c] / (n * n) as f64;
+                            }
+                        }
+                    }
+                    albedo.push(sum.map(|v| v as f32));
+                }
+            }
+            TriangleTexels {
+                origin: lo,
+                size,
+                albedo,
+                weight: vec![1.0; size[0] * size[1]],
+            }
+        })
+        .collect();
+    AlbedoMap {
+        texel_m,
+        triangles,
+        fallback: appearances.iter().map(|a| a.albedo.mean_albedo()).collect(),
+        samples: (0, 0),
     }
 }
 

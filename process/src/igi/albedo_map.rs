@@ -6,8 +6,10 @@
 //! ρd(x) = π (L(x) − S(x) − ΔS(x)) / (E_direct(x) + E_indirect(x)),
 //!
 //! where S is the recovered lobe's reflection of the lamps and ΔS its
-//! reflection of the indirect light, `ρs a(ωo) E_indirect / π` with `a`
-//! the lobe's directional albedo toward the camera (as the solver's
+//! reflection of the indirect light, traced along directions sampled from
+//! the lobe into the recovered scene (thesis §4.6; `specular_rays`), or
+//! with `specular_rays` 0 approximated as `ρs a(ωo) E_indirect / π` with
+//! `a` the lobe's directional albedo toward the camera (as the solver's
 //! [`super::radiosity`] takes it beyond one glossy bounce). Without ΔS a
 //! glossy surface lit mostly by the room's walls keeps `ρs a / ρd` of
 //! extra light in its map: measured +12 % on the room's wood floor (ρs
@@ -21,8 +23,9 @@
 //! and where a texel has three or more samples the brightest is dropped
 //! (§4.6: "the brightest sample ... is likely to contain a highlight").
 //! The views' disagreement on each texel then measures the photographs'
-//! noise, and each surface's texels are shrunk toward its mean by the
-//! share of their variation that is texture (`shrink_noise`).
+//! noise, the gather's own spread the indirect irradiance's, and each
+//! surface's texels are shrunk toward its mean by the share of their
+//! variation that is texture (`shrink_noise`).
 //!
 //! The map is a grid of square texels per triangle over its planar texture
 //! coordinates (metres); a texel no view saw takes the mean of its seen
@@ -50,7 +53,10 @@ pub const FILL_RADIUS: i64 = 3;
 /// The albedo map's knobs (speed against error).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AlbedoMapOptions {
-    /// Texel side, metres.
+    /// Texel side, metres. Default 1 cm: on the simulated room a map of
+    /// the true textures on 2 cm texels (each texel its box mean) leaves
+    /// the posters' 5 cm stripes 4.4 % off per 4×4 block of the relit
+    /// image, on 1 cm texels 1.5 % (BENCHMARKS.md).
     pub texel_m: f64,
     /// Side of the cells over which the indirect irradiance is gathered, metres.
     pub irradiance_cell_m: f64,
@@ -71,6 +77,10 @@ pub struct AlbedoMapOptions {
     /// Remove the recovered specular reflection, weight by diffuse share
     /// and drop the brightest sample (false: leaves highlights in; a baseline).
     pub remove_specular: bool,
+    /// Rays sampled from the recovered lobe per glossy sample to estimate
+    /// ΔS, the lobe's reflection of the room's light (module doc); 0: the
+    /// uniform-light approximation `ρs a(ωo) E_indirect / π`.
+    pub specular_rays: u32,
     /// Shrink each texel toward its surface's mean by the share of the
     /// texels' variation that is texture rather than the photographs'
     /// noise ([`shrink_noise`]; false: the raw per-texel means).
@@ -80,7 +90,7 @@ pub struct AlbedoMapOptions {
 impl Default for AlbedoMapOptions {
     fn default() -> Self {
         AlbedoMapOptions {
-            texel_m: 0.02,
+            texel_m: 0.01,
             irradiance_cell_m: 0.25,
             irradiance_rays: 128,
             max_bounces: 12,
@@ -88,6 +98,7 @@ impl Default for AlbedoMapOptions {
             seed: 3,
             indirect: true,
             remove_specular: true,
+            specular_rays: 8,
             shrink_noise: true,
         }
     }
@@ -151,6 +162,23 @@ struct Sample {
     albedo: [f64; 3],
     brightness: f64,
     weight: f64,
+    /// Variance of `albedo` from the indirect irradiance's Monte Carlo
+    /// noise (common to every view of the point).
+    irradiance_noise: [f64; 3],
+}
+
+/// One seen texel's statistics, for [`shrink_noise`].
+#[derive(Debug, Clone, Copy)]
+struct TexelSpread {
+    triangle: usize,
+    texel: usize,
+    /// Σw and Σw² of its samples.
+    w: f64,
+    w2: f64,
+    /// The weighted scatter Σw(x − m)² per channel.
+    scatter: [f64; 3],
+    /// The weighted mean of its samples' irradiance noise variance.
+    irradiance_noise: [f64; 3],
 }
 
 impl TriangleTexels {
@@ -245,12 +273,14 @@ impl AlbedoMap {
         // Samples per triangle.
         let mut per_triangle: Vec<Vec<Sample>> = vec![Vec::new(); triangles.len()];
         let grids = &triangles;
-        for view in &input.views {
+        for (view_index, view) in input.views.iter().enumerate() {
             let cam = &view.camera;
             let (w, h) = (cam.width, cam.height);
             let rows: Vec<Vec<(usize, Sample)>> = (0..h)
                 .into_par_iter()
                 .map(|y| {
+                    let mut rng = ChaCha8Rng::seed_from_u64(options.seed ^ SPECULAR_SEED);
+                    rng.set_stream(((view_index as u64) << 32) | y as u64);
                     let mut out = Vec::new();
                     for x in 0..w {
                         if view.mask.as_ref().is_some_and(|m| !m[y * w + x]) {
@@ -287,16 +317,21 @@ impl AlbedoMap {
                         if !options.remove_specular {
                             specular = [0.0; 3];
                         }
-                        let e_ind = match &indirect {
+                        let (e_ind, e_ind_var) = match &indirect {
                             Some(f) => f.at(hit.triangle, tri, &hit.point, sides[hit.triangle].dot(&normal) > 0.0),
-                            None => [0.0; 3],
+                            None => ([0.0; 3], [0.0; 3]),
                         };
                         let e: [f64; 3] = [0, 1, 2].map(|c| e_direct[c] + e_ind[c]);
                         if e.iter().any(|v| *v <= 1e-12) {
                             continue;
                         }
                         // ΔS: the lobe's reflection of the indirect light (module doc).
-                        if options.remove_specular
+                        if options.remove_specular && options.indirect && options.specular_rays > 0 {
+                            let ds = lobe_indirect(&scene, &points, tri, &hit.point, normal, &wo, options, &mut rng);
+                            for c in 0..3 {
+                                specular[c] += ds[c];
+                            }
+                        } else if options.remove_specular
                             && let (Some(lobe), Some(Some(table))) = (
                                 scene.materials()[tri.material as usize].specular,
                                 lobe_albedo.get(tri.material as usize),
@@ -329,13 +364,16 @@ impl AlbedoMap {
                         let Some(texel) = grid.index(i, j) else {
                             continue;
                         };
+                        let albedo = [0, 1, 2].map(|c| std::f64::consts::PI * diffuse[c] / e[c]);
                         out.push((
                             hit.triangle,
                             Sample {
                                 texel,
-                                albedo: [0, 1, 2].map(|c| std::f64::consts::PI * diffuse[c] / e[c]),
+                                albedo,
                                 brightness: lm,
                                 weight,
+                                irradiance_noise: [0, 1, 2]
+                                    .map(|c| albedo[c] * albedo[c] * e_ind_var[c] / (e[c] * e[c])),
                             },
                         ));
                     }
@@ -348,8 +386,7 @@ impl AlbedoMap {
         }
         let mut used = 0usize;
         let mut dropped = 0usize;
-        // Per texel: (triangle, texel, Σw, Σw², the weighted scatter Σw(x − m)² per channel).
-        let mut spread: Vec<(usize, usize, f64, f64, [f64; 3])> = Vec::new();
+        let mut spread: Vec<TexelSpread> = Vec::new();
         for (t, (grid, samples)) in triangles.iter_mut().zip(per_triangle.iter_mut()).enumerate() {
             samples.sort_by(|a, b| a.texel.cmp(&b.texel).then(b.brightness.total_cmp(&a.brightness)));
             let mut k = 0;
@@ -363,10 +400,11 @@ impl AlbedoMap {
                 } else {
                     k
                 };
-                let (mut sum, mut w, mut w2) = ([0.0; 3], 0.0, 0.0);
+                let (mut sum, mut w, mut w2, mut irr) = ([0.0; 3], 0.0, 0.0, [0.0; 3]);
                 for s in &samples[start..end] {
                     for c in 0..3 {
                         sum[c] += s.weight * s.albedo[c];
+                        irr[c] += s.weight * s.irradiance_noise[c];
                     }
                     w += s.weight;
                     w2 += s.weight * s.weight;
@@ -382,7 +420,14 @@ impl AlbedoMap {
                     }
                     grid.albedo[texel] = mean.map(|v| v as f32);
                     grid.weight[texel] = w as f32;
-                    spread.push((t, texel, w, w2, scatter));
+                    spread.push(TexelSpread {
+                        triangle: t,
+                        texel,
+                        w,
+                        w2,
+                        scatter,
+                        irradiance_noise: irr.map(|v| v / w),
+                    });
                 }
                 k = end;
             }
@@ -411,6 +456,69 @@ pub(crate) fn sphere_hit(centre: &Vector3<f64>, radius: f64, ray: &Ray, limit: f
     }
     let t = -b - disc.sqrt();
     t > 0.0 && t < limit
+}
+
+/// Seed offset of the lobe-sampled ΔS rays (apart from the gather's).
+const SPECULAR_SEED: u64 = 0x5bec_u64;
+
+/// ΔS at `p` toward `wo`: the recovered lobe's reflection of the light
+/// arriving from the room's surfaces (not the lamps, whose reflection is
+/// [`direct`]'s), by `options.specular_rays` directions sampled from the
+/// lobe, each followed by [`path_radiance`] through the recovered scene
+/// (thesis §4.6: "tracing a perturbed reflected ray into the
+/// environment"). Zero for a surface without a lobe. The uniform-light
+/// approximation `ρs a E_indirect / π` misses what the lobe actually
+/// mirrors: on the blue plastic board (ρd red 0.08 under ρs 0.06) it left
+/// the map's red 10 % high.
+#[allow(clippy::too_many_arguments)]
+fn lobe_indirect(
+    scene: &Scene,
+    points: &[PointLight],
+    tri: &Triangle,
+    p: &Vector3<f64>,
+    normal: Vector3<f64>,
+    wo: &Vector3<f64>,
+    options: &AlbedoMapOptions,
+    rng: &mut ChaCha8Rng,
+) -> [f64; 3] {
+    let material = &scene.materials()[tri.material as usize];
+    if material.specular.is_none() {
+        return [0.0; 3];
+    }
+    let lobe_only = Material {
+        name: String::new(),
+        albedo: Texture::Constant([0.0; 3]),
+        specular: material.specular,
+        emission: [0.0; 3],
+    };
+    let bsdf = SurfaceBsdf::at(&lobe_only, tri, p, normal);
+    let origin = p + normal * 1e-6 * (1.0 + p.norm());
+    let strata = Strata::new(options.specular_rays, rng);
+    let mut sum = [0.0; 3];
+    for k in 0..options.specular_rays {
+        let [u1, u2] = strata.point(k, rng);
+        let Some(s) = bsdf.sample(wo, [0.0, u1, u2]) else {
+            continue;
+        };
+        let cos = s.direction.dot(&normal);
+        if cos <= 0.0 || s.pdf <= 0.0 {
+            continue;
+        }
+        let l = path_radiance(
+            scene,
+            points,
+            Ray {
+                origin,
+                direction: s.direction,
+            },
+            options.max_bounces.saturating_sub(1),
+            rng,
+        );
+        for c in 0..3 {
+            sum[c] += s.value[c] * cos / s.pdf * l[c];
+        }
+    }
+    sum.map(|v| v / f64::from(options.specular_rays))
 }
 
 /// The lamps' irradiance at `p` (shadow-tested) and the recovered lobe's
@@ -464,9 +572,10 @@ fn direct(
 /// simulated room the relit image was 12.4 % off with constant 25 cm cells,
 /// 8.6 % with constant 10 cm cells (six times the cost).
 struct IndirectField {
-    /// Per triangle: divisions per edge and the nodes' irradiance, node
-    /// `(i, j)` (at barycentric `(i/n, j/n)`, `i + j ≤ n`) at [`node_index`].
-    nodes: Vec<(usize, Vec<[f64; 3]>)>,
+    /// Per triangle: divisions per edge, the nodes' irradiance, node
+    /// `(i, j)` (at barycentric `(i/n, j/n)`, `i + j ≤ n`) at [`node_index`],
+    /// and the mean over its nodes of their estimates' variance.
+    nodes: Vec<(usize, Vec<[f64; 3]>, [f64; 3])>,
 }
 
 /// Index of lattice node `(i, j)` (`i + j ≤ n`) in row-major order over `j`.
@@ -495,6 +604,7 @@ impl IndirectField {
                 let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
                 rng.set_stream(ti as u64);
                 let mut values = Vec::with_capacity((n + 1) * (n + 2) / 2);
+                let mut variance = [0.0; 3];
                 for j in 0..=n {
                     for i in 0..=n - j {
                         // Nodes on the edges and corners are pulled 0.1 % toward
@@ -503,22 +613,29 @@ impl IndirectField {
                         let third = 1.0 / 3.0;
                         let (u, v) = (third + (u - third) * 0.999, third + (v - third) * 0.999);
                         let p = tri.point(u, v);
-                        values.push(irradiance(scene, points, &p, side, options, &mut rng));
+                        let (e, var) = irradiance(scene, points, &p, side, options, &mut rng);
+                        values.push(e);
+                        for c in 0..3 {
+                            variance[c] += var[c];
+                        }
                     }
                 }
-                (n, values)
+                let count = values.len() as f64;
+                (n, values, variance.map(|v| v / count))
             })
             .collect();
         IndirectField { nodes }
     }
 
     /// The indirect irradiance at `p` on triangle `t` (zero on the side no
-    /// camera sees), interpolated linearly within the lattice's sub-triangle.
-    fn at(&self, t: usize, tri: &Triangle, p: &Vector3<f64>, seen_side: bool) -> [f64; 3] {
+    /// camera sees), interpolated linearly within the lattice's
+    /// sub-triangle, and its Monte Carlo variance (the triangle's mean
+    /// node variance times the interpolation weights' Σw²).
+    fn at(&self, t: usize, tri: &Triangle, p: &Vector3<f64>, seen_side: bool) -> ([f64; 3], [f64; 3]) {
         if !seen_side {
-            return [0.0; 3];
+            return ([0.0; 3], [0.0; 3]);
         }
-        let (n, values) = &self.nodes[t];
+        let (n, values, variance) = &self.nodes[t];
         let n = *n;
         let (e1, e2, q) = (
             tri.vertices[1] - tri.vertices[0],
@@ -531,7 +648,7 @@ impl IndirectField {
         let mut u = ((d22 * q1 - d12 * q2) / det).clamp(0.0, 1.0);
         let mut v = ((d11 * q2 - d12 * q1) / det).clamp(0.0, 1.0);
         if !(u.is_finite() && v.is_finite()) {
-            return values[0];
+            return (values[0], *variance);
         }
         if u + v > 1.0 {
             let s = 1.0 / (u + v);
@@ -555,7 +672,11 @@ impl IndirectField {
                 [node(a + 1, b + 1), node(a + 1, b), node(a, b + 1)],
             )
         };
-        [0, 1, 2].map(|c| (w[0] * k[0][c] + w[1] * k[1][c] + w[2] * k[2][c]).max(0.0))
+        let w2: f64 = w.iter().map(|x| x * x).sum();
+        (
+            [0, 1, 2].map(|c| (w[0] * k[0][c] + w[1] * k[1][c] + w[2] * k[2][c]).max(0.0)),
+            variance.map(|v| v * w2),
+        )
     }
 }
 
@@ -563,7 +684,12 @@ impl IndirectField {
 /// of cosine-distributed paths (direct light at their first hit counts,
 /// the lamps themselves do not), their directions stratified
 /// ([`super::stratified`]) and each continued by
-/// [`super::lamp_paths::path_radiance`] (Russian roulette).
+/// [`super::lamp_paths::path_radiance`] (Russian roulette); and the
+/// estimate's variance. The rays are drawn as two independently
+/// stratified halves, whose difference `a − b` estimates it without the
+/// bias a per-ray variance has under stratification: `(a − b)² / 4`
+/// (one degree of freedom; [`IndirectField`] pools it over a triangle's
+/// nodes). One ray: variance 0.
 fn irradiance(
     scene: &Scene,
     points: &[PointLight],
@@ -571,22 +697,39 @@ fn irradiance(
     normal: &Vector3<f64>,
     options: &AlbedoMapOptions,
     rng: &mut ChaCha8Rng,
-) -> [f64; 3] {
+) -> ([f64; 3], [f64; 3]) {
     let (a, b) = tangents(normal);
     let origin = p + normal * 1e-6 * (1.0 + p.norm());
-    let mut sum = [0.0; 3];
-    let strata = Strata::new(options.irradiance_rays, rng);
-    for k in 0..options.irradiance_rays {
-        let [u1, u2] = strata.point(k, rng);
-        let r = u1.sqrt();
-        let phi = std::f64::consts::TAU * u2;
-        let d = (a * (r * phi.cos()) + b * (r * phi.sin()) + normal * (1.0 - u1).max(0.0).sqrt()).normalize();
-        let l = path_radiance(scene, points, Ray { origin, direction: d }, options.max_bounces, rng);
-        for c in 0..3 {
-            sum[c] += l[c];
+    let n = options.irradiance_rays;
+    let halves = if n >= 2 { [n / 2, n - n / 2] } else { [n, 0] };
+    let mut sums = [[0.0; 3]; 2];
+    for (half, &count) in halves.iter().enumerate() {
+        if count == 0 {
+            continue;
+        }
+        let strata = Strata::new(count, rng);
+        for k in 0..count {
+            let [u1, u2] = strata.point(k, rng);
+            let r = u1.sqrt();
+            let phi = std::f64::consts::TAU * u2;
+            let d = (a * (r * phi.cos()) + b * (r * phi.sin()) + normal * (1.0 - u1).max(0.0).sqrt()).normalize();
+            let l = path_radiance(scene, points, Ray { origin, direction: d }, options.max_bounces, rng);
+            for c in 0..3 {
+                sums[half][c] += l[c];
+            }
         }
     }
-    sum.map(|v| std::f64::consts::PI * v / f64::from(options.irradiance_rays))
+    let pi = std::f64::consts::PI;
+    let e = [0, 1, 2].map(|c| pi * (sums[0][c] + sums[1][c]) / f64::from(n));
+    let var = if halves[1] > 0 {
+        [0, 1, 2].map(|c| {
+            let d = pi * (sums[0][c] / f64::from(halves[0]) - sums[1][c] / f64::from(halves[1]));
+            d * d / 4.0
+        })
+    } else {
+        [0.0; 3]
+    };
+    (e, var)
 }
 
 /// Empirical-Bayes (Wiener) shrinkage of the texels of each surface,
@@ -597,7 +740,10 @@ fn irradiance(
 /// texel's weighted mean of its samples, `μ` the surface's mean over
 /// texels, the per-sample noise variance `σ²` pooled over the surface's
 /// texels seen at least twice (`Σ w (x − m_t)²` over `Σ w − Σ w² / Σ w`),
-/// a texel's noise variance `N_t = σ² Σ w² / (Σ w)²`, and the texture's
+/// a texel's noise variance `N_t = σ² Σ w² / (Σ w)² + I_t`, where `I_t`
+/// is the part the indirect irradiance's Monte Carlo noise puts in the
+/// texel (`ρd² var(E_indirect) / E²`, common to every view, so that the
+/// views' disagreement cannot show it: [`irradiance`] measures it), and the texture's
 /// variance `S = max(var_t(m_t) − mean_t N_t, 0)`, each texel becomes
 ///
 /// m_t' = μ + S / (S + N_t) · (m_t − μ),
@@ -606,24 +752,18 @@ fn irradiance(
 /// noise are independent with those variances. A surface without texture
 /// (S ≈ 0) comes back flat; a high-contrast texture (S ≫ N) is kept; the
 /// pattern's correlation with the truth is unchanged by a common factor.
-fn shrink_noise(
-    triangles: &mut [TriangleTexels],
-    spread: &[(usize, usize, f64, f64, [f64; 3])],
-    material: &[usize],
-    surfaces: usize,
-) {
+fn shrink_noise(triangles: &mut [TriangleTexels], spread: &[TexelSpread], material: &[usize], surfaces: usize) {
     for s in 0..surfaces {
-        let texels: Vec<&(usize, usize, f64, f64, [f64; 3])> =
-            spread.iter().filter(|e| material.get(e.0) == Some(&s)).collect();
+        let texels: Vec<&TexelSpread> = spread.iter().filter(|e| material.get(e.triangle) == Some(&s)).collect();
         if texels.len() < 16 {
             continue;
         }
         for c in 0..3 {
             let (mut scatter, mut dof) = (0.0, 0.0);
-            for (_, _, w, w2, sc) in &texels {
-                let d = w - w2 / w;
-                if d > 1e-9 * w {
-                    scatter += sc[c];
+            for t in &texels {
+                let d = t.w - t.w2 / t.w;
+                if d > 1e-9 * t.w {
+                    scatter += t.scatter[c];
                     dof += d;
                 }
             }
@@ -633,16 +773,19 @@ fn shrink_noise(
             let sigma2 = scatter / dof;
             let values: Vec<f64> = texels
                 .iter()
-                .map(|(t, k, ..)| f64::from(triangles[*t].albedo[*k][c]))
+                .map(|t| f64::from(triangles[t.triangle].albedo[t.texel][c]))
                 .collect();
             let n = values.len() as f64;
             let mu = values.iter().sum::<f64>() / n;
             let var = values.iter().map(|v| (v - mu).powi(2)).sum::<f64>() / (n - 1.0);
-            let noise: Vec<f64> = texels.iter().map(|(_, _, w, w2, _)| sigma2 * w2 / (w * w)).collect();
+            let noise: Vec<f64> = texels
+                .iter()
+                .map(|t| sigma2 * t.w2 / (t.w * t.w) + t.irradiance_noise[c])
+                .collect();
             let signal = (var - noise.iter().sum::<f64>() / n).max(0.0);
-            for ((t, k, ..), (v, nt)) in texels.iter().zip(values.iter().zip(&noise)) {
+            for (t, (v, nt)) in texels.iter().zip(values.iter().zip(&noise)) {
                 let gain = if signal + nt > 0.0 { signal / (signal + nt) } else { 1.0 };
-                triangles[*t].albedo[*k][c] = (mu + gain * (v - mu)) as f32;
+                triangles[t.triangle].albedo[t.texel][c] = (mu + gain * (v - mu)) as f32;
             }
         }
     }
@@ -762,13 +905,13 @@ mod tests {
             }
         }
         let field = IndirectField {
-            nodes: vec![(n, values)],
+            nodes: vec![(n, values, [0.0; 3])],
         };
         for (u, v) in [(0.1, 0.2), (0.33, 0.41), (0.7, 0.29), (0.0, 1.0), (0.95, 0.02)] {
             let p = tri.point(u, v);
-            let e = field.at(0, &tri, &p, true)[0];
+            let e = field.at(0, &tri, &p, true).0[0];
             assert!((e - (1.0 + 2.0 * u + 3.0 * v)).abs() < 1e-9, "({u}, {v}): {e}");
         }
-        assert_eq!(field.at(0, &tri, &tri.point(0.2, 0.2), false), [0.0; 3]);
+        assert_eq!(field.at(0, &tri, &tri.point(0.2, 0.2), false).0, [0.0; 3]);
     }
 }

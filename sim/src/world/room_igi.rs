@@ -82,13 +82,18 @@ impl RoomIgi {
 
     /// The solver's views of the room used by the test, the budget example
     /// and the helper's runs: a wide view at each scene pose (60°,
-    /// `width` × `height`), the highlight views (20°, `width / 2` square)
-    /// and the ceiling views (60° at [`CEILING_ELEVATION_DEG`]). The first
-    /// is the wide view `wide-sw`, the relighting check's camera.
+    /// `width` × `height`), the highlight views (20°, `width / 2` square),
+    /// the ceiling views (60° at [`CEILING_ELEVATION_DEG`]) and, last (so
+    /// that the earlier views' photographs keep their seeds), the
+    /// highlight views from free positions of [`RoomIgi::mirror_cameras`]
+    /// (the metal sphere's). The first is the wide view `wide-sw`, the
+    /// relighting check's camera. ([`RoomIgi::write_scene_file`] writes
+    /// the free-position views too, last; the demo's capture has none.)
     pub fn solver_cameras(&self, width: usize, height: usize) -> Vec<(String, ViewCamera)> {
         let mut cams = self.cameras(60.0, width, height);
         cams.extend(self.highlight_cameras(20.0, width / 2));
         cams.extend(self.ceiling_cameras(CEILING_ELEVATION_DEG, 60.0, width, height));
+        cams.extend(self.mirror_cameras(20.0, width / 2, MIRROR_CAMERA_DISTANCE_M));
         cams
     }
 
@@ -285,6 +290,87 @@ impl RoomIgi {
                         ViewCamera {
                             position: p,
                             look: m - p,
+                            up: Vector3::z(),
+                            vfov_rad: vfov_deg.to_radians(),
+                            width: px,
+                            height: px,
+                        },
+                    ));
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Distance from a highlight to the camera of [`RoomIgi::mirror_cameras`], metres.
+pub const MIRROR_CAMERA_DISTANCE_M: f64 = 1.2;
+
+impl RoomIgi {
+    /// Highlight views from free positions, for the glossy surfaces whose
+    /// highlight no scene pose sees ([`RoomIgi::highlight_cameras`] finds
+    /// none for them: the metal sphere, whose flat facets mirror each lamp
+    /// toward a few directions only). For each lamp and each such surface,
+    /// the first of its triangles (in file order) that the lamp lights, at
+    /// whose centre the lamp's mirror direction, followed `distance_m`,
+    /// reaches a free point of the room with a clear view back: a camera
+    /// there aimed at that centre, `px` square, `vfov_deg` wide. Without
+    /// them the solver cannot measure such a surface's lobe and keeps it
+    /// diffuse, and the room relit under new lamps lacks the light the
+    /// lobe throws on the walls (BENCHMARKS.md: the metal sphere's
+    /// reflections of the lamps, about 4.8 % per 4×4 block on the paint).
+    pub fn mirror_cameras(&self, vfov_deg: f64, px: usize, distance_m: f64) -> Vec<(String, ViewCamera)> {
+        use campanile_process::render::Ray;
+        let scene = &self.loaded.scene;
+        let seen: Vec<String> = self
+            .highlight_cameras(vfov_deg, px)
+            .into_iter()
+            .map(|(name, _)| name)
+            .collect();
+        let clear = |a: &Vector3<f64>, b: &Vector3<f64>| {
+            let d = b - a;
+            let len = d.norm();
+            len > 0.0
+                && !scene.occluded(
+                    &Ray {
+                        origin: *a,
+                        direction: d / len,
+                    },
+                    len * (1.0 - 1e-6),
+                )
+        };
+        let mut out = Vec::new();
+        for (lamp, bulb) in &self.lamps {
+            for (s, surface) in scene.surfaces().iter().enumerate() {
+                let name = format!("highlight-{surface}-{lamp}");
+                if seen.contains(&name) {
+                    continue;
+                }
+                let found = scene
+                    .triangles()
+                    .iter()
+                    .filter(|t| t.surface as usize == s)
+                    .find_map(|t| {
+                        scene.materials()[t.material as usize].specular?;
+                        let c = (t.vertices[0] + t.vertices[1] + t.vertices[2]) / 3.0;
+                        let to_lamp = (bulb.center - c).normalize();
+                        let n = t.normal;
+                        let cos = to_lamp.dot(&n);
+                        let mirror = n * (2.0 * cos) - to_lamp;
+                        // Lit, and a look direction not along "up".
+                        if cos <= 0.1 || mirror.z.abs() > 0.95 {
+                            return None;
+                        }
+                        let lift = c + n * 1e-4;
+                        let p = c + mirror * distance_m;
+                        (clear(&lift, &bulb.center) && clear(&lift, &p)).then_some((p, c))
+                    });
+                if let Some((p, c)) = found {
+                    out.push((
+                        format!("{name}-free"),
+                        ViewCamera {
+                            position: p,
+                            look: c - p,
                             up: Vector3::z(),
                             vfov_rad: vfov_deg.to_radians(),
                             width: px,
@@ -533,8 +619,8 @@ fn write_exr(image: &RadianceImage, path: &Path) -> Result<(), WorldError> {
 impl RoomIgi {
     /// Photographs the room and writes a `campanile igi` scene file
     /// (`dir/scene.ron`, the OBJ beside it, EXR images under `dir/images`):
-    /// every lamp on, seen from the scene's poses, the highlight views and
-    /// the ceiling views; each lamp given by three HDR images of its bulb (lit alone),
+    /// every lamp on, seen from the scene's poses, the highlight views,
+    /// the ceiling views and the free-position highlight views; each lamp given by three HDR images of its bulb (lit alone),
     /// from the first three pose positions, to be triangulated. Returns the
     /// scene file's path.
     pub fn write_scene_file(&self, dir: &Path, shot: &SceneFileShot) -> Result<std::path::PathBuf, WorldError> {
@@ -556,6 +642,7 @@ impl RoomIgi {
             shot.wide_px.0,
             shot.wide_px.1,
         ));
+        cams.extend(self.mirror_cameras(shot.highlight.0, shot.highlight.1, MIRROR_CAMERA_DISTANCE_M));
         let mut text = String::from(
             "// Written by the simulator: the room with every lamp on.\nIgiScene(\n    geometry: \"room.obj\",\n    surfaces: [\n",
         );
