@@ -633,3 +633,19 @@ fn path_splitting_cuts_the_noise_of_a_shadowed_wall() {
         "mean wall radiance {old_mean} without splitting, {new_mean} with it (σ {sigma})"
     );
 }
+
+/// A segment through the 20 m ground square (z = 0) is blocked; one above
+/// it, one ending on it, and one from it upward are clear; a point is not a
+/// segment.
+#[test]
+fn segments_are_clear_only_when_nothing_lies_between_their_ends() {
+    let scene = ground(10.0, Texture::Constant([0.5; 3]));
+    let (above, below) = (Vector3::new(0.0, 0.0, 1.0), Vector3::new(0.0, 0.0, -1.0));
+    assert!(!scene.segment_clear(&above, &below));
+    assert!(scene.segment_clear(&above, &Vector3::new(5.0, 5.0, 2.0)));
+    assert!(scene.segment_clear(&above, &Vector3::new(3.0, 0.0, 0.0)));
+    assert!(scene.segment_clear(&Vector3::new(3.0, 0.0, 1e-4), &above));
+    assert!(!scene.segment_clear(&above, &above));
+    // Beyond the square's edge the segment passes under nothing.
+    assert!(scene.segment_clear(&Vector3::new(11.0, 0.0, 1.0), &Vector3::new(11.0, 0.0, -1.0)));
+}

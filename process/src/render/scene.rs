@@ -134,6 +134,22 @@ impl Scene {
         self.accel.occluded(&self.triangles, ray, RAY_EPSILON, t_max)
     }
 
+    /// Whether the segment from `a` to `b` is clear: nothing between them
+    /// (the last millionth of its length excluded, so that a surface at `b`
+    /// does not count). A segment of zero length is not clear.
+    pub fn segment_clear(&self, a: &Vector3<f64>, b: &Vector3<f64>) -> bool {
+        let d = b - a;
+        let len = d.norm();
+        len > 0.0
+            && !self.occluded(
+                &Ray {
+                    origin: *a,
+                    direction: d / len,
+                },
+                len * (1.0 - 1e-6),
+            )
+    }
+
     /// The diffuse albedo at `point` on triangle `triangle`: the ground truth
     /// of the per-texel albedo.
     pub fn albedo_at(&self, triangle: usize, point: &Vector3<f64>) -> [f64; 3] {

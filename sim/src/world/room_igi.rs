@@ -230,7 +230,6 @@ impl RoomIgi {
     /// reflection on one of the surface's triangles is visible and lit;
     /// a camera there aimed at that point, `px` square, `vfov_deg` wide.
     pub fn highlight_cameras(&self, vfov_deg: f64, px: usize) -> Vec<(String, ViewCamera)> {
-        use campanile_process::render::Ray;
         let scene = &self.loaded.scene;
         let positions: Vec<Vector3<f64>> = self
             .loaded
@@ -239,17 +238,6 @@ impl RoomIgi {
             .iter()
             .map(|p| Vector3::new(p.position_m.0, p.position_m.1, p.position_m.2))
             .collect();
-        let visible = |a: &Vector3<f64>, b: &Vector3<f64>| {
-            let d = b - a;
-            let len = d.norm();
-            !scene.occluded(
-                &Ray {
-                    origin: *a,
-                    direction: d / len,
-                },
-                len * (1.0 - 1e-6),
-            )
-        };
         let mut out = Vec::new();
         for (lamp, bulb) in &self.lamps {
             for (s, surface) in scene.surfaces().iter().enumerate() {
@@ -281,7 +269,8 @@ impl RoomIgi {
                             let v = (d11 * q2 - d12 * q1) / det;
                             let inside = u > 0.02 && v > 0.02 && u + v < 0.98;
                             let lift = m + n * dp.signum() * 1e-4;
-                            (inside && visible(p, &lift) && visible(&bulb.center, &lift)).then_some((*p, m))
+                            (inside && scene.segment_clear(p, &lift) && scene.segment_clear(&bulb.center, &lift))
+                                .then_some((*p, m))
                         })
                 });
                 if let Some((p, m)) = found {
@@ -320,25 +309,12 @@ impl RoomIgi {
     /// lobe throws on the walls (BENCHMARKS.md: the metal sphere's
     /// reflections of the lamps, about 4.8 % per 4×4 block on the paint).
     pub fn mirror_cameras(&self, vfov_deg: f64, px: usize, distance_m: f64) -> Vec<(String, ViewCamera)> {
-        use campanile_process::render::Ray;
         let scene = &self.loaded.scene;
         let seen: Vec<String> = self
             .highlight_cameras(vfov_deg, px)
             .into_iter()
             .map(|(name, _)| name)
             .collect();
-        let clear = |a: &Vector3<f64>, b: &Vector3<f64>| {
-            let d = b - a;
-            let len = d.norm();
-            len > 0.0
-                && !scene.occluded(
-                    &Ray {
-                        origin: *a,
-                        direction: d / len,
-                    },
-                    len * (1.0 - 1e-6),
-                )
-        };
         let mut out = Vec::new();
         for (lamp, bulb) in &self.lamps {
             for (s, surface) in scene.surfaces().iter().enumerate() {
@@ -363,7 +339,7 @@ impl RoomIgi {
                         }
                         let lift = c + n * 1e-4;
                         let p = c + mirror * distance_m;
-                        (clear(&lift, &bulb.center) && clear(&lift, &p)).then_some((p, c))
+                        (scene.segment_clear(&lift, &bulb.center) && scene.segment_clear(&lift, &p)).then_some((p, c))
                     });
                 if let Some((p, c)) = found {
                     out.push((

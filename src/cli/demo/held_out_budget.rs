@@ -30,9 +30,8 @@ use campanile_process::render::{CameraRig, RenderSettings, Scene, render};
 use campanile_process::report::{Section, Table};
 use campanile_process::sun::sun_position;
 use campanile_sim::world::World;
-use nalgebra::Vector3;
 
-use super::super::process::outdoor_stage::block_rmse;
+use super::super::process::outdoor_stage::{block_rmse, rig_of};
 use super::super::process::{Outdoor, Processed};
 
 /// One term of the budget for one view: relative RMSE per pixel and per 4 × 4 block.
@@ -97,18 +96,6 @@ fn true_reflectance(scene: &Scene, refl: &Reflectance, world: &World) -> Reflect
         est.rho_sun = m;
     }
     out
-}
-
-/// The rig of held-out view `g`, as the stage re-rendered it.
-fn rig_of(p: &Processed, g: &campanile_process::pipeline::MergedGroup) -> CameraRig {
-    CameraRig {
-        pinhole: g.pinhole,
-        mount: p.optics.mount,
-        head: g.head,
-        position: Vector3::from(g.position_m),
-        width: g.map.width,
-        height: g.map.height,
-    }
 }
 
 /// The simulator's render of `rig` at `time` with `spp` paths per pixel.

@@ -84,7 +84,8 @@ pub fn targets(p: &Processed, scene: &Scene) -> Result<Vec<usize>> {
         .collect()
 }
 
-fn rig_of(p: &Processed, g: &MergedGroup) -> CameraRig {
+/// The camera of merged group `g` (its head pose and the station's mount).
+pub fn rig_of(p: &Processed, g: &MergedGroup) -> CameraRig {
     CameraRig {
         pinhole: g.pinhole,
         mount: p.optics.mount,
