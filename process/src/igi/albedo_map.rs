@@ -481,18 +481,10 @@ fn lobe_indirect(
     options: &AlbedoMapOptions,
     rng: &mut ChaCha8Rng,
 ) -> [f64; 3] {
-    let material = &scene.materials()[tri.material as usize];
-    if material.specular.is_none() {
+    if scene.materials()[tri.material as usize].specular.is_none() {
         return [0.0; 3];
     }
-    let lobe_only = Material {
-        name: String::new(),
-        albedo: Texture::Constant([0.0; 3]),
-        specular: material.specular,
-        emission: [0.0; 3],
-    };
-    let bsdf = SurfaceBsdf::at(&lobe_only, tri, p, normal);
-    let origin = p + normal * 1e-6 * (1.0 + p.norm());
+    let (bsdf, origin) = lobe_at(scene, tri, p, normal);
     let strata = Strata::new(options.specular_rays, rng);
     let mut sum = [0.0; 3];
     for k in 0..options.specular_rays {
@@ -521,6 +513,22 @@ fn lobe_indirect(
     sum.map(|v| v / f64::from(options.specular_rays))
 }
 
+/// The recovered specular lobe alone of `tri`'s material at `p` (no
+/// diffuse part: the albedo map divides the rest out), and the point just
+/// off the surface that rays leave from.
+fn lobe_at(scene: &Scene, tri: &Triangle, p: &Vector3<f64>, normal: Vector3<f64>) -> (SurfaceBsdf, Vector3<f64>) {
+    let lobe_only = Material {
+        name: String::new(),
+        albedo: Texture::Constant([0.0; 3]),
+        specular: scene.materials()[tri.material as usize].specular,
+        emission: [0.0; 3],
+    };
+    (
+        SurfaceBsdf::at(&lobe_only, tri, p, normal),
+        p + normal * 1e-6 * (1.0 + p.norm()),
+    )
+}
+
 /// The lamps' irradiance at `p` (shadow-tested) and the recovered lobe's
 /// reflection of them toward `wo`.
 fn direct(
@@ -531,15 +539,7 @@ fn direct(
     normal: Vector3<f64>,
     wo: &Vector3<f64>,
 ) -> ([f64; 3], [f64; 3]) {
-    let material = &scene.materials()[tri.material as usize];
-    let lobe_only = Material {
-        name: String::new(),
-        albedo: Texture::Constant([0.0; 3]),
-        specular: material.specular,
-        emission: [0.0; 3],
-    };
-    let bsdf = SurfaceBsdf::at(&lobe_only, tri, p, normal);
-    let origin = p + normal * 1e-6 * (1.0 + p.norm());
+    let (bsdf, origin) = lobe_at(scene, tri, p, normal);
     let (mut e, mut s) = ([0.0; 3], [0.0; 3]);
     for l in points {
         let to = l.position - origin;
@@ -549,7 +549,7 @@ fn direct(
         if cos <= 0.0 || scene.occluded(&Ray { origin, direction: wi }, d2.sqrt()) {
             continue;
         }
-        let f = if material.specular.is_some() {
+        let f = if scene.materials()[tri.material as usize].specular.is_some() {
             bsdf.eval(&wi, wo)
         } else {
             [0.0; 3]

@@ -139,11 +139,7 @@ pub fn photo_floor(p: &Processed, o: &Outdoor, world: &World, photo_spp: u32, bo
         .held_out
         .iter()
         .map(|v| {
-            let g = p
-                .merged
-                .iter()
-                .find(|g| g.key == v.label)
-                .ok_or_else(|| anyhow!("held-out view {} not among the merged groups", v.label))?;
+            let g = group_of(p, &v.label)?;
             let rig = rig_of(p, g);
             let a = simulate(world, &rig, g.time, photo_spp, bounces, 0xA11CE)?;
             let b = simulate(world, &rig, g.time, photo_spp, bounces, 0xB0B)?;
@@ -157,6 +153,14 @@ pub fn photo_floor(p: &Processed, o: &Outdoor, world: &World, photo_spp: u32, bo
             ))
         })
         .collect()
+}
+
+/// The merged group of held-out view `label`.
+fn group_of<'a>(p: &'a Processed, label: &str) -> Result<&'a campanile_process::pipeline::MergedGroup> {
+    p.merged
+        .iter()
+        .find(|g| g.key == label)
+        .ok_or_else(|| anyhow!("held-out view {label} not among the merged groups"))
 }
 
 /// Per view, the least-squares gauge of the HDR map against the simulator's radiance.
@@ -178,11 +182,7 @@ pub fn budget(
     let mut terms = Vec::new();
     let mut gauges = Vec::new();
     for v in &o.products.held_out {
-        let g = p
-            .merged
-            .iter()
-            .find(|g| g.key == v.label)
-            .ok_or_else(|| anyhow!("held-out view {} not among the merged groups", v.label))?;
+        let g = group_of(p, &v.label)?;
         let rig = rig_of(p, g);
         let daylight = world
             .daylight(g.time)
