@@ -240,7 +240,7 @@ fn the_room_is_recovered_and_relit_under_new_lamps() {
         100.0 * floor,
         100.0 * relative_rmse(&ours, &sim, |i| sim.data[i * 3] < 20.0).unwrap()
     );
-    // Measured: relit 2.65 %, floor 1.40 % (256 paths per pixel in both
+    // Measured: relit 2.67 %, floor 1.40 % (256 paths per pixel in both
     // renders). Before: 3.44 % without the metal's lobe (its reflections
     // of the new lamps missing from the walls), with ΔS as uniform light
     // and 2 cm texels, and the shrinkage blind to the gather's noise; 9.5 %

@@ -38,13 +38,12 @@ use rayon::prelude::*;
 
 use super::error::IgiError;
 use super::input::IgiInput;
-use super::lamp_paths::path_radiance;
+use super::lamp_paths::{PathVertex, path_radiance, scattered_radiance};
 use super::recover::IgiResult;
 use super::relit_scene::{point_lights, recovered_scene, seen_sides};
 use super::specular_albedo::SpecularAlbedo;
 use super::stratified::Strata;
 use crate::brdf::ShadingFrame;
-use crate::render::surface_bsdf::SurfaceBsdf;
 use crate::render::{Material, PointLight, Ray, Scene, Texture, Triangle};
 
 /// Texels searched around an unseen texel for seen ones.
@@ -327,7 +326,7 @@ impl AlbedoMap {
                         }
                         // ΔS: the lobe's reflection of the indirect light (module doc).
                         if options.remove_specular && options.indirect && options.specular_rays > 0 {
-                            let ds = lobe_indirect(&scene, &points, tri, &hit.point, normal, &wo, options, &mut rng);
+                            let ds = lobe_indirect(&scene, &points, tri, &hit.point, &wo, options, &mut rng);
                             for c in 0..3 {
                                 specular[c] += ds[c];
                             }
@@ -463,20 +462,18 @@ const SPECULAR_SEED: u64 = 0x5bec_u64;
 
 /// ΔS at `p` toward `wo`: the recovered lobe's reflection of the light
 /// arriving from the room's surfaces (not the lamps, whose reflection is
-/// [`direct`]'s), by `options.specular_rays` directions sampled from the
-/// lobe, each followed by [`path_radiance`] through the recovered scene
-/// (thesis §4.6: "tracing a perturbed reflected ray into the
-/// environment"). Zero for a surface without a lobe. The uniform-light
-/// approximation `ρs a E_indirect / π` misses what the lobe actually
-/// mirrors: on the blue plastic board (ρd red 0.08 under ρs 0.06) it left
-/// the map's red 10 % high.
-#[allow(clippy::too_many_arguments)]
+/// [`direct`]'s), by `options.specular_rays` stratified directions sampled
+/// from the lobe, each followed through the recovered scene
+/// ([`scattered_radiance`]; thesis §4.6: "tracing a perturbed reflected
+/// ray into the environment"). Zero for a surface without a lobe. The
+/// uniform-light approximation `ρs a E_indirect / π` misses what the lobe
+/// actually mirrors: on the blue plastic board (ρd red 0.08 under ρs 0.06)
+/// it left the map's red 10 % high.
 fn lobe_indirect(
     scene: &Scene,
     points: &[PointLight],
     tri: &Triangle,
     p: &Vector3<f64>,
-    normal: Vector3<f64>,
     wo: &Vector3<f64>,
     options: &AlbedoMapOptions,
     rng: &mut ChaCha8Rng,
@@ -484,49 +481,27 @@ fn lobe_indirect(
     if scene.materials()[tri.material as usize].specular.is_none() {
         return [0.0; 3];
     }
-    let (bsdf, origin) = lobe_at(scene, tri, p, normal);
-    let strata = Strata::new(options.specular_rays, rng);
-    let mut sum = [0.0; 3];
-    for k in 0..options.specular_rays {
-        let [u1, u2] = strata.point(k, rng);
-        let Some(s) = bsdf.sample(wo, [0.0, u1, u2]) else {
-            continue;
-        };
-        let cos = s.direction.dot(&normal);
-        if cos <= 0.0 || s.pdf <= 0.0 {
-            continue;
-        }
-        let l = path_radiance(
-            scene,
-            points,
-            Ray {
-                origin,
-                direction: s.direction,
-            },
-            options.max_bounces.saturating_sub(1),
-            rng,
-        );
-        for c in 0..3 {
-            sum[c] += s.value[c] * cos / s.pdf * l[c];
-        }
-    }
-    sum.map(|v| v / f64::from(options.specular_rays))
+    let v = lobe_vertex(scene, tri, p, wo);
+    scattered_radiance(
+        scene,
+        points,
+        &v,
+        (options.specular_rays, options.max_bounces, true),
+        rng,
+    )
 }
 
-/// The recovered specular lobe alone of `tri`'s material at `p` (no
-/// diffuse part: the albedo map divides the rest out), and the point just
-/// off the surface that rays leave from.
-fn lobe_at(scene: &Scene, tri: &Triangle, p: &Vector3<f64>, normal: Vector3<f64>) -> (SurfaceBsdf, Vector3<f64>) {
+/// The path vertex at `p` seen from `wo` with the recovered specular lobe
+/// of `tri`'s material alone (no diffuse part: the albedo map divides the
+/// rest out).
+fn lobe_vertex(scene: &Scene, tri: &Triangle, p: &Vector3<f64>, wo: &Vector3<f64>) -> PathVertex {
     let lobe_only = Material {
         name: String::new(),
         albedo: Texture::Constant([0.0; 3]),
         specular: scene.materials()[tri.material as usize].specular,
         emission: [0.0; 3],
     };
-    (
-        SurfaceBsdf::at(&lobe_only, tri, p, normal),
-        p + normal * 1e-6 * (1.0 + p.norm()),
-    )
+    PathVertex::at(&lobe_only, tri, p, *wo)
 }
 
 /// The lamps' irradiance at `p` (shadow-tested) and the recovered lobe's
@@ -539,7 +514,7 @@ fn direct(
     normal: Vector3<f64>,
     wo: &Vector3<f64>,
 ) -> ([f64; 3], [f64; 3]) {
-    let (bsdf, origin) = lobe_at(scene, tri, p, normal);
+    let PathVertex { bsdf, origin, .. } = lobe_vertex(scene, tri, p, wo);
     let (mut e, mut s) = ([0.0; 3], [0.0; 3]);
     for l in points {
         let to = l.position - origin;

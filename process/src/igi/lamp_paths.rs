@@ -91,13 +91,32 @@ pub fn surface_radiance(
     scene: &Scene,
     points: &[PointLight],
     v: &PathVertex,
-    (samples, max_bounces, stratified): (u32, u32, bool),
+    paths: (u32, u32, bool),
     rng: &mut ChaCha8Rng,
 ) -> [f64; 3] {
     let mut l = [0.0; 3];
     add_direct(scene, points, v, &[1.0; 3], &mut l);
+    let scattered = scattered_radiance(scene, points, v, paths, rng);
+    for c in 0..3 {
+        l[c] += scattered[c];
+    }
+    l
+}
+
+/// The interreflected part of [`surface_radiance`]: the light leaving `v`
+/// toward its viewer after at least one other surface, estimated by
+/// `samples` BRDF-sampled paths of up to `max_bounces − 1` further
+/// scattering events, their first directions stratified if `stratified`.
+/// Zero when `max_bounces < 2` or `samples == 0`.
+pub fn scattered_radiance(
+    scene: &Scene,
+    points: &[PointLight],
+    v: &PathVertex,
+    (samples, max_bounces, stratified): (u32, u32, bool),
+    rng: &mut ChaCha8Rng,
+) -> [f64; 3] {
     if max_bounces < 2 || samples == 0 {
-        return l;
+        return [0.0; 3];
     }
     let strata = stratified.then(|| Strata::new(samples, rng));
     let mut sum = [0.0; 3];
@@ -130,10 +149,7 @@ pub fn surface_radiance(
             sum[c] += s.value[c] * cos / s.pdf * li[c];
         }
     }
-    for c in 0..3 {
-        l[c] += sum[c] / f64::from(samples);
-    }
-    l
+    sum.map(|v| v / f64::from(samples))
 }
 
 /// The radiance arriving along `ray` (toward its origin) by one path of up
