@@ -5,6 +5,7 @@ mod config_check;
 mod demo;
 mod devices;
 mod env;
+pub mod exit;
 mod hdr;
 mod igi;
 mod logging;
@@ -21,10 +22,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-/// Exit code for success.
-pub const EXIT_OK: u8 = 0;
-/// Exit code for a usage error or an invalid configuration file.
-pub const EXIT_USAGE: u8 = 2;
+pub use exit::{EXIT_FAILURE, EXIT_OK, EXIT_QUALITY, EXIT_USAGE};
 
 /// Campanile: a capture-and-process station for real scenes.
 ///
@@ -39,8 +37,11 @@ pub const EXIT_USAGE: u8 = 2;
     version,
     propagate_version = true,
     max_term_width = 100,
-    after_help = "Exit status: 0 success, 1 failure while working, 2 usage or configuration error.\n\
-                  Examples: campanile config check examples/*.ron"
+    after_help = concat!(
+        "Exit status: 0 ok; 1 failure while working; 2 bad input or usage (an argument, a configuration or input \
+         file, a value); 3 finished, but a product failed its quality gate (quality.json names it).\n",
+        "Examples: campanile config check examples/*.ron"
+    )
 )]
 pub struct Cli {
     #[command(flatten)]
@@ -99,16 +100,13 @@ pub enum Command {
     },
 }
 
-/// Exit code for a failure while doing the work.
-pub const EXIT_FAILURE: u8 = 1;
-
-/// Prints an error chain and maps it to an exit code.
+/// Prints an error chain and maps it to an exit code (see [`exit`]).
 fn report(result: anyhow::Result<()>) -> u8 {
     match result {
         Ok(()) => EXIT_OK,
         Err(e) => {
             eprintln!("error: {e:#}");
-            EXIT_FAILURE
+            exit::code_of(&e)
         }
     }
 }
