@@ -35,6 +35,7 @@ impl fmt::Display for BadInput {
 impl std::error::Error for BadInput {}
 
 /// An `anyhow` error that exits 2, with `message` as its text.
+#[allow(dead_code)] // until the subcommands use it (issue 21)
 pub fn bad_input(message: impl Into<String>) -> anyhow::Error {
     anyhow::Error::new(BadInput(message.into()))
 }

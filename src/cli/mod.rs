@@ -22,7 +22,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-pub use exit::{EXIT_FAILURE, EXIT_OK, EXIT_QUALITY, EXIT_USAGE};
+pub use exit::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
 
 /// Campanile: a capture-and-process station for real scenes.
 ///
