@@ -74,6 +74,111 @@ fn calibrate_then_merge_recovers_the_chart_radiance() {
         let median = rel[rel.len() / 2];
         assert!(median < 0.02, "channel {c}: median relative error {median}");
     }
+
+    // The verdicts beside the products: both ok on the chart.
+    for product in ["curve.quality.json", "merged.quality.json"] {
+        let q: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join(product)).expect(product)).unwrap();
+        assert_eq!(q["verdict"], "ok", "{product}: {q}");
+    }
+
+    // An all-black and an all-white bracket merge (every pixel is masked)
+    // but fail their gate: exit 3, naming the figure (issue 21).
+    for (name, code, figure) in [
+        ("black", 0u16, "fraction of pixels dark in every exposure 1 > 0.5"),
+        ("white", 255, "fraction of pixels clipped in every exposure 1 > 0.5"),
+    ] {
+        let mut shots = Vec::new();
+        for k in 0..3 {
+            let p = dir.path().join(format!("{name}{k}.png"));
+            let img = campanile_process::camera::image::CodeImage {
+                width: 16,
+                height: 12,
+                bits: 8,
+                data: vec![code; 16 * 12 * 3],
+                label: name.into(),
+            };
+            write_png(&img, &p).expect("png");
+            shots.push(p.to_str().expect("utf-8").to_owned());
+        }
+        let exr = dir.path().join(format!("{name}.exr"));
+        let mut args = vec![
+            "hdr",
+            "merge",
+            "--times",
+            "0.01,0.1,1",
+            "--curve",
+            curve.to_str().expect("utf-8"),
+            "--out",
+            exr.to_str().expect("utf-8"),
+        ];
+        args.extend(shots.iter().map(String::as_str));
+        let out = campanile(&args);
+        let (stdout, stderr) = (
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr),
+        );
+        assert_eq!(out.status.code(), Some(3), "{name}: {stdout}{stderr}");
+        assert!(stdout.contains(figure), "{name}: {stdout}");
+        let q: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join(format!("{name}.quality.json"))).unwrap()).unwrap();
+        assert_eq!(q["products"][0]["verdict"], "failed", "{name}: {q}");
+
+        // Thresholds are data: a file that accepts a blank frame passes it
+        // (exit 0); one whose bounds are in the wrong order is refused
+        // (exit 2), naming the field.
+        let lenient = dir.path().join("lenient.ron");
+        std::fs::write(
+            &lenient,
+            "Quality(merge: (valid: (poor: 0.0, failed: 0.0), clipped: (poor: 1.0, failed: 1.0), \
+             dark: (poor: 1.0, failed: 1.0)))",
+        )
+        .unwrap();
+        let bad = dir.path().join("bad.ron");
+        std::fs::write(&bad, "Quality(merge: (valid: (poor: 0.5, failed: 0.9)))").unwrap();
+        for (thresholds, code, expected) in [(&lenient, 0, "quality: 1 ok"), (&bad, 2, "merge.valid.failed")] {
+            let mut with = args.clone();
+            with.extend(["--thresholds", thresholds.to_str().unwrap()]);
+            let out = campanile(&with);
+            let text = format!(
+                "{}{}",
+                String::from_utf8_lossy(&out.stdout),
+                String::from_utf8_lossy(&out.stderr)
+            );
+            assert_eq!(
+                out.status.code(),
+                Some(code),
+                "{name}, {}: {text}",
+                thresholds.display()
+            );
+            assert!(text.contains(expected), "{name}: {text}");
+        }
+    }
+
+    // A merge through a curve whose verdict says failed inherits it: the
+    // chart's good bracket merged through it exits 3 and says why.
+    let verdict = dir.path().join("curve.quality.json");
+    let mut q: serde_json::Value = serde_json::from_slice(&std::fs::read(&verdict).unwrap()).unwrap();
+    q["verdict"] = "failed".into();
+    std::fs::write(&verdict, q.to_string()).unwrap();
+    let mut args = vec![
+        "hdr",
+        "merge",
+        "--times",
+        &times_arg,
+        "--curve",
+        curve.to_str().expect("utf-8"),
+        "--out",
+        exr.to_str().expect("utf-8"),
+    ];
+    args.extend(paths.iter().map(String::as_str));
+    let out = campanile(&args);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(3), "{stdout}");
+    assert!(
+        stdout.contains("(inherited from ") && stdout.contains("curve.csv: failed"),
+        "{stdout}"
+    );
 }
 
 #[test]

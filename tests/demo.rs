@@ -143,6 +143,21 @@ fn the_quick_demo_runs_end_to_end_and_its_figures_match_the_simulator() {
     println!("{}", String::from_utf8_lossy(&out.stdout));
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(processed.join("report.html").is_file());
+    // The clean session: every product passes its quality gate (issue 21;
+    // `tests/quality_gates.rs` has the session that does not).
+    let quality: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(processed.join("quality.json")).expect("quality.json")).unwrap();
+    let not_ok: Vec<String> = quality["products"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|p| p["verdict"] != "ok")
+        .map(|p| format!("{} {}: {}", p["product"], p["verdict"], p["checks"]))
+        .collect();
+    assert!(not_ok.is_empty(), "products not ok: {not_ok:#?}");
+    assert_eq!(quality["verdict"], "ok");
+    let html = std::fs::read_to_string(processed.join("report.html")).unwrap();
+    assert!(html.contains("<div class=\"quality ok\" id=\"quality\"><strong>Quality: ok</strong>"));
     // The morning's environment map as EXR: 36 × 18 regions, those the tiles
     // saw (elevations −30° to 10°: 4 of the 18 bands at least) with radiance.
     let env = std::fs::read_dir(processed.join("light"))

@@ -23,14 +23,28 @@ fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }
 
+/// Runs `campanile ARGS` and returns its standard output. It must succeed,
+/// or exit 3 with only low-sun suns failed: below 8° the triplet disagrees
+/// by 8–42% at 0.31° pixels (the README's false alarm), and those sun
+/// measurements fail their gate (spread > 15%) by design.
 fn run(args: &[&str]) -> String {
     let out = campanile(args);
     let stdout = text(&out.stdout);
-    assert!(
-        out.status.success(),
-        "campanile {args:?}\nstdout:\n{stdout}\nstderr:\n{}",
-        text(&out.stderr)
-    );
+    let why = format!("campanile {args:?}\nstdout:\n{stdout}\nstderr:\n{}", text(&out.stderr));
+    match out.status.code() {
+        Some(0) => {}
+        Some(3) => {
+            let line = stdout.lines().find(|l| l.starts_with("quality: ")).expect(&why);
+            let failed = line.split(" — failed: ").nth(1).expect(&why);
+            for product in failed.split("; ") {
+                assert!(
+                    product.starts_with("sun sky@") && product.contains("triplet spread"),
+                    "{product}: {why}"
+                );
+            }
+        }
+        _ => panic!("{why}"),
+    }
     stdout
 }
 

@@ -67,6 +67,12 @@ pub fn load_scene(path: &Path) -> Result<Loaded<Scene>, ConfigErrors> {
     load_valid(expect_kind(SourceFile::read(path)?, "Scene")?)
 }
 
+/// Reads and validates a quality-thresholds file (`Quality(...)`, any
+/// subset of the fields of [`crate::quality::Quality`]).
+pub fn load_quality(path: &Path) -> Result<Loaded<crate::quality::Quality>, ConfigErrors> {
+    load_valid(expect_kind(SourceFile::read(path)?, "Quality")?)
+}
+
 /// Reads and validates a plan file and the scene it names.
 pub fn load_plan(path: &Path) -> Result<LoadedPlan, ConfigErrors> {
     load_plan_source(expect_kind(SourceFile::read(path)?, "Plan")?)

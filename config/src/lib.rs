@@ -21,6 +21,7 @@ pub mod head;
 pub mod lights;
 pub mod link;
 pub mod plan;
+pub mod quality;
 pub mod scene;
 pub mod site;
 pub mod source;
@@ -36,13 +37,15 @@ mod roundtrip;
 
 pub use camera::Camera;
 pub use document::{
-    Document, Loaded, LoadedPlan, check_plan_on_station, load, load_plan, load_scene, load_station, load_text,
+    Document, Loaded, LoadedPlan, check_plan_on_station, load, load_plan, load_quality, load_scene, load_station,
+    load_text,
 };
 pub use error::{ConfigError, ConfigErrors};
 pub use filter_wheel::FilterWheel;
 pub use head::PanTiltHead;
 pub use lights::Lights;
 pub use plan::Plan;
+pub use quality::Quality;
 pub use scene::Scene;
 pub use site::Site;
 pub use station::Station;

@@ -304,6 +304,11 @@ pub struct Plan {
     /// The sessions.
     #[cfg_attr(test, proptest(strategy = "crate::arbitrary::small_vec()"))]
     pub sessions: Vec<Session>,
+    /// Quality gates for this plan's products, where they differ from the
+    /// defaults (`crate::quality`); a command's `--thresholds` file wins.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(test, proptest(value = "None"))]
+    pub quality: Option<crate::quality::Quality>,
 }
 
 impl Validate for Plan {
@@ -313,6 +318,9 @@ impl Validate for Plan {
             v.invalid("sessions", "an empty list".into(), "at least one session");
         }
         v.unique_names("sessions", self.sessions.iter().map(|s| s.name.as_str()));
+        if let Some(q) = &self.quality {
+            v.at("quality", |v| q.validate(v));
+        }
         v.at("sessions", |v| {
             for (i, s) in self.sessions.iter().enumerate() {
                 v.at(i, |v| validate_session(s, v));

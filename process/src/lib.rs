@@ -21,6 +21,7 @@ pub mod model_choice;
 pub mod outdoor;
 pub mod pipeline;
 pub mod pose;
+pub mod quality;
 pub mod render;
 pub mod report;
 pub mod scene_geometry;

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use campanile_process::environment::{EnvironmentFile, RegionRecord, fit_region, read_observations};
+use campanile_process::quality::{QualityReport, gates};
 use clap::Subcommand;
 
 use super::sky::SunArgs;
@@ -30,6 +31,12 @@ pub enum EnvCommand {
         /// Where to write the models (RON); standard output when absent.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Quality thresholds (a `Quality(...)` RON file, any subset of the
+        /// gates). Each region's verdict (its residual) goes to OUT's stem +
+        /// .quality.json (with no --out, one line on standard error); a
+        /// failed region exits 3.
+        #[arg(long, value_name = "FILE.ron")]
+        thresholds: Option<PathBuf>,
     },
     /// Predict every region's radiance under new light (eq. 5.13).
     ///
@@ -63,7 +70,12 @@ fn rgb(flag: &str, text: &str) -> Result<[f64; 3]> {
 
 pub fn run(cmd: EnvCommand) -> Result<()> {
     match cmd {
-        EnvCommand::Fit { observations, out } => {
+        EnvCommand::Fit {
+            observations,
+            out,
+            thresholds,
+        } => {
+            let q = super::verdicts::thresholds(thresholds.as_deref(), None)?;
             let file = File::open(&observations).with_context(|| format!("{}: cannot open", observations.display()))?;
             let groups =
                 read_observations(BufReader::new(file)).with_context(|| format!("{}", observations.display()))?;
@@ -76,7 +88,18 @@ pub fn run(cmd: EnvCommand) -> Result<()> {
                     fit,
                 });
             }
-            super::ron_output::write_ron(&EnvironmentFile { regions }, out.as_deref())
+            let quality = QualityReport::new(
+                regions
+                    .iter()
+                    .map(|r| gates::environment_region(&r.region, &r.fit, &q))
+                    .collect(),
+                &q,
+            );
+            super::ron_output::write_ron(&EnvironmentFile { regions }, out.as_deref())?;
+            match &out {
+                Some(path) => super::verdicts::finish(&quality, &super::verdicts::beside(path)),
+                None => super::verdicts::finish_on_stderr(&quality),
+            }
         }
         EnvCommand::Predict {
             models,

@@ -19,7 +19,9 @@ use campanile_process::hdr::robertson::{RobertsonOptions, calibrate_robertson};
 use campanile_process::hdr::sampling::SampleOptions;
 use clap::{Args, Subcommand, ValueEnum};
 
+use super::verdicts;
 use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
+use campanile_process::quality::{QualityReport, gates};
 
 #[derive(Debug, Subcommand)]
 pub enum HdrCommand {
@@ -95,6 +97,11 @@ pub struct CalibrateArgs {
     /// Accept 8-bit images that look resampled (for cameras that filter their own output).
     #[arg(long)]
     allow_resampled: bool,
+    /// Quality thresholds (a `Quality(...)` RON file, any subset of the
+    /// gates). The curve's verdict goes to OUT's stem + .quality.json; a
+    /// failed curve exits 3.
+    #[arg(long, value_name = "FILE.ron")]
+    thresholds: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]
@@ -122,6 +129,12 @@ pub struct MergeArgs {
     /// Sensor read noise in electrons.
     #[arg(long, default_value_t = NoiseModel::default().read_noise_electrons)]
     read_noise: f64,
+    /// Quality thresholds (a `Quality(...)` RON file, any subset of the
+    /// gates). The map's verdict (pixels valid, clipped or dark in every
+    /// exposure) goes to OUT's stem + .quality.json; a failed map (an
+    /// all-black or all-white bracket) exits 3.
+    #[arg(long, value_name = "FILE.ron")]
+    thresholds: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]
@@ -137,7 +150,7 @@ pub struct LensArgs {
     out: PathBuf,
 }
 
-/// Runs an `hdr` subcommand; returns the exit code (0 ok, 1 failure, 2 bad input or usage).
+/// Runs an `hdr` subcommand; returns the exit code (0 ok, 1 failure, 2 bad input or usage, 3 a failed product).
 pub fn run(cmd: HdrCommand) -> u8 {
     let result = match cmd {
         HdrCommand::Calibrate(a) => calibrate(&a),
@@ -153,8 +166,13 @@ pub fn run(cmd: HdrCommand) -> u8 {
     }
 }
 
-/// 2 for problems with the input (files, values, options), 1 for failures while working.
+/// 2 for problems with the input (files, values, options), 3 for a
+/// product that failed its quality gate, 1 for failures while working.
 fn exit_code(e: &anyhow::Error) -> u8 {
+    let code = super::exit::code_of(e);
+    if code != EXIT_FAILURE {
+        return code;
+    }
     match e.chain().find_map(|c| c.downcast_ref::<HdrError>()) {
         Some(HdrError::Singular { .. }) => EXIT_FAILURE,
         Some(HdrError::Io { .. } | HdrError::Exr { .. }) if is_output_error(e) => EXIT_FAILURE,
@@ -194,13 +212,14 @@ fn write(path: &Path, text: &str) -> Result<()> {
 }
 
 fn calibrate(a: &CalibrateArgs) -> Result<()> {
+    let q = verdicts::thresholds(a.thresholds.as_deref(), None)?;
     let bracket = load(&a.bracket)?;
     let sampling = SampleOptions {
         samples: a.samples,
         seed: a.seed,
         ..Default::default()
     };
-    let (curve, method) = match a.method {
+    let (curve, method, quality) = match a.method {
         Method::Debevec => {
             let opts = DebevecOptions {
                 lambda: a.lambda,
@@ -232,7 +251,8 @@ fn calibrate(a: &CalibrateArgs) -> Result<()> {
                     );
                 }
             }
-            (cal.curve, cal.method)
+            let quality = gates::response(&cal, bracket.len(), bracket.len(), &q);
+            (cal.curve, cal.method, quality)
         }
         Method::Robertson => {
             let opts = RobertsonOptions {
@@ -242,7 +262,12 @@ fn calibrate(a: &CalibrateArgs) -> Result<()> {
             };
             let (curve, iters) = calibrate_robertson(&bracket, &opts).context("recovering the response (Robertson)")?;
             println!("Robertson: {iters:?} iterations (R, G, B)");
-            (curve, format!("robertson samples={} seed={}", a.samples, a.seed))
+            let quality = gates::response_curve(&curve, bracket.len(), bracket.len(), &q);
+            (
+                curve,
+                format!("robertson samples={} seed={}", a.samples, a.seed),
+                quality,
+            )
         }
     };
     write(&a.out, &curve.to_csv(&method))?;
@@ -250,7 +275,7 @@ fn calibrate(a: &CalibrateArgs) -> Result<()> {
     let svg = curve_plot_svg(&curve, &format!("Response curve ({method})")).context("plotting the curve")?;
     write(&plot, &svg)?;
     println!("wrote {} and {}", a.out.display(), plot.display());
-    Ok(())
+    verdicts::finish(&QualityReport::new(vec![quality], &q), &verdicts::beside(&a.out))
 }
 
 fn per_channel(name: &str, v: &[f64]) -> Result<[f64; 3]> {
@@ -265,6 +290,7 @@ fn per_channel(name: &str, v: &[f64]) -> Result<[f64; 3]> {
 }
 
 fn merge_cmd(a: &MergeArgs) -> Result<()> {
+    let q = verdicts::thresholds(a.thresholds.as_deref(), None)?;
     let bracket = load(&a.bracket)?;
     let text = std::fs::read_to_string(&a.curve).with_context(|| format!("reading curve {}", a.curve.display()))?;
     let curve = ResponseCurve::from_csv(&text, &a.curve).context("reading the curve")?;
@@ -299,7 +325,15 @@ fn merge_cmd(a: &MergeArgs) -> Result<()> {
         map.height,
         bracket.len()
     );
-    Ok(())
+    let name = a
+        .out
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    let mut quality = gates::radiance(&name, &map, false, &q);
+    if let Some(curve) = verdicts::of_input(&a.curve)? {
+        quality.inherit(&curve);
+    }
+    verdicts::finish(&QualityReport::new(vec![quality], &q), &verdicts::beside(&a.out))
 }
 
 fn lens(a: &LensArgs) -> Result<()> {

@@ -14,6 +14,7 @@ use campanile_process::igi::relight::{RelightSettings, relight};
 use campanile_process::igi::relit_scene::recovered_scene;
 use campanile_process::igi::scene_file::{LoadedIgiScene, load, load_lights};
 use campanile_process::igi::{IgiLight, IgiOptions, IgiResult, format_table, recover};
+use campanile_process::quality::{QualityReport, gates};
 use clap::Args;
 
 /// Recover every surface's Ward BRDF and albedo map from a scene file.
@@ -43,6 +44,11 @@ pub struct IgiArgs {
     /// A faster, coarser run (fewer radiosity cells, rays and iterations).
     #[arg(long)]
     quick: bool,
+    /// Quality thresholds (a `Quality(...)` RON file, any subset of the
+    /// gates). Each surface's verdict (its fit's residual, the energy
+    /// bound) goes to OUT/quality.json; a failed surface exits 3.
+    #[arg(long, value_name = "FILE.ron")]
+    thresholds: Option<PathBuf>,
 }
 
 /// The solver's and the albedo map's settings: `quick` for the tests and `demo --quick`.
@@ -283,8 +289,10 @@ pub fn write_products(r: &Recovered, out: &Path) -> Result<()> {
 
 /// Runs `campanile igi`.
 pub fn run(args: IgiArgs) -> Result<()> {
+    let q = super::verdicts::thresholds(args.thresholds.as_deref(), None)?;
     let r = recover_scene(&args.scene, args.quick).with_context(|| format!("reading {}", args.scene.display()))?;
     write_products(&r, &args.out)?;
+    let quality = QualityReport::new(r.result.surfaces.iter().map(|s| gates::brdf(s, &q)).collect(), &q);
     if let Some(lights) = &args.relight {
         let lights: Vec<IgiLight> = load_lights(lights)
             .map_err(|e| anyhow!("{e}"))?
@@ -298,5 +306,5 @@ pub fn run(args: IgiArgs) -> Result<()> {
             println!("relit {}", path.display());
         }
     }
-    Ok(())
+    super::verdicts::finish(&quality, &args.out.join("quality.json"))
 }

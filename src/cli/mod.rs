@@ -17,6 +17,7 @@ mod site;
 mod sky;
 mod station;
 mod sun;
+mod verdicts;
 
 use std::process::ExitCode;
 

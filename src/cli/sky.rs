@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use campanile_process::exr_io::write_radiance_exr;
 use campanile_process::hdr::merge::RadianceMap;
+use campanile_process::quality::{QualityReport, gates};
 use campanile_process::sky::{
     ChannelSky, KnownSky, SkyFile, angle_between, direction, fit_sky_robust, predict_sky, read_directions,
     read_samples, render_latlong,
@@ -51,6 +52,12 @@ pub enum SkyCommand {
         /// above), −10% blue to +10% red; masked samples count too.
         #[arg(long, value_name = "PNG")]
         residual_map: Option<PathBuf>,
+        /// Quality thresholds (a `Quality(...)` RON file, any subset of the
+        /// gates). The fit's verdict (residual, samples masked, convergence)
+        /// goes to OUT's stem + .quality.json (with no --out, one line on
+        /// standard error); a failed fit exits 3.
+        #[arg(long, value_name = "FILE.ron")]
+        thresholds: Option<PathBuf>,
     },
     /// Predict the sky at another sun position from skies fitted at others.
     ///
@@ -160,12 +167,15 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
             sun,
             out,
             residual_map,
+            thresholds,
         } => {
+            let q = super::verdicts::thresholds(thresholds.as_deref(), None)?;
             let (zs, az) = sun.resolve()?;
             let file = File::open(&samples).with_context(|| format!("{}: cannot open", samples.display()))?;
             let table = read_samples(BufReader::new(file)).with_context(|| format!("{}", samples.display()))?;
             let sun_dir = direction(zs, az);
             let mut channels = Vec::new();
+            let mut converged = [true; 3];
             for (c, name) in table.channels.iter().enumerate() {
                 let pts = table.sky_samples(c, sun_dir);
                 let robust =
@@ -180,6 +190,9 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
                     fit.reason
                 );
                 channels.push(ChannelSky::new(name, fit, pts.len(), robust.masked_fraction));
+                if let Some(slot) = converged.get_mut(c) {
+                    *slot = fit.converged;
+                }
             }
             let sky = SkyFile {
                 sun_zenith_deg: zs.to_degrees(),
@@ -203,7 +216,15 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
                     campanile_process::report::false_colour_png("sky residuals", size, size, &map, (-0.1, 0.1))?;
                 std::fs::write(&png, bytes).with_context(|| format!("{}: cannot write", png.display()))?;
             }
-            super::ron_output::write_ron(&sky, out.as_deref())
+            super::ron_output::write_ron(&sky, out.as_deref())?;
+            let name = samples
+                .file_name()
+                .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+            let quality = QualityReport::new(vec![gates::sky(&name, &sky.channels, Some(converged), &q)], &q);
+            match &out {
+                Some(path) => super::verdicts::finish(&quality, &super::verdicts::beside(path)),
+                None => super::verdicts::finish_on_stderr(&quality),
+            }
         }
         SkyCommand::Predict { skies, sun, out } => {
             let (zs, az) = sun.resolve()?;

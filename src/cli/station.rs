@@ -19,12 +19,13 @@ use chrono::{DateTime, TimeDelta, Utc};
 use clap::{Args, Subcommand};
 
 use super::capture::{Inputs, SimulatedWorld, simulated_world};
-use super::process::sky_series::{SkySeriesOptions, process_scan, recompute_day};
+use super::process::sky_series::{SkySeriesOptions, process_scan, recompute_day, series_quality};
 use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
 use campanile_capture::schedule::Occurrence;
 use campanile_capture::store::PROCESSED_DIR;
 use campanile_capture::unattended::ScanHook;
 use campanile_process::hdr::debevec::DebevecOptions;
+use campanile_process::quality::{Quality, Verdict};
 
 #[derive(Debug, Subcommand)]
 pub enum StationCommand {
@@ -307,7 +308,7 @@ fn run_simulated(args: &RunArgs, inputs: &Inputs, options: &StationOptions) -> R
             &mut sim,
             &clock,
             options,
-            hook(args).as_mut(),
+            hook(args, inputs.plan.plan.value.quality.clone().unwrap_or_default()).as_mut(),
             &stop,
             &mut NoProgress,
         )
@@ -318,6 +319,7 @@ fn run_simulated(args: &RunArgs, inputs: &Inputs, options: &StationOptions) -> R
 /// The sky time series of `campanile process`, run on each finished scan.
 struct SkySeriesHook {
     response: PathBuf,
+    thresholds: Quality,
 }
 
 impl ScanHook for SkySeriesHook {
@@ -329,16 +331,28 @@ impl ScanHook for SkySeriesHook {
             debevec: DebevecOptions::default(),
         };
         process_scan(session_dir, &occurrence.key, &opts).map_err(|e| format!("{e:#}"))?;
-        recompute_day(&opts.out).map_err(|e| format!("{e:#}"))?;
+        let series = recompute_day(&opts.out).map_err(|e| format!("{e:#}"))?;
+        // The day's verdicts beside its products; a scan that failed is
+        // logged (the station goes on: the next scan may be clear).
+        let day = series_quality(series.scans.iter(), &self.thresholds);
+        super::verdicts::write(&day, &opts.out.join("quality.json")).map_err(|e| format!("{e:#}"))?;
+        let this = series_quality(
+            series.scans.iter().filter(|s| s.occurrence == occurrence.key),
+            &self.thresholds,
+        );
+        if this.verdict != Verdict::Ok {
+            tracing::warn!(scan = %occurrence.key, "{}", this.summary_line());
+        }
         Ok(())
     }
 }
 
 /// The scan hook `args` ask for.
-fn hook(args: &RunArgs) -> Box<dyn ScanHook> {
+fn hook(args: &RunArgs, thresholds: Quality) -> Box<dyn ScanHook> {
     match (&args.response, args.process) {
         (Some(response), true) => Box::new(SkySeriesHook {
             response: response.clone(),
+            thresholds,
         }),
         _ => Box::new(NoProcessing),
     }
@@ -378,7 +392,7 @@ fn run_real(args: &RunArgs, inputs: &Inputs, options: &StationOptions) -> Result
             &mut rig,
             &SystemClock,
             options,
-            hook(args).as_mut(),
+            hook(args, inputs.plan.plan.value.quality.clone().unwrap_or_default()).as_mut(),
             &stop,
             &mut NoProgress,
         )

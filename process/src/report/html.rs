@@ -3,6 +3,8 @@
 use base64::Engine as _;
 use base64::engine::general_purpose::STANDARD;
 
+use crate::quality::{QualityReport, Verdict};
+
 /// A figure: an inline image with a caption.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Figure {
@@ -53,6 +55,9 @@ pub struct Report {
     pub title: String,
     /// Lines under the title.
     pub intro: Vec<String>,
+    /// The products' quality verdicts: a banner at the top names every
+    /// `poor` or `failed` product with its figures.
+    pub quality: Option<QualityReport>,
     /// Sections, in order.
     pub sections: Vec<Section>,
 }
@@ -76,11 +81,41 @@ h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-to
 table{border-collapse:collapse;margin:1em 0;font-size:.9em}td,th{border:1px solid #bbb;padding:.25em .6em;text-align:right}\
 th{background:#eee}td:first-child,th:first-child{text-align:left}caption{text-align:left;font-weight:bold;padding:.3em 0}\
 .figs{display:flex;flex-wrap:wrap;gap:1em}figure{margin:0}figure img{max-width:560px;border:1px solid #ddd;image-rendering:pixelated}\
-figcaption{font-size:.85em;color:#555;max-width:560px}nav a{margin-right:1em}";
+figcaption{font-size:.85em;color:#555;max-width:560px}nav a{margin-right:1em}\
+.quality{border:2px solid;padding:.5em 1em;margin:1em 0}.quality ul{margin:.3em 0}\
+.quality.ok{border-color:#2a7;background:#eefaf3}.quality.poor{border-color:#d90;background:#fff8e6}\
+.quality.failed{border-color:#c22;background:#fdeeee}";
 
 const CHECK: &str = "window.addEventListener('load',function(){var i=document.images,n=0;\
 for(var k=0;k<i.length;k++){if(i[k].complete&&i[k].naturalWidth>0)n++;}\
 document.body.setAttribute('data-images-loaded',n+'/'+i.length);});";
+
+/// The quality banner: the overall verdict, then every `failed` and
+/// `poor` product with the figures that put it there.
+fn banner(q: &QualityReport) -> String {
+    let c = q.counts;
+    let mut h = format!(
+        "<div class=\"quality {}\" id=\"quality\"><strong>Quality: {}</strong> ({} ok, {} poor, {} failed; every figure and threshold in quality.json)",
+        q.verdict, q.verdict, c.ok, c.poor, c.failed
+    );
+    for verdict in [Verdict::Failed, Verdict::Poor] {
+        let items: Vec<String> = q
+            .with(verdict)
+            .map(|p| {
+                format!(
+                    "<li><b>{verdict}</b> {}: {}</li>",
+                    escape(&p.product),
+                    escape(&p.reasons())
+                )
+            })
+            .collect();
+        if !items.is_empty() {
+            h.push_str(&format!("<ul>{}</ul>", items.join("")));
+        }
+    }
+    h.push_str("</div>\n");
+    h
+}
 
 impl Report {
     /// The page, self-contained.
@@ -92,6 +127,9 @@ impl Report {
         h.push_str(&format!("<h1>{}</h1>\n", escape(&self.title)));
         for line in &self.intro {
             h.push_str(&format!("<p>{}</p>\n", escape(line)));
+        }
+        if let Some(q) = &self.quality {
+            h.push_str(&banner(q));
         }
         h.push_str("<nav>");
         for (i, s) in self.sections.iter().enumerate() {
@@ -159,6 +197,7 @@ mod tests {
         let r = Report {
             title: "a <b> & c".into(),
             intro: vec![],
+            quality: None,
             sections: vec![Section {
                 title: "s".into(),
                 paragraphs: vec!["x < y".into()],
@@ -180,5 +219,44 @@ mod tests {
         // "<svg xmlns='http://www.w3.org/2000/svg'/>" in base64.
         assert!(html.contains("data:image/svg+xml;base64,PHN2ZyB4bWxucz0naHR0cDovL3d3dy53My5vcmcvMjAwMC9zdmcnLz4="));
         assert_eq!(r.figure_count(), 1);
+    }
+
+    #[test]
+    fn the_banner_names_every_failed_and_poor_product_with_its_figures() {
+        use crate::quality::{Better, Check, Gate, ProductQuality, Quality, QualityReport};
+        let failed = ProductQuality::new(
+            "response",
+            vec![Check::new(
+                "condition estimate",
+                1.2e9,
+                Gate::new(1e6, 1e8),
+                Better::Lower,
+            )],
+        );
+        let poor = ProductQuality::new(
+            "sun s@1",
+            vec![Check::new("triplet spread", 0.05, Gate::new(0.03, 0.15), Better::Lower)],
+        );
+        let ok = ProductQuality::new("sky s@1", vec![]);
+        let r = Report {
+            title: "t".into(),
+            quality: Some(QualityReport::new(vec![failed, poor, ok], &Quality::default())),
+            ..Report::default()
+        };
+        let html = r.to_html();
+        let banner = &html[html.find("<div class=\"quality failed\"").expect("a failed banner")..];
+        let banner = &banner[..banner.find("</div>").unwrap()];
+        assert!(banner.contains("1 ok, 1 poor, 1 failed"), "{banner}");
+        assert!(
+            banner.contains("<li><b>failed</b> response: condition estimate 1.2e9 &gt; 1e8</li>"),
+            "{banner}"
+        );
+        assert!(
+            banner.contains("<li><b>poor</b> sun s@1: triplet spread 0.05 &gt; 0.03</li>"),
+            "{banner}"
+        );
+        assert!(!banner.contains("sky s@1"), "ok products are only counted: {banner}");
+        // It comes before the first section.
+        assert!(html.find("id=\"quality\"").unwrap() < html.find("<nav>").unwrap());
     }
 }

@@ -149,6 +149,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
         Some(&scene),
         &campanile_process::hdr::debevec::DebevecOptions::default(),
         Some((18, 36)),
+        None,
     )?;
     let products = args.out.join("campanile-processed");
     process::write_outputs(&processed, &products)?;
@@ -168,10 +169,12 @@ pub fn run(args: DemoArgs) -> Result<()> {
     // Outdoors: pseudo-albedos, the held-out time, the day.
     eprintln!("recovering pseudo-albedos and re-rendering the held-out time …");
     let outdoor = process::outdoor_stages(&processed, &Default::default())?;
+    let mut quality = processed.quality.clone();
     let mut albedo_figures = None;
     let mut held_out_rmse = Vec::new();
     let mut held_out_floor = Vec::new();
     if let Some(o) = &outdoor {
+        quality.push(process::outdoor_quality(&processed, o));
         process::write_outdoor(o, &products)?;
         let truth_albedo = |triangle: usize, point: [f64; 3]| world.pseudo_albedos(triangle, point).sky_environment;
         let (outdoor_sections, figures) =
@@ -221,6 +224,8 @@ pub fn run(args: DemoArgs) -> Result<()> {
     eprintln!("the room: lamps, BRDFs, albedo maps, relit under new lamps …");
     let room = room::room(&args.out, args.quick)?;
     sections.push(room.section);
+    quality.extend(room.quality);
+    let quality = campanile_process::quality::QualityReport::new(quality, &processed.thresholds);
     let rows = &mut speed.tables[0].rows;
     rows.insert(
         0,
@@ -274,6 +279,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
             ),
             format!("Sessions and products are in {}.", display(&args.out)),
         ],
+        quality: Some(quality.clone()),
         sections,
     };
     let path = args.out.join("report.html");
@@ -284,7 +290,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
         path.display(),
         report.figure_count()
     );
-    Ok(())
+    crate::cli::verdicts::finish(&quality, &args.out.join("quality.json"))
 }
 
 fn display(p: &Path) -> String {

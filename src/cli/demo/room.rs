@@ -42,6 +42,8 @@ pub struct RoomRun {
     pub recover_s: f64,
     /// See `photograph_s`.
     pub relight_s: f64,
+    /// The verdicts of the room session's products.
+    pub quality: Vec<campanile_process::quality::ProductQuality>,
 }
 
 fn rel(got: f64, truth: f64) -> f64 {
@@ -83,12 +85,20 @@ pub fn room(dir: &Path, quick: bool) -> Result<RoomRun> {
         None,
         &campanile_process::hdr::debevec::DebevecOptions::default(),
         None,
+        None,
     )?;
     let processed_dir = out.join("processed");
     process::write_outputs(&processed, &processed_dir)?;
     let products = process::room::room_stage(&processed, &processed_dir, &process::room::RoomOptions { scale, quick })?;
     let r = &products.recovered;
     let recover_s = t.elapsed().as_secs_f64();
+    let quality = process::room::room_quality(&processed, &products)
+        .into_iter()
+        .map(|mut q| {
+            q.product = format!("room: {}", q.product);
+            q
+        })
+        .collect();
     let (wide_w, wide_h) = products.views.first().map_or((0, 0), |v| v.size);
     let truth = world.true_materials().map_err(|e| anyhow!("{e}"))?;
     let truth_opt: Vec<_> = truth.iter().copied().map(Some).collect();
@@ -293,5 +303,6 @@ pub fn room(dir: &Path, quick: bool) -> Result<RoomRun> {
         photograph_s,
         recover_s,
         relight_s,
+        quality,
     })
 }

@@ -18,6 +18,9 @@ use campanile_process::hdr::debevec::DebevecOptions;
 use campanile_process::pipeline::{
     MergedGroup, OccurrenceLight, Purpose, StationOptics, calibrate_response, group_frames, illumination, merge_groups,
 };
+use campanile_process::quality::{ProductQuality, Quality, QualityReport, gates};
+
+use crate::cli::verdicts;
 use campanile_process::report::{Report, Section};
 use campanile_process::sky::{ChannelSky, SkyFile};
 use clap::Args;
@@ -42,7 +45,8 @@ pub use session_frames::SessionInputs;
 ///   light/<occurrence>.ron         the sky per channel (eq. 5.9 parameters, model and why)
 ///   light/<occurrence>-environment.exr   the environment's lat-long region map
 ///   summary.json                   every figure and diagnostic, with stage times
-///   report.html                    the same as a page with plots (self-contained)
+///   quality.json                   every product's verdict (ok, poor, failed), its figures and thresholds
+///   report.html                    the same as a page with plots (self-contained), the verdicts in a banner
 ///
 /// A sky-only session (only sun shots, sky scans and brackets aimed at head
 /// angles) is processed as a sky time series instead: per scan the sun's
@@ -58,6 +62,11 @@ pub use session_frames::SessionInputs;
 /// and, when OUT is SESSION/processed and no --shard is given, each scan's
 /// occurrence is added to SESSION/processed/products.ron once its file is
 /// on disk (the station may then delete its raw frames).
+///
+/// Exit status: 0 every product ok or poor; 1 failure while working; 2 bad
+/// input (no such session, a bad option or thresholds file); 3 finished,
+/// but a product failed its quality gate (quality.json and the summary
+/// line name it; products made from it inherit its verdict).
 ///
 /// Examples:
 ///   campanile process campanile-day-session --scene examples/campanile-scene.ron
@@ -125,6 +134,12 @@ pub struct ProcessArgs {
     /// over the cell. BENCHMARKS.md sweeps it.
     #[arg(long, value_name = "M", default_value_t = campanile_process::outdoor::ReflectanceSettings::default().spacing_m, value_parser = grid_spacing)]
     grid_spacing: f64,
+    /// Quality thresholds (a `Quality(...)` RON file; any subset of the
+    /// gates, the rest keep the plan's or the defaults). Every product
+    /// gets a verdict, ok, poor or failed, in OUT/quality.json and the
+    /// report's banner; a failed one makes the command exit 3.
+    #[arg(long, value_name = "FILE.ron")]
+    thresholds: Option<PathBuf>,
 }
 
 fn grid_spacing(s: &str) -> Result<f64, String> {
@@ -147,7 +162,13 @@ fn room_scale(s: &str) -> Result<f64, String> {
 
 /// `process` on a room session: the response and HDR, then the room stage.
 fn run_room(args: &ProcessArgs, out: &Path, debevec: &DebevecOptions) -> Result<()> {
-    let processed = process_session(&args.session, args.scene.as_deref(), debevec, None)?;
+    let processed = process_session(
+        &args.session,
+        args.scene.as_deref(),
+        debevec,
+        None,
+        args.thresholds.as_deref(),
+    )?;
     write_outputs(&processed, out)?;
     let opts = room::RoomOptions {
         scale: args.room_scale,
@@ -163,6 +184,7 @@ fn run_room(args: &ProcessArgs, out: &Path, debevec: &DebevecOptions) -> Result<
         speed.tables[0].rows.push(vec![stage.clone(), format!("{s:.2}")]);
     }
     sections.push(speed);
+    let quality = QualityReport::new(room::room_quality(&processed, &products), &processed.thresholds);
     let report = Report {
         title: format!("Campanile: {}", args.session.display()),
         intro: vec![format!(
@@ -170,6 +192,7 @@ fn run_room(args: &ProcessArgs, out: &Path, debevec: &DebevecOptions) -> Result<
             args.session.display(),
             env!("CARGO_PKG_VERSION")
         )],
+        quality: Some(quality.clone()),
         sections,
     };
     write_report(&report, &out.join("report.html"))?;
@@ -182,7 +205,7 @@ fn run_room(args: &ProcessArgs, out: &Path, debevec: &DebevecOptions) -> Result<
     for (stage, s) in processed.summary.stage_seconds.iter().chain(&products.seconds) {
         println!("  {stage:<44} {s:>7.2} s");
     }
-    Ok(())
+    verdicts::finish(&quality, &out.join("quality.json"))
 }
 
 /// What `process` measured, for `summary.json` and the report.
@@ -226,6 +249,10 @@ pub struct Processed {
     pub merged: Vec<MergedGroup>,
     pub light: Vec<OccurrenceLight>,
     pub summary: Summary,
+    /// The thresholds, and the verdicts of the response, each radiance
+    /// map and each occurrence's sun, sky and environment.
+    pub thresholds: Quality,
+    pub quality: Vec<ProductQuality>,
 }
 
 pub fn run(args: ProcessArgs) -> Result<()> {
@@ -235,10 +262,17 @@ pub fn run(args: ProcessArgs) -> Result<()> {
         ..DebevecOptions::default()
     };
     debevec.sampling.samples = args.samples;
+    if !args.session.is_dir() {
+        return Err(crate::cli::exit::bad_input(format!(
+            "{}: no such session directory (give the directory `campanile capture --out` wrote)",
+            args.session.display()
+        )));
+    }
     let inputs = SessionInputs::open(&args.session, args.scene.as_deref())?;
     if sky_series::is_sky_only(&inputs.plan) {
+        let q = verdicts::thresholds(args.thresholds.as_deref(), Some(&inputs.plan))?;
         drop(inputs);
-        return run_sky_series(&args, out, debevec);
+        return run_sky_series(&args, out, debevec, &q);
     }
     if args.response.is_some() || args.shard.is_some() || args.merge_shards.is_some() || args.occurrence.is_some() {
         anyhow::bail!(
@@ -256,6 +290,7 @@ pub fn run(args: ProcessArgs) -> Result<()> {
         args.scene.as_deref(),
         &debevec,
         Some((args.env_rows, args.env_cols)),
+        args.thresholds.as_deref(),
     )?;
     write_outputs(&processed, &out)?;
     let settings = campanile_process::outdoor::ReflectanceSettings {
@@ -285,6 +320,11 @@ pub fn run(args: ProcessArgs) -> Result<()> {
             );
         }
     }
+    let mut quality = processed.quality.clone();
+    if let Some(o) = &outdoor {
+        quality.push(outdoor_quality(&processed, o));
+    }
+    let quality = QualityReport::new(quality, &processed.thresholds);
     let report = Report {
         title: format!("Campanile: {}", args.session.display()),
         intro: vec![format!(
@@ -292,6 +332,7 @@ pub fn run(args: ProcessArgs) -> Result<()> {
             args.session.display(),
             env!("CARGO_PKG_VERSION")
         )],
+        quality: Some(quality.clone()),
         sections,
     };
     write_report(&report, &out.join("report.html"))?;
@@ -315,10 +356,38 @@ pub fn run(args: ProcessArgs) -> Result<()> {
             println!("    note: {n}");
         }
     }
-    Ok(())
+    verdicts::finish(&quality, &out.join("quality.json"))
 }
 
-fn run_sky_series(args: &ProcessArgs, out: PathBuf, debevec: DebevecOptions) -> Result<()> {
+/// The pseudo-albedos' verdict: what they inherited from the response and
+/// the training occurrences' sun and sky (the light they are divided by),
+/// with the photos the outlier test dropped as notes.
+pub fn outdoor_quality(p: &Processed, o: &Outdoor) -> ProductQuality {
+    let mut q = ProductQuality::new("pseudo-albedos", Vec::new());
+    let training: Vec<&str> = p
+        .light
+        .iter()
+        .filter(|l| !l.held_out)
+        .map(|l| l.occurrence.as_str())
+        .collect();
+    for upstream in &p.quality {
+        let from_training = training
+            .iter()
+            .any(|occ| upstream.product == format!("sun {occ}") || upstream.product == format!("sky {occ}"));
+        if upstream.product == "response" || from_training {
+            q.inherit(upstream);
+        }
+    }
+    for photo in o.products.reflectance.photos.iter().filter(|c| c.outlier) {
+        q.notes.push(format!(
+            "photo {} left out as an outlier (trimmed mean log ratio {:.3})",
+            photo.label, photo.median_log_ratio
+        ));
+    }
+    q
+}
+
+fn run_sky_series(args: &ProcessArgs, out: PathBuf, debevec: DebevecOptions, q: &Quality) -> Result<()> {
     let opts = sky_series::SkySeriesOptions {
         out: out.clone(),
         response: args.response.clone(),
@@ -390,7 +459,14 @@ fn run_sky_series(args: &ProcessArgs, out: PathBuf, debevec: DebevecOptions) -> 
     }
     let flagged = series.scans.iter().filter(|s| !s.quality.names().is_empty()).count();
     println!("  {} scans in the series, {flagged} flagged", series.scans.len());
-    let report = sky_series::report(&args.session, &series, run.as_ref())?;
+    // With --occurrence, the verdicts (and the exit status) are that scan's;
+    // otherwise the whole series'.
+    let judged = series
+        .scans
+        .iter()
+        .filter(|s| args.occurrence.as_ref().is_none_or(|o| &s.occurrence == o));
+    let quality = sky_series::series_quality(judged, q);
+    let report = sky_series::report(&args.session, &series, run.as_ref(), Some(quality.clone()))?;
     write_report(&report, &out.join("report.html"))?;
     if let Some(run) = &run
         && !run.failed.is_empty()
@@ -403,7 +479,7 @@ fn run_sky_series(args: &ProcessArgs, out: PathBuf, debevec: DebevecOptions) -> 
             run.failed.len()
         );
     }
-    Ok(())
+    verdicts::finish(&quality, &out.join("quality.json"))
 }
 
 pub fn bar(len: u64, what: &str) -> ProgressBar {
@@ -428,10 +504,12 @@ pub fn process_session(
     scene: Option<&Path>,
     debevec: &DebevecOptions,
     env: Option<(usize, usize)>,
+    thresholds_file: Option<&Path>,
 ) -> Result<Processed> {
     let mut stages = Vec::new();
     let t = Instant::now();
     let inputs = SessionInputs::open(dir, scene)?;
+    let q = verdicts::thresholds(thresholds_file, Some(&inputs.plan))?;
     let optics = StationOptics::of_station(&inputs.station);
     let b = bar(0, "reading frames");
     let frames = inputs.frames(&b)?;
@@ -443,6 +521,9 @@ pub fn process_session(
     let groups = group_frames(frames);
     let (calibration, choice) = calibrate_response(&groups, debevec)?;
     stages.push(("response (Debevec–Malik)".to_owned(), t.elapsed().as_secs_f64()));
+    let planned = inputs.planned_exposures(&choice.group, choice.exposures);
+    let response_quality = gates::response(&calibration, choice.exposures, planned, &q)
+        .with_note(format!("bracket {}: {}", choice.group, choice.reason));
 
     let t = Instant::now();
     let b = bar(1, "merging HDR");
@@ -459,6 +540,14 @@ pub fn process_session(
         }
         None => Vec::new(),
     };
+
+    let mut quality = vec![response_quality.clone()];
+    for g in &merged {
+        let mut p = gates::radiance(&g.key, &g.map, matches!(g.purpose, Purpose::Sun), &q);
+        p.inherit(&response_quality);
+        quality.push(p);
+    }
+    quality.extend(light.iter().flat_map(|l| light_quality(l, &response_quality, &q)));
 
     let occurrences = light
         .iter()
@@ -498,7 +587,40 @@ pub fn process_session(
         merged,
         light,
         summary,
+        thresholds: q,
+        quality,
     })
+}
+
+/// The verdicts of an occurrence's sun, sky and environment, each
+/// inheriting the response's. A sun shot or sky scan that was taken but
+/// gave no product is `failed`, with the reason.
+fn light_quality(l: &OccurrenceLight, response: &ProductQuality, q: &Quality) -> Vec<ProductQuality> {
+    let occ = &l.occurrence;
+    let not_made = |what: &str, absent: &str| {
+        (!l.notes.iter().any(|n| n == absent))
+            .then(|| ProductQuality::not_made(format!("{what} {occ}"), format!("not measured: {}", l.notes.join("; "))))
+    };
+    let sun = match &l.sun_irradiance {
+        Some(s) => Some(gates::sun(occ, s.spread, s.frames, &s.refused, q)),
+        None => not_made("sun", "no sun shot"),
+    };
+    let sky = match (&l.sky, sky_file(l)) {
+        (Some(fits), Some(file)) => {
+            let converged = [0, 1, 2].map(|c| fits.get(c).is_none_or(|f| f.fit.converged));
+            Some(gates::sky(occ, &file.channels, Some(converged), q))
+        }
+        _ => not_made("sky", "no sky scan"),
+    };
+    let env = l.environment.as_ref().map(|m| gates::environment(occ, m, q));
+    [sun, sky, env]
+        .into_iter()
+        .flatten()
+        .map(|mut p| {
+            p.inherit(response);
+            p
+        })
+        .collect()
 }
 
 /// The report sections of stages 1 and 2 (with the simulator's truth beside the figures, if given).

@@ -23,6 +23,7 @@ use campanile_config::plan::Step;
 use campanile_process::igi::scene_file::{BulbImageEntry, CameraEntry, IgiScene, ImageEntry, LightEntry, SurfaceGroup};
 use campanile_process::pipeline::room_views::{RectifiedView, bulb_window, rectified_camera, rectify};
 use campanile_process::pipeline::{MergedGroup, Purpose};
+use campanile_process::quality::{ProductQuality, gates};
 use campanile_process::report::{Figure, Section, Table, tonemapped_png};
 use nalgebra::Vector3;
 use serde::Serialize;
@@ -79,6 +80,21 @@ pub struct RoomProducts {
     pub recovered: Recovered,
     /// Seconds per stage.
     pub seconds: Vec<(String, f64)>,
+}
+
+/// The verdicts of a room session: the response and radiance maps', then
+/// each surface's BRDF, inheriting the response's.
+pub fn room_quality(p: &Processed, products: &RoomProducts) -> Vec<ProductQuality> {
+    let mut quality = p.quality.clone();
+    let response = p.quality.iter().find(|q| q.product == "response");
+    quality.extend(products.recovered.result.surfaces.iter().map(|s| {
+        let mut q = gates::brdf(s, &p.thresholds);
+        if let Some(r) = response {
+            q.inherit(r);
+        }
+        q
+    }));
+    quality
 }
 
 /// The step index of a group key `"{occurrence}/s{step}/t{target}"`.

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow, bail};
-use campanile_capture::store::{FrameEntry, SessionReader, ShotKind};
+use campanile_capture::store::{FrameEntry, JournalEntry, SessionReader, ShotKind};
 use campanile_config::plan::Step;
 use campanile_config::source::SourceFile;
 use campanile_config::{Plan, Scene, Station};
@@ -158,6 +158,37 @@ impl SessionInputs {
             })
             .collect();
         frames
+    }
+
+    /// Exposures the plan asked for in the bracket that calibrated the
+    /// response (`group`, of which `used` frames were read): the frames
+    /// journaled missed in that group added back, and at least the
+    /// densest unfiltered fixed bracket of the plan (the calibration
+    /// bracket, which a response from a lesser bracket stands in for).
+    pub fn planned_exposures(&self, group: &str, used: usize) -> usize {
+        let prefix = format!("{group}/");
+        let missed = self
+            .reader
+            .entries()
+            .iter()
+            .filter(|e| matches!(e, JournalEntry::Missed(m) if m.key.starts_with(&prefix)))
+            .count();
+        let densest = self
+            .plan
+            .sessions
+            .iter()
+            .flat_map(|s| &s.steps)
+            .filter_map(|step| match step {
+                Step::Bracket {
+                    exposures_s,
+                    filter: None,
+                    ..
+                } => Some(exposures_s.len()),
+                _ => None,
+            })
+            .max()
+            .unwrap_or(0);
+        (used + missed).max(densest)
     }
 
     /// The plan session of an occurrence id (`{session}@…`).

@@ -24,6 +24,7 @@ use campanile_process::hdr::curve::ResponseCurve;
 use campanile_process::hdr::curve_plot::curve_plot_svg;
 use campanile_process::hdr::debevec::DebevecOptions;
 use campanile_process::pipeline::{StationOptics, calibrate_response, group_frames, merge_groups};
+use campanile_process::quality::{Quality, QualityReport, gates};
 use campanile_process::report::{Report, Section, Table};
 use campanile_process::sky_series::{ScanProducts, Shard, SkySeries, scan_path, scan_products, store, write_scan};
 use rayon::prelude::*;
@@ -361,7 +362,18 @@ pub fn merge_shards(session: &Path, shards: &[PathBuf], opts: &SkySeriesOptions)
 }
 
 /// The report page of the series.
-pub fn report(session: &Path, series: &SkySeries, run: Option<&ScanRun>) -> Result<Report> {
+/// The verdicts of these scans of a series: each one's sun and sky.
+pub fn series_quality<'a>(scans: impl Iterator<Item = &'a ScanProducts>, thresholds: &Quality) -> QualityReport {
+    let products = scans.flat_map(|s| gates::scan(s, thresholds)).collect();
+    QualityReport::new(products, thresholds)
+}
+
+pub fn report(
+    session: &Path,
+    series: &SkySeries,
+    run: Option<&ScanRun>,
+    quality: Option<QualityReport>,
+) -> Result<Report> {
     let mut sections = campanile_process::sky_series::sky_series_sections(series)?;
     if let Some(r) = run {
         let rate = if r.scan_seconds > 0.0 {
@@ -395,6 +407,7 @@ pub fn report(session: &Path, series: &SkySeries, run: Option<&ScanRun>) -> Resu
             session.display(),
             env!("CARGO_PKG_VERSION")
         )],
+        quality,
         sections,
     })
 }
