@@ -58,7 +58,7 @@ impl Gate {
             Better::Lower => self.poor <= self.failed,
             Better::Higher => self.poor >= self.failed,
         };
-        if !ordered {
+        if !ordered && self.poor.is_finite() && self.failed.is_finite() {
             v.invalid(
                 "failed",
                 crate::validate::fmt_f64(self.failed),
