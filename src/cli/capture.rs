@@ -19,8 +19,7 @@ use campanile_capture::store::{
 use campanile_config::camera::CameraDriver;
 use campanile_config::document::{Document, load_text};
 use campanile_config::{Station, check_plan_on_station, load_plan, load_station};
-use campanile_firmware_link::link::host::RetryPolicy;
-use campanile_firmware_link::link::soak::{PROVEN_FAULT_CHANCE, PROVEN_POLICY};
+use campanile_firmware_link::link::soak::PROVEN_FAULT_CHANCE;
 use campanile_sim::camera::CameraOptions;
 use campanile_sim::faults::{CameraFaultPlan, Device, FaultPlan, LinkFaults, Outage};
 use campanile_sim::station::{SimOptions, SimStation};
@@ -592,24 +591,11 @@ fn run_simulated<S: Storage>(
         },
         ..CameraOptions::default()
     };
-    // Byte faults on the links (flags or the station's `simulation`): the
-    // retry policy the link soak proves for them, for start-up probes and
-    // every later command alike.
-    let configured = inputs.station.simulation.as_ref();
-    let link_faults = faults.link.map_or_else(
-        || configured.is_some_and(|s| s.link_drop_chance > 0.0 || s.link_corrupt_chance > 0.0),
-        |l| l.drop_chance > 0.0 || l.corrupt_chance > 0.0,
-    );
     let options = SimOptions {
         origin,
         position_m: home,
         faults,
         camera,
-        retry: if link_faults {
-            PROVEN_POLICY
-        } else {
-            RetryPolicy::default()
-        },
         ..SimOptions::default()
     };
     let runtime = tokio::runtime::Builder::new_current_thread()

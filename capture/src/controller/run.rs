@@ -387,7 +387,11 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
                     } else {
                         ShotOutcome::Stored
                     };
-                    tracing::debug!(exposure_s = meta.exposure_actual_s, filter = ?meta.filter, "frame stored");
+                    tracing::debug!(
+                        exposure_s = meta.exposure_actual_s,
+                        filter = meta.filter.as_deref().unwrap_or("none"),
+                        "frame stored"
+                    );
                     self.progress.shot(shot, outcome);
                     return Ok(None);
                 }
