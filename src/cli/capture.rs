@@ -89,7 +89,7 @@ pub struct CaptureArgs {
     sim_bounces: u32,
     /// Simulation: chance that a byte is dropped on every serial link,
     /// 0–0.05 (the link soak proves 10⁴ commands exactly once up to 5 % drop
-    /// + 5 % corruption; at 10 % + 10 % a command needs over 10⁵ attempts).
+    /// + 5 % corruption; at 10 % + 10 % a command needs about 18 000 attempts).
     #[arg(long, value_name = "P", value_parser = link_chance)]
     sim_drop_chance: Option<f64>,
     /// Simulation: chance that a byte is corrupted on every serial link,
