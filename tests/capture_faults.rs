@@ -173,3 +173,122 @@ fn a_session_completes_through_link_faults_a_disconnect_and_camera_timeouts() {
     assert!(report.reconnects >= 1, "the head is reconnected: {report:?}");
     assert!(store.verify().unwrap().is_ok());
 }
+
+/// A plan of about 2 minutes: four brackets of 4, 8 and 16 s.
+const LONG_PLAN: &str = r#"Plan(
+    name: "late test",
+    start_date: "2026-08-28",
+    sessions: [(
+        name: "one",
+        trigger: Clock(time: "20:00:00"),
+        steps: [
+            Bracket(aim: PanTilt(pan_deg: 30.0, tilt_deg: 10.0), exposures_s: [4.0, 8.0, 16.0]),
+            Bracket(aim: PanTilt(pan_deg: 60.0, tilt_deg: 10.0), exposures_s: [4.0, 8.0, 16.0]),
+            Bracket(aim: PanTilt(pan_deg: 90.0, tilt_deg: 10.0), exposures_s: [4.0, 8.0, 16.0]),
+            Bracket(aim: PanTilt(pan_deg: 120.0, tilt_deg: 10.0), exposures_s: [4.0, 8.0, 16.0]),
+        ],
+    )],
+)"#;
+
+/// Run the first `shots` shots of LONG_PLAN (all if `None`) into the
+/// session in `dir` (created if absent, else resumed), on a fault-free
+/// station that comes up `delay_s` after the session's trigger.
+fn run_started_at(dir: &Path, shots: Option<usize>, delay_s: i64) {
+    let st = station();
+    let plan: Plan = ron::from_str(LONG_PLAN).unwrap();
+    let mut t = timeline(&plan, &st, None, &TimelineOptions::default()).unwrap();
+    if let Some(n) = shots {
+        t.occurrences[0].shots.truncate(n);
+    }
+    let snapshot = Snapshot {
+        plan_ron: LONG_PLAN.into(),
+        station_ron: "(test)".into(),
+        scene_ron: None,
+        provenance: Provenance {
+            campanile_version: "test".into(),
+            created_utc: chrono::DateTime::default(),
+            calibration: Vec::new(),
+            sources: None,
+        },
+    };
+    let mut store = if dir.join("journal.jsonl").exists() {
+        SessionStore::resume(dir).unwrap().0
+    } else {
+        SessionStore::create(dir, snapshot).unwrap()
+    };
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_time()
+        .start_paused(true)
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let options = SimOptions {
+            origin: t.occurrences[0].start + chrono::TimeDelta::seconds(delay_s),
+            ..SimOptions::default()
+        };
+        let source = Arc::new(StaticSky { station: st.clone() });
+        let mut sim = SimStation::start(&st, source, options).await.unwrap();
+        let clock = sim.clock();
+        controller::run(
+            &t,
+            &plan,
+            &st,
+            &mut store,
+            &mut sim,
+            &clock,
+            &RunOptions::default(),
+            &mut NoProgress,
+        )
+        .await
+        .unwrap();
+    });
+}
+
+/// Each frame of the session in `dir`: (key, seconds behind its planned
+/// time, `late_by_s` if journaled late).
+fn behind_plan(dir: &Path) -> Vec<(String, f64, Option<f64>)> {
+    let st = station();
+    let plan: Plan = ron::from_str(LONG_PLAN).unwrap();
+    let t = timeline(&plan, &st, None, &TimelineOptions::default()).unwrap();
+    let occ = &t.occurrences[0];
+    let offsets = campanile_capture::schedule::duration::start_offsets(&occ.shots, &st, occ.sun);
+    let (store, _) = SessionStore::resume(dir).unwrap();
+    store
+        .entries()
+        .iter()
+        .map(|e| {
+            let f = e.frame().expect("every shot is taken");
+            let i = occ.shots.iter().position(|s| s.key == f.key).unwrap();
+            let planned = occ.start + chrono::TimeDelta::from_std(offsets[i]).unwrap();
+            let late_by = matches!(e, JournalEntry::Late(_)).then(|| f.meta.late_by_s.unwrap());
+            (f.key.clone(), (f.meta.time - planned).as_seconds_f64(), late_by)
+        })
+        .collect()
+}
+
+/// Issue 21: `late` means late against the plan. A resume 75 s after the
+/// trigger, with the first half of the occurrence done, takes the rest
+/// less than the 60 s tolerance behind their planned times (the trigger
+/// plus each shot's estimated start): they are not late (they used to be
+/// journaled late by the occurrence's 75 s). A whole run that starts 75 s
+/// late is late by about that, frame by frame, against the plan.
+#[test]
+fn frames_are_late_only_against_their_planned_time() {
+    let tmp = tempfile::tempdir().unwrap();
+    let resumed = tmp.path().join("resumed");
+    run_started_at(&resumed, Some(6), -10);
+    run_started_at(&resumed, None, 75);
+    let frames = behind_plan(&resumed);
+    assert_eq!(frames.len(), 12);
+    for (key, by, late_by) in &frames[6..] {
+        assert!((0.0..60.0).contains(by), "{key} is {by} s behind its plan");
+        assert_eq!(*late_by, None, "{key} is {by} s behind its plan");
+    }
+    let delayed = tmp.path().join("delayed");
+    run_started_at(&delayed, None, 75);
+    for (key, by, late_by) in behind_plan(&delayed) {
+        assert!((75.0..85.0).contains(&by), "{key} is {by} s behind its plan");
+        let late_by = late_by.unwrap_or_else(|| panic!("{key} is {by} s behind but not late"));
+        assert!((late_by - by).abs() < 1e-6, "{key}: late_by_s {late_by}, {by} s behind");
+    }
+}

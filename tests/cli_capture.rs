@@ -164,6 +164,9 @@ fn fault_flags_are_checked() {
         ),
         ("--sim-outage", "tripod:1:2", "expected DEVICE:AFTER_S:DURATION_S"),
         ("--sim-outage", "head:-1:2", "expected DEVICE:AFTER_S:DURATION_S"),
+        // Beyond what the link soak proves (issue 21).
+        ("--sim-drop-chance", "0.1", "expected a chance between 0 and 0.05"),
+        ("--sim-corrupt-chance", "0.06", "expected a chance between 0 and 0.05"),
     ] {
         let out = campanile(&[
             "capture",
@@ -260,4 +263,193 @@ fn a_real_station_without_its_camera_driver_is_refused_clearly() {
         "{stderr}"
     );
     assert!(!dir.exists(), "no session directory is made");
+}
+
+/// Issue 21: 5 % byte drop + 5 % corruption on every link (the edge of
+/// the range the flags accept) starts, and the session completes.
+#[test]
+fn link_faults_at_five_percent_start_and_the_session_completes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (plan, station) = write_inputs(tmp.path());
+    let dir = tmp.path().join("links");
+    let out = campanile(&[
+        "-q",
+        "capture",
+        &plan,
+        "--station",
+        &station,
+        "--out",
+        dir.to_str().unwrap(),
+        "--sim-drop-chance",
+        "0.05",
+        "--sim-corrupt-chance",
+        "0.05",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert_eq!(frames(&dir).len(), 8);
+}
+
+/// Issue 21: a start that fails (links too bad for the simulated head)
+/// leaves no session directory behind, or an existing empty one empty,
+/// and its message names the device once, without cable advice.
+#[test]
+fn a_start_that_fails_leaves_no_session_behind() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (plan, station) = write_inputs(tmp.path());
+    let text = std::fs::read_to_string(&station).unwrap();
+    let bad = text.replace("link_drop_chance: 0.0", "link_drop_chance: 0.45");
+    assert_ne!(bad, text, "the example station's simulation line moved");
+    std::fs::write(&station, bad).unwrap();
+    let absent = tmp.path().join("absent");
+    let empty = tmp.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    for dir in [&absent, &empty] {
+        let out = campanile(&[
+            "-q",
+            "capture",
+            &plan,
+            "--station",
+            &station,
+            "--out",
+            dir.to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert!(
+            stderr.contains("connecting to sim:head: no valid reply after 5000 attempt(s)"),
+            "{stderr}"
+        );
+        assert_eq!(stderr.matches("no valid reply").count(), 1, "{stderr}");
+        assert!(!stderr.contains("cable") && !stderr.contains("power"), "{stderr}");
+    }
+    assert!(!absent.exists());
+    assert_eq!(std::fs::read_dir(&empty).unwrap().count(), 0);
+}
+
+/// Issue 21: a quota too small for even the snapshot leaves no directory
+/// behind (it left `DIR/frames/`, which both a new capture and --resume
+/// refused); the same command without the quota then starts in it.
+#[test]
+fn a_quota_too_small_to_start_leaves_nothing_and_a_new_capture_starts() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (plan, station) = write_inputs(tmp.path());
+    let dir = tmp.path().join("tiny");
+    let d = dir.to_str().unwrap();
+    let out = campanile(&[
+        "-q",
+        "capture",
+        &plan,
+        "--station",
+        &station,
+        "--out",
+        d,
+        "--sim-disk-quota",
+        "100",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("quota of 100 bytes reached"), "{stderr}");
+    assert!(!dir.exists(), "{:?}", std::fs::read_dir(&dir).map(|d| d.count()));
+    let out = campanile(&["-q", "capture", &plan, "--station", &station, "--out", d]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(frames(&dir).len(), 8);
+}
+
+/// Issue 21: a resume that repairs says what it repaired even under -q
+/// (which hides the log), and the log reads as words, not a Rust struct.
+#[test]
+fn resume_repairs_are_printed_under_quiet_and_logged_in_words() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (plan, station) = write_inputs(tmp.path());
+    let dir = tmp.path().join("torn");
+    let d = dir.to_str().unwrap();
+    // Stop after the snapshot and a frame or two: a quota just big enough.
+    let out = campanile(&[
+        "-q",
+        "capture",
+        &plan,
+        "--station",
+        &station,
+        "--out",
+        d,
+        "--sim-disk-quota",
+        "20000",
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    let tear = || {
+        use std::io::Write;
+        let mut j = std::fs::OpenOptions::new()
+            .append(true)
+            .open(dir.join("journal.jsonl"))
+            .unwrap();
+        j.write_all(b"{\"status\":\"do").unwrap();
+    };
+    tear();
+    let out = campanile(&["-q", "capture", "--resume", d, "--sim-disk-quota", "20000"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("repaired: cut a torn journal line of 13 bytes"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("see the log"), "{stderr}");
+    tear();
+    let out = campanile(&["capture", "--resume", d, "--sim-disk-quota", "20000"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("resumed"), "{stderr}");
+    assert!(
+        !stderr.contains("ResumeReport {") && !stderr.contains("torn_line"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("cut a torn journal line of 13 bytes"), "{stderr}");
+}
+
+/// Issue 21: each resume of a session with missed shots used to add
+/// another `missed` line per shot. The journal holds at most one per
+/// shot, and the summary counts shots.
+#[test]
+fn resumes_that_miss_the_same_shots_add_no_missed_lines() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (plan, station) = write_inputs(tmp.path());
+    let dir = tmp.path().join("missed");
+    let d = dir.to_str().unwrap();
+    let faults = ["--sim-camera-error-chance", "0.6"];
+    let mut args = vec!["-q", "capture", &plan, "--station", &station, "--out", d];
+    args.extend(faults);
+    let first = campanile(&args);
+    assert_eq!(
+        first.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
+    let mut summaries = Vec::new();
+    for _ in 0..2 {
+        let mut args = vec!["-q", "capture", "--resume", d];
+        args.extend(faults);
+        let out = campanile(&args);
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        let line = stdout
+            .lines()
+            .find(|l| l.contains("shots missed"))
+            .expect("a summary")
+            .to_owned();
+        summaries.push(line);
+    }
+    let (store, _) = SessionStore::resume(&dir).unwrap();
+    let mut per_key = std::collections::HashMap::new();
+    for e in store.entries() {
+        if let JournalEntry::Missed(m) = e {
+            *per_key.entry(m.key.clone()).or_insert(0) += 1;
+        }
+    }
+    assert!(!per_key.is_empty(), "the camera errors missed no shot");
+    assert!(per_key.values().all(|&n| n == 1), "{per_key:?}");
+    let distinct = per_key.keys().filter(|k| !store.completed(k)).count();
+    for line in &summaries {
+        let n: usize = line.split_whitespace().last().unwrap().parse().unwrap();
+        assert!(n <= 8 && n >= distinct, "{line} with {distinct} shots missed now");
+    }
+    let last: usize = summaries[1].split_whitespace().last().unwrap().parse().unwrap();
+    assert_eq!(last, distinct, "{summaries:?}");
 }

@@ -4,10 +4,11 @@
 //!
 //! ```text
 //! cargo run --release -p campanile-firmware-link --example link_soak -- \
-//!     [--commands 10000] [--seed 42] [--drop-chance 0.02] [--corrupt-chance 0.02]
+//!     [--commands 10000] [--seed 42] [--drop-chance 0.02] [--corrupt-chance 0.02] \
+//!     [--max-attempts N (30 ms each; default 500)]
 //! ```
 
-use campanile_firmware_link::link::soak::{SoakConfig, run};
+use campanile_firmware_link::link::soak::{PROVEN_POLICY, SoakConfig, run};
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -15,6 +16,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut seed = 42u64;
     let mut drop = 0.02f64;
     let mut corrupt = 0.02f64;
+    let mut max_attempts = None;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let v = args.next().ok_or(format!("{a} needs a value"))?;
@@ -23,12 +25,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--seed" => seed = v.parse()?,
             "--drop-chance" => drop = v.parse()?,
             "--corrupt-chance" => corrupt = v.parse()?,
+            "--max-attempts" => max_attempts = Some(v.parse()?),
             other => return Err(format!("unknown flag {other}").into()),
         }
     }
     let mut config = SoakConfig::standard(commands, seed);
     config.faults.drop_chance = drop;
     config.faults.corrupt_chance = corrupt;
+    if let Some(n) = max_attempts {
+        config.policy = PROVEN_POLICY;
+        config.policy.max_attempts = n;
+    }
     let rt = tokio::runtime::Builder::new_current_thread()
         .enable_time()
         .start_paused(true)

@@ -9,7 +9,7 @@ pub enum DriverError {
     #[error("I/O error on the device link: {0}")]
     Io(#[from] std::io::Error),
     /// The device did not answer in time, after every retry.
-    #[error("no valid reply after {attempts} attempt(s); check the cable, the baud rate and the device's power")]
+    #[error("no valid reply after {attempts} attempt(s)")]
     Timeout {
         /// Attempts made.
         attempts: u32,

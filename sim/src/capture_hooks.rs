@@ -32,8 +32,8 @@ impl Clock for SimClock {
 
 fn device_error(e: SimError) -> DeviceError {
     match e {
-        SimError::Connect { source, .. } => source,
-        SimError::Open { source, .. } => DeviceError::Link(DriverError::Io(source)),
+        SimError::Connect { error, .. } => error,
+        SimError::Open { error, .. } => DeviceError::Link(DriverError::Io(error)),
         SimError::Unsupported(what) => DeviceError::Camera(format!("the simulator cannot emulate {what}")),
     }
 }

@@ -10,19 +10,19 @@ pub enum SimError {
     #[error("the simulator cannot emulate {0}")]
     Unsupported(String),
     /// A simulated device's port cannot be opened (it is disconnected).
-    #[error("cannot open {port}: {source}")]
+    #[error("cannot open {port}: {error}")]
     Open {
         /// The port, e.g. `sim:head`.
         port: String,
-        /// Why.
-        source: std::io::Error,
+        /// Why (in the message, so not also a source to print twice).
+        error: std::io::Error,
     },
     /// The host driver failed to connect to a simulated device.
-    #[error("connecting to {port}: {source}")]
+    #[error("connecting to {port}: {error}")]
     Connect {
         /// The port, e.g. `sim:head`.
         port: String,
-        /// Why.
-        source: DeviceError,
+        /// Why (in the message, so not also a source to print twice).
+        error: DeviceError,
     },
 }

@@ -33,6 +33,7 @@ use crate::seed::{Purpose, derive};
 use campanile_capture::device::LightChannel;
 use campanile_config::Station;
 use campanile_firmware_link::link::host::RetryPolicy;
+use campanile_firmware_link::link::soak::PROVEN_POLICY;
 use campanile_process::pose::HeadPose;
 use chrono::{DateTime, Utc};
 use std::sync::Arc;
@@ -54,9 +55,12 @@ pub struct SimOptions {
     pub camera: CameraOptions,
     /// Faults (camera faults, outages, link-fault overrides).
     pub faults: FaultPlan,
-    /// How the campanile-link drivers retry (the driver's default: 20
-    /// attempts of 100 ms, which a link with a few percent of byte faults
-    /// can exhaust; see the fault test).
+    /// How the campanile-link drivers retry, at start-up and after. Left
+    /// at the driver's default (20 attempts of 100 ms, which a link with a
+    /// few percent of byte faults can exhaust) on a link with byte faults,
+    /// the station uses [`PROVEN_POLICY`], which the link soak proves up to
+    /// [`PROVEN_FAULT_CHANCE`](campanile_firmware_link::link::soak::PROVEN_FAULT_CHANCE)
+    /// of drop and of corruption.
     pub retry: RetryPolicy,
 }
 
@@ -111,6 +115,12 @@ impl<S: FrameSource> SimStation<S> {
             None => (0, LinkFaults::default()),
         };
         let link = options.faults.link.unwrap_or(config_faults).config(seed);
+        let faulty = link.drop_chance > 0.0 || link.corrupt_chance > 0.0;
+        let retry = if faulty && options.retry == RetryPolicy::default() {
+            PROVEN_POLICY
+        } else {
+            options.retry
+        };
         let imperfections = HeadImperfections {
             seed: derive(seed, Purpose::Encoder, 0),
             ..options.head
@@ -126,13 +136,13 @@ impl<S: FrameSource> SimStation<S> {
             .as_ref()
             .map(|l| LightsPort::new(l, options.tick, link))
             .transpose()?;
-        let head = head_port.connect(options.retry).await?;
+        let head = head_port.connect(retry).await?;
         let wheel = match &wheel_port {
-            Some(p) => Some(p.connect(options.retry).await?),
+            Some(p) => Some(p.connect(retry).await?),
             None => None,
         };
         let lights = match &lights_port {
-            Some(p) => Some(p.connect(options.retry).await?),
+            Some(p) => Some(p.connect(retry).await?),
             None => None,
         };
         let truth = DeviceTruth {
@@ -171,7 +181,7 @@ impl<S: FrameSource> SimStation<S> {
             lights,
             truth,
             clock,
-            retry: options.retry,
+            retry,
             home_m: options.position_m,
         })
     }

@@ -19,6 +19,7 @@ use campanile_capture::store::{
 use campanile_config::camera::CameraDriver;
 use campanile_config::document::{Document, load_text};
 use campanile_config::{Station, check_plan_on_station, load_plan, load_station};
+use campanile_firmware_link::link::soak::PROVEN_FAULT_CHANCE;
 use campanile_sim::camera::CameraOptions;
 use campanile_sim::faults::{CameraFaultPlan, Device, FaultPlan, LinkFaults, Outage};
 use campanile_sim::station::{SimOptions, SimStation};
@@ -86,11 +87,14 @@ pub struct CaptureArgs {
     /// Simulation: render bounces (scattering events per path, the first included).
     #[arg(long, value_name = "N", default_value_t = 1)]
     sim_bounces: u32,
-    /// Simulation: chance that a byte is dropped on every serial link (0–0.5).
-    #[arg(long, value_name = "P")]
+    /// Simulation: chance that a byte is dropped on every serial link,
+    /// 0–0.05 (the link soak proves 10⁴ commands exactly once up to 5 % drop
+    /// + 5 % corruption; at 10 % + 10 % a command needs about 18 000 attempts).
+    #[arg(long, value_name = "P", value_parser = link_chance)]
     sim_drop_chance: Option<f64>,
-    /// Simulation: chance that a byte is corrupted on every serial link (0–0.5).
-    #[arg(long, value_name = "P")]
+    /// Simulation: chance that a byte is corrupted on every serial link,
+    /// 0–0.05 (as for --sim-drop-chance).
+    #[arg(long, value_name = "P", value_parser = link_chance)]
     sim_corrupt_chance: Option<f64>,
     /// Simulation: chance that any one frame never arrives (the camera times out), 0–1.
     #[arg(long, value_name = "P", value_parser = chance)]
@@ -113,6 +117,16 @@ fn chance(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(p) if (0.0..=1.0).contains(&p) => Ok(p),
         _ => Err(format!("found {s:?}; expected a chance between 0 and 1")),
+    }
+}
+
+/// A byte-fault chance in [0, PROVEN_FAULT_CHANCE], what the link soak proves.
+fn link_chance(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(p) if (0.0..=PROVEN_FAULT_CHANCE).contains(&p) => Ok(p),
+        _ => Err(format!(
+            "found {s:?}; expected a chance between 0 and {PROVEN_FAULT_CHANCE} (the link is proven to hold up to {PROVEN_FAULT_CHANCE} drop and {PROVEN_FAULT_CHANCE} corruption)"
+        )),
     }
 }
 
@@ -405,10 +419,8 @@ fn capture(args: &CaptureArgs, inputs: &Inputs) -> Result<bool> {
     match args.sim_disk_quota {
         Some(quota) => {
             if inputs.station.uses_simulation() {
-                // The quota counts what is already in the directory.
-                if args.out.is_some() {
-                    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-                }
+                // The quota counts what is already in the directory (none
+                // if absent: the session store creates it).
                 let storage = QuotaStorage::open(FsStorage, dir, quota)
                     .with_context(|| format!("measuring {} for the disk quota", dir.display()))?;
                 capture_into(args, inputs, storage)
@@ -443,8 +455,10 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
                     dir.display()
                 );
             }
+            // The repairs themselves, not "see the log": -q hides the log.
+            let repairs: String = report.repairs().iter().map(|r| format!("\n  repaired: {r}")).collect();
             eprintln!(
-                "resuming {}{}: {} frames and {} missed shots journaled{}",
+                "resuming {}{}: {} frames and {} missed shots journaled{repairs}",
                 dir.display(),
                 if inputs.from_session {
                     " with its own plan.ron and station.ron"
@@ -453,13 +467,8 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
                 },
                 report.frames,
                 report.missed,
-                if report.is_clean() {
-                    ""
-                } else {
-                    "; repairs: see the log"
-                }
             );
-            tracing::info!(?report, "resumed");
+            tracing::info!(%report, "resumed");
             (store, true)
         }
         (None, None) => bail!("give --out DIR or --resume DIR"),
@@ -471,10 +480,21 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
     let promised = inputs.timeline.frames_promised();
     let mut bars = Bars::new(promised);
     let wall = Instant::now();
-    let result = if inputs.station.uses_simulation() {
-        run_simulated(args, inputs, &mut store, resumed, &mut bars)?
+    let started = if inputs.station.uses_simulation() {
+        run_simulated(args, inputs, &mut store, resumed, &mut bars)
     } else {
-        run_real(inputs, &mut store, &mut bars)?
+        run_real(inputs, &mut store, &mut bars)
+    };
+    let result = match started {
+        Ok(r) => r,
+        Err(e) => {
+            // A run that could not start leaves no new session behind.
+            let dir = store.dir().to_path_buf();
+            if let Err(d) = store.discard_unused() {
+                tracing::warn!(dir = %dir.display(), error = %d, "could not remove the unused session");
+            }
+            return Err(e);
+        }
     };
     bars.session.finish_and_clear();
     bars.step.finish_and_clear();
@@ -491,7 +511,9 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
         .filter(|s| s.promised)
         .map(|s| s.key.as_str())
         .collect();
-    let (mut stored, mut late, mut missed, mut extra) = (0, 0, 0, 0);
+    let (mut stored, mut late, mut extra) = (0, 0, 0);
+    // Shots, not lines: a journal from before one-line-per-shot may hold several.
+    let mut missed_keys = std::collections::HashSet::new();
     for e in store.entries() {
         let promised = promised_keys.contains(e.key());
         match e {
@@ -500,7 +522,9 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
                 stored += 1;
                 late += 1;
             }
-            JournalEntry::Missed(_) if !store.completed(e.key()) => missed += 1,
+            JournalEntry::Missed(_) if !store.completed(e.key()) => {
+                missed_keys.insert(e.key());
+            }
             JournalEntry::Missed(_) => {}
             JournalEntry::Pruned(_) | JournalEntry::Outage(_) => {}
             _ => extra += 1,
@@ -510,6 +534,7 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
     println!("  frames promised      {promised}");
     println!("  frames stored        {stored} (of which late: {late})");
     println!("  auto-bracket extras  {extra}");
+    let missed = missed_keys.len();
     println!("  shots missed         {missed}");
     println!(
         "  this run             {} frames, {} missed, {} retries, {} reconnects, {} metering captures, {} sun retakes",
@@ -654,7 +679,12 @@ fn run_real<S: Storage>(inputs: &Inputs, store: &mut SessionStore<S>, bars: &mut
         };
         let mut rig = StationRig::connect(&inputs.station, SerialOpener, camera, options)
             .await
-            .with_context(|| format!("connecting the devices of station {}", inputs.station_label))?;
+            .with_context(|| {
+                format!(
+                    "connecting the devices of station {} (check the cables, the baud rates and the devices' power)",
+                    inputs.station_label
+                )
+            })?;
         Ok(controller::run(
             &inputs.timeline,
             &inputs.plan.plan.value,

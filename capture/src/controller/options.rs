@@ -7,8 +7,10 @@ use std::time::Duration;
 /// Tolerances and limits of a run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunOptions {
-    /// An occurrence that starts more than this after its trigger has its
-    /// frames journaled `late` (with `late_by_s`).
+    /// An occurrence that starts more than this after its trigger has the
+    /// frames taken more than this after their planned times (the trigger
+    /// plus each shot's estimated start) journaled `late`, with `late_by_s`
+    /// against the planned time.
     pub late_tolerance: Duration,
     /// An occurrence that cannot start within this of its trigger is
     /// recorded missed, shot by shot, with the reason.

@@ -3,7 +3,11 @@
 //!
 //! Per occurrence: wait for its start; if it cannot start within
 //! [`RunOptions::start_window`], journal its shots missed; if it starts
-//! later than [`RunOptions::late_tolerance`], journal its frames `late`.
+//! later than [`RunOptions::late_tolerance`], journal `late` each frame
+//! taken more than that after its planned time (the trigger plus the
+//! shot's estimated start in the occurrence, [`duration::start_offsets`]),
+//! with `late_by_s` against that time: a resumed run that reaches a shot
+//! no later than a clean run would does not call it late.
 //! Per shot: aim, filter, lights, exposure, capture, journal. A device
 //! failure is retried per the step's [`ErrorPolicy`] (a dropped link is
 //! reconnected first, with doubling waits), then the step's fallback
@@ -38,7 +42,9 @@ use crate::clock::Clock;
 use crate::device::{
     Camera, CaptureSettings, DeviceError, ExposureTime, FilterWheel, Frame, Gain, Level, Lights, PanTilt, Pose,
 };
-use crate::schedule::{FilterChoice, Occurrence, PlannedAim, PlannedExposure, PlannedShot, ShotKind, Timeline};
+use crate::schedule::{
+    FilterChoice, Occurrence, PlannedAim, PlannedExposure, PlannedShot, ShotKind, Timeline, duration,
+};
 use crate::store::{self, FrameMeta, LightLevel, PoseDeg, SessionStore, Storage, StoreError};
 
 /// Frame numbers reserved per shot (see [`Rig::number_frames_from`]):
@@ -286,17 +292,23 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
             }
             return Ok(());
         }
-        let late_by = (late > self.options.late_tolerance).then_some(late.as_secs_f64());
-        if let Some(l) = late_by {
-            tracing::warn!(late_by_s = l, "the occurrence starts late");
+        let started_late = late > self.options.late_tolerance;
+        if started_late {
+            tracing::warn!(late_by_s = late.as_secs_f64(), "the occurrence starts late");
         }
+        let offsets = duration::start_offsets(&occ.shots, self.station, occ.sun);
         tracing::info!(shots = occ.shots.len(), open, "occurrence starts");
         self.progress.occurrence(occ);
         let mut state = OccurrenceState::default();
         let mut current = None;
         let mut skipped: HashMap<usize, String> = HashMap::new();
         let mut aborted: Option<String> = None;
-        for shot in &occ.shots {
+        for (i, shot) in occ.shots.iter().enumerate() {
+            // When the plan has the shot begin, if the occurrence started late.
+            let planned = started_late.then(|| {
+                let offset = offsets.get(i).copied().unwrap_or_default();
+                occ.start + chrono::TimeDelta::from_std(offset).unwrap_or_default()
+            });
             if current != Some(shot.step) {
                 current = Some(shot.step);
                 let kind = self.step(occ, shot.step).map_or("step", Step::kind);
@@ -334,7 +346,7 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
             let policy = self.step(occ, shot.step).map(Step::on_error).unwrap_or_default();
             let span = tracing::info_span!("shot", key = %shot.key);
             if let Some(reason) = self
-                .shot_with_policy(occ, shot, &mut state, late_by, policy)
+                .shot_with_policy(occ, shot, &mut state, planned, policy)
                 .instrument(span)
                 .await?
             {
@@ -360,12 +372,12 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
         occ: &Occurrence,
         shot: &PlannedShot,
         state: &mut OccurrenceState,
-        late_by: Option<f64>,
+        planned: Option<DateTime<Utc>>,
         policy: ErrorPolicy,
     ) -> Result<Option<String>, StoreError> {
         let mut attempt = 0u32;
         loop {
-            match self.shot(occ, shot, state, late_by, attempt).await {
+            match self.shot(occ, shot, state, planned, attempt).await {
                 Ok(Taken::Frame(frame, meta)) => {
                     self.store.record_frame(&shot.key, &meta, &frame)?;
                     self.report.frames += 1;
@@ -375,7 +387,11 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
                     } else {
                         ShotOutcome::Stored
                     };
-                    tracing::debug!(exposure_s = meta.exposure_actual_s, filter = ?meta.filter, "frame stored");
+                    tracing::debug!(
+                        exposure_s = meta.exposure_actual_s,
+                        filter = meta.filter.as_deref().unwrap_or("none"),
+                        "frame stored"
+                    );
                     self.progress.shot(shot, outcome);
                     return Ok(None);
                 }
@@ -437,13 +453,14 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
         if t.is_finite() { t.clamp(lo, hi) } else { lo }
     }
 
-    /// One attempt at a shot.
+    /// One attempt at a shot; its frame is `late` if taken more than the
+    /// late tolerance after `planned`.
     async fn shot(
         &mut self,
         occ: &Occurrence,
         shot: &PlannedShot,
         state: &mut OccurrenceState,
-        late_by: Option<f64>,
+        planned: Option<DateTime<Utc>>,
         attempt: u32,
     ) -> Result<Taken, ShotError> {
         let ordinal = self.ordinals.get(&shot.key).copied().unwrap_or(0);
@@ -541,7 +558,9 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
         meta.pose_reached = Some(reached);
         meta.filter = filter;
         meta.lights = lights;
-        meta.late_by_s = late_by;
+        meta.late_by_s = planned
+            .map(|p| (meta.time - p).as_seconds_f64())
+            .filter(|&by| by > self.options.late_tolerance.as_secs_f64());
         meta.notes = notes;
         if shot.kind == ShotKind::Centering {
             let fix = self.fix_from_centering(occ, shot, Codes::from(&frame), reached, frame.timestamp, exposure_s);

@@ -89,10 +89,28 @@ fn slot(filter: &FilterChoice) -> Option<&str> {
 /// The estimated duration of `shots` taken in order, with the sun at `sun`
 /// (azimuth, elevation in degrees) for shots aimed at it.
 pub fn estimate(shots: &[PlannedShot], station: &Station, sun: (f64, f64)) -> Duration {
+    seconds(walk(shots, station, sun).1)
+}
+
+/// When each of `shots`, taken in order from the occurrence's start, is
+/// planned to begin (its slew and filter change), as an offset from the
+/// start: the estimate of the shots before it.
+pub fn start_offsets(shots: &[PlannedShot], station: &Station, sun: (f64, f64)) -> Vec<Duration> {
+    walk(shots, station, sun).0.into_iter().map(seconds).collect()
+}
+
+fn seconds(s: f64) -> Duration {
+    Duration::from_millis((s * 1000.0).round() as u64)
+}
+
+/// The start of each shot and the end of the last, seconds from the start.
+fn walk(shots: &[PlannedShot], station: &Station, sun: (f64, f64)) -> (Vec<f64>, f64) {
     let mut head = (0.0, 0.0);
     let mut filter: Option<&str> = None;
     let mut total = 0.0;
+    let mut starts = Vec::with_capacity(shots.len());
     for shot in shots {
+        starts.push(total);
         if let Some(to) = shot.aim.head_angles(&station.head, sun) {
             total += slew_s(head, to, &station.head.dynamics);
             head = to;
@@ -104,7 +122,7 @@ pub fn estimate(shots: &[PlannedShot], station: &Station, sun: (f64, f64)) -> Du
         }
         total += exposure_s(shot, station) + READOUT_S;
     }
-    Duration::from_millis((total * 1000.0).round() as u64)
+    (starts, total)
 }
 
 #[cfg(test)]

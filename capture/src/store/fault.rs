@@ -32,6 +32,8 @@ pub enum Operation {
     Truncate,
     /// [`Storage::remove`].
     Remove,
+    /// [`Storage::remove_dir`].
+    RemoveDir,
 }
 
 impl fmt::Display for Operation {
@@ -45,6 +47,7 @@ impl fmt::Display for Operation {
             Operation::Append => "append",
             Operation::Truncate => "truncate",
             Operation::Remove => "remove",
+            Operation::RemoveDir => "remove directory",
         };
         f.write_str(name)
     }
@@ -175,6 +178,10 @@ impl<S: Storage> Storage for CrashingStorage<S> {
 
     fn remove(&self, path: &Path) -> io::Result<()> {
         self.run(Operation::Remove, path, || self.inner.remove(path))
+    }
+
+    fn remove_dir(&self, dir: &Path) -> io::Result<()> {
+        self.run(Operation::RemoveDir, dir, || self.inner.remove_dir(dir))
     }
 }
 
@@ -315,6 +322,10 @@ impl<S: Storage> Storage for QuotaStorage<S> {
         self.inner.remove(path)?;
         self.release(old);
         Ok(())
+    }
+
+    fn remove_dir(&self, dir: &Path) -> io::Result<()> {
+        self.inner.remove_dir(dir)
     }
 }
 

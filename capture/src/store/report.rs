@@ -40,29 +40,78 @@ impl ResumeReport {
     }
 }
 
+impl ResumeReport {
+    /// Each repair made and each file left alone, in words, e.g. "cut a
+    /// torn journal line of 17 bytes at offset 4096"; empty when clean.
+    pub fn repairs(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if let Some(t) = self.torn_line {
+            out.push(format!(
+                "cut a torn journal line of {} bytes at offset {}",
+                t.bytes, t.offset
+            ));
+        }
+        for p in &self.temp_files_removed {
+            out.push(format!("removed temporary file {}", p.display()));
+        }
+        for p in &self.orphan_frames_removed {
+            out.push(format!("removed unjournaled frame {} (to be retaken)", p.display()));
+        }
+        for p in &self.unknown_files {
+            out.push(format!("left unknown file {}", p.display()));
+        }
+        out
+    }
+}
+
 impl fmt::Display for ResumeReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{} frames and {} missed shots journaled", self.frames, self.missed)?;
         if let Some(k) = &self.last_key {
             write!(f, " (last: {k:?})")?;
         }
-        if let Some(t) = self.torn_line {
-            write!(
-                f,
-                "; cut a torn journal line of {} bytes at offset {}",
-                t.bytes, t.offset
-            )?;
-        }
-        if !self.temp_files_removed.is_empty() {
-            write!(f, "; removed {} temporary files", self.temp_files_removed.len())?;
-        }
-        for p in &self.orphan_frames_removed {
-            write!(f, "; removed unjournaled frame {} (to be retaken)", p.display())?;
-        }
-        for p in &self.unknown_files {
-            write!(f, "; left unknown file {}", p.display())?;
+        for r in self.repairs() {
+            write!(f, "; {r}")?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_resume_report_reads_as_words_not_a_struct() {
+        let clean = ResumeReport {
+            frames: 12,
+            missed: 3,
+            last_key: Some("morning@2026-08-28/s0/t1/f2".into()),
+            ..ResumeReport::default()
+        };
+        assert_eq!(
+            clean.to_string(),
+            "12 frames and 3 missed shots journaled (last: \"morning@2026-08-28/s0/t1/f2\")"
+        );
+        assert!(clean.repairs().is_empty());
+        let repaired = ResumeReport {
+            torn_line: Some(TornLine {
+                offset: 4096,
+                bytes: 17,
+            }),
+            temp_files_removed: vec!["s/.plan.ron.tmp".into()],
+            orphan_frames_removed: vec!["s/frames/a.png".into()],
+            ..clean
+        };
+        assert_eq!(
+            repaired.repairs(),
+            [
+                "cut a torn journal line of 17 bytes at offset 4096",
+                "removed temporary file s/.plan.ron.tmp",
+                "removed unjournaled frame s/frames/a.png (to be retaken)",
+            ]
+        );
+        assert!(!repaired.to_string().contains("torn_line"), "{repaired}");
     }
 }
 

@@ -7,7 +7,7 @@ use super::frame_file::{check_frame, encode_png, read_checked_bytes, read_checke
 use super::journal::{FrameEntry, FrameMeta, JournalEntry, MissedEntry, OutageEntry, PrunedEntry, parse_journal};
 use super::key::{check_key, frame_file_name};
 use super::report::{ResumeReport, TornLine, VerifyReport};
-use super::snapshot::Snapshot;
+use super::snapshot::{PLAN_FILE, PROVENANCE_FILE, SCENE_FILE, STATION_FILE, Snapshot};
 use super::storage::{AtomicWriteError, FsStorage, Storage, is_temp_name, write_atomic};
 use crate::device::Frame;
 use campanile_process::camera::image::CodeImage;
@@ -23,8 +23,10 @@ pub const FRAMES_DIR: &str = "frames";
 
 /// A session directory open for recording.
 ///
-/// Every shot key is recorded at most once: as a frame (`done` or `late`)
-/// or, if it could not be taken, as `missed`.
+/// Every shot key has at most one frame line (`done` or `late`) and at
+/// most one `missed` line, and no line after its frame: the journal holds
+/// at most one `missed` line per shot however often the session is
+/// resumed.
 ///
 /// **Missed shots.** A key recorded missed is final *for the run* (this
 /// `SessionStore` value): [`SessionStore::record_frame`] and
@@ -32,7 +34,9 @@ pub const FRAMES_DIR: &str = "frames";
 /// [`StoreError::Duplicate`]. A later run (after [`SessionStore::resume`])
 /// may retake it: [`SessionStore::missed`] tells the controller it was
 /// missed, and a frame recorded for it then appears as a later journal
-/// line, after the `missed` line, so the journal keeps both facts. A
+/// line, after the `missed` line, so the journal keeps both facts. If the
+/// later run misses it again, [`SessionStore::record_missed`] writes no
+/// second line: the first `missed` line (its time and reason) stands. A
 /// completed key is final for the session.
 #[derive(Debug)]
 pub struct SessionStore<S: Storage = FsStorage> {
@@ -54,6 +58,9 @@ pub struct SessionStore<S: Storage = FsStorage> {
     journal_len: u64,
     /// Set when a failure left the directory needing `resume`.
     broken: Option<String>,
+    /// Made by `create` (whether the directory existed before); `None`
+    /// when resumed.
+    created: Option<bool>,
 }
 
 impl SessionStore<FsStorage> {
@@ -75,14 +82,13 @@ impl<S: Storage> SessionStore<S> {
     ///
     /// The snapshot files are written atomically first and the empty
     /// journal last, so a directory with a journal always has its
-    /// snapshot. A crash during `create` leaves a directory that `create`
-    /// refuses and `resume` does not accept; remove it and start again.
+    /// snapshot. A failure during `create` (a full disk) removes what it
+    /// made, leaving the directory as it was (absent or empty). A crash
+    /// during `create` leaves a directory that `create` refuses and
+    /// `resume` does not accept; remove it and start again.
     pub fn create_with(storage: S, dir: &Path, snapshot: Snapshot) -> Result<Self, StoreError> {
-        let io_err = |action, path: &Path| {
-            let path = path.to_path_buf();
-            move |source| StoreError::Io { action, path, source }
-        };
-        if let Some(names) = storage.list(dir).map_err(io_err("listing", dir))?
+        let listing = storage.list(dir).map_err(io_error("listing", dir))?;
+        if let Some(names) = &listing
             && !names.is_empty()
         {
             return Err(StoreError::SessionExists {
@@ -90,18 +96,15 @@ impl<S: Storage> SessionStore<S> {
                 entries: names.len(),
             });
         }
-        let frames = dir.join(FRAMES_DIR);
-        storage
-            .create_dir_all(&frames)
-            .map_err(io_err("creating directory", &frames))?;
-        storage.sync_dir(dir).map_err(io_err("fsyncing directory", dir))?;
-        if let Some(parent) = dir.parent().filter(|p| !p.as_os_str().is_empty()) {
-            storage.sync_dir(parent).map_err(io_err("fsyncing directory", parent))?;
+        let existed = listing.is_some();
+        if let Err(e) = lay_out(&storage, dir, &snapshot) {
+            // A failure (not a crash) undoes what was made, so the
+            // directory is as it was and `create` accepts it again.
+            if let Err(undo) = undo_create(&storage, dir, existed) {
+                tracing::warn!(dir = %dir.display(), error = %undo, "could not remove the unfinished session");
+            }
+            return Err(e);
         }
-        for (name, bytes) in snapshot.files() {
-            write_atomic(&storage, dir, name, &bytes).map_err(atomic_io_error)?;
-        }
-        write_atomic(&storage, dir, JOURNAL_FILE, b"").map_err(atomic_io_error)?;
         Ok(Self {
             storage,
             dir: dir.to_path_buf(),
@@ -114,7 +117,24 @@ impl<S: Storage> SessionStore<S> {
             pruned: HashSet::new(),
             journal_len: 0,
             broken: None,
+            created: Some(existed),
         })
+    }
+
+    /// Remove a session this value created and never recorded in (an
+    /// empty journal, no frames), leaving its directory as it was before
+    /// [`SessionStore::create`]: absent, or empty. For a run that could not
+    /// start. Returns whether it removed the session; a resumed session,
+    /// or one with journal lines, is kept.
+    pub fn discard_unused(self) -> Result<bool, StoreError> {
+        let Some(existed) = self.created else {
+            return Ok(false);
+        };
+        if !self.entries.is_empty() || self.journal_len > 0 || self.broken.is_some() {
+            return Ok(false);
+        }
+        undo_create(&self.storage, &self.dir, existed).map_err(io_error("removing the unused session", &self.dir))?;
+        Ok(true)
     }
 
     /// [`SessionStore::resume`] on any storage.
@@ -159,6 +179,7 @@ impl<S: Storage> SessionStore<S> {
             pruned: HashSet::new(),
             journal_len: parsed.complete_len,
             broken: None,
+            created: None,
         };
         for (i, entry) in parsed.entries.into_iter().enumerate() {
             store.admit(entry).map_err(|reason| StoreError::JournalCorrupt {
@@ -430,10 +451,22 @@ impl<S: Storage> SessionStore<S> {
 
     /// Record that the shot `key` was not taken, at `time`, and why: one
     /// journal line with status `missed`. Refused for a completed key, or
-    /// one already missed in this run ([`StoreError::Duplicate`]).
+    /// one already missed in this run ([`StoreError::Duplicate`]). A key
+    /// already journaled missed by an earlier run gets no second line: it
+    /// is marked missed in this run and its first line, returned, stands.
     pub fn record_missed(&mut self, key: &str, reason: &str, time: DateTime<Utc>) -> Result<JournalEntry, StoreError> {
         self.check_writable()?;
         self.check_new_key(key)?;
+        if self.missed.contains(key)
+            && let Some(first) = self
+                .entries
+                .iter()
+                .find(|e| matches!(e, JournalEntry::Missed(m) if m.key == key))
+        {
+            let first = first.clone();
+            self.missed_this_run.insert(key.to_string());
+            return Ok(first);
+        }
         let entry = JournalEntry::Missed(MissedEntry {
             key: key.to_string(),
             time,
@@ -654,6 +687,60 @@ impl<S: Storage> SessionStore<S> {
 #[cfg(test)]
 #[path = "session_tests.rs"]
 mod tests;
+
+fn io_error(action: &'static str, path: &Path) -> impl FnOnce(io::Error) -> StoreError {
+    let path = path.to_path_buf();
+    move |source| StoreError::Io { action, path, source }
+}
+
+/// Make a new session's files in `dir` (empty or absent): the frames
+/// directory, the snapshot, then the empty journal.
+fn lay_out<S: Storage>(storage: &S, dir: &Path, snapshot: &Snapshot) -> Result<(), StoreError> {
+    let frames = dir.join(FRAMES_DIR);
+    storage
+        .create_dir_all(&frames)
+        .map_err(io_error("creating directory", &frames))?;
+    storage.sync_dir(dir).map_err(io_error("fsyncing directory", dir))?;
+    if let Some(parent) = dir.parent().filter(|p| !p.as_os_str().is_empty()) {
+        storage
+            .sync_dir(parent)
+            .map_err(io_error("fsyncing directory", parent))?;
+    }
+    for (name, bytes) in snapshot.files() {
+        write_atomic(storage, dir, name, &bytes).map_err(atomic_io_error)?;
+    }
+    write_atomic(storage, dir, JOURNAL_FILE, b"").map_err(atomic_io_error)?;
+    Ok(())
+}
+
+/// Remove what [`lay_out`] makes in `dir` (which held nothing before, and
+/// did not exist unless `existed`): the journal, the snapshot files and
+/// temporary files, the empty frames directory, and `dir` itself if it was
+/// made. Anything else stays (and keeps `dir`).
+fn undo_create<S: Storage>(storage: &S, dir: &Path, existed: bool) -> io::Result<()> {
+    let ours = [JOURNAL_FILE, PLAN_FILE, STATION_FILE, SCENE_FILE, PROVENANCE_FILE];
+    let frames = dir.join(FRAMES_DIR);
+    if let Some(names) = storage.list(&frames)? {
+        for name in names.iter().filter(|n| is_temp_name(n)) {
+            storage.remove(&frames.join(name))?;
+        }
+        storage.remove_dir(&frames)?;
+    }
+    for name in storage.list(dir)?.unwrap_or_default() {
+        if ours.contains(&name.as_str()) || is_temp_name(&name) {
+            storage.remove(&dir.join(name))?;
+        }
+    }
+    if !existed {
+        storage.remove_dir(dir)?;
+        if let Some(parent) = dir.parent().filter(|p| !p.as_os_str().is_empty()) {
+            storage.sync_dir(parent)?;
+        }
+    } else {
+        storage.sync_dir(dir)?;
+    }
+    Ok(())
+}
 
 fn atomic_io_error(e: AtomicWriteError) -> StoreError {
     StoreError::Io {

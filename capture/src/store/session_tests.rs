@@ -709,3 +709,69 @@ fn pruned_frames_are_gone_on_purpose_and_outages_are_journaled() {
     assert_eq!(report.orphan_frames_removed, vec![kept.clone()]);
     assert!(!kept.exists() && store.pruned(&key(2)) && store.completed(&key(2)));
 }
+
+#[test]
+fn a_shot_missed_again_on_each_resume_keeps_its_one_missed_line() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("s");
+    let t0 = Utc.with_ymd_and_hms(2026, 8, 28, 7, 0, 0).unwrap();
+    let mut store = SessionStore::create(&dir, snapshot()).unwrap();
+    store.record_missed("c", "head stalled", t0).unwrap();
+    drop(store);
+    for run in 1..=3 {
+        let (mut store, report) = SessionStore::resume(&dir).unwrap();
+        assert_eq!(report.missed, 1, "run {run}");
+        let later = t0 + chrono::Duration::hours(run);
+        let stands = store.record_missed("c", "camera timed out", later).unwrap();
+        let JournalEntry::Missed(m) = &stands else {
+            panic!("{stands:?}")
+        };
+        assert_eq!((m.reason.as_str(), m.time), ("head stalled", t0), "run {run}");
+        assert!(store.missed_in_this_run("c"));
+        // Still final for this run.
+        let err = store.record_missed("c", "again", later).unwrap_err();
+        assert!(matches!(err, StoreError::Duplicate { .. }), "{err}");
+        assert_eq!(store.entries().len(), 1, "run {run}");
+    }
+    let lines = std::fs::read_to_string(dir.join(JOURNAL_FILE)).unwrap();
+    assert_eq!(lines.lines().count(), 1, "{lines}");
+}
+
+#[test]
+fn a_create_that_fails_leaves_the_directory_as_it_was() {
+    let tmp = tempfile::tempdir().unwrap();
+    // Absent before: absent after.
+    let dir = tmp.path().join("s");
+    let quota = QuotaStorage::open(FsStorage, &dir, 100).unwrap();
+    let err = SessionStore::create_with(&quota, &dir, snapshot()).unwrap_err();
+    assert!(matches!(err, StoreError::Io { .. } | StoreError::DiskFull(_)), "{err}");
+    assert!(!dir.exists(), "{:?}", std::fs::read_dir(&dir).map(|d| d.count()));
+    assert_eq!(quota.used(), 0);
+    // Empty before: empty after, and a new create takes it.
+    std::fs::create_dir(&dir).unwrap();
+    let quota = QuotaStorage::open(FsStorage, &dir, 100).unwrap();
+    SessionStore::create_with(&quota, &dir, snapshot()).unwrap_err();
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
+    SessionStore::create(&dir, snapshot()).unwrap();
+    assert!(dir.join(JOURNAL_FILE).exists());
+}
+
+#[test]
+fn an_unused_new_session_is_discarded_and_a_used_or_resumed_one_kept() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("s");
+    let store = SessionStore::create(&dir, snapshot()).unwrap();
+    assert!(store.discard_unused().unwrap());
+    assert!(!dir.exists());
+    let empty = tmp.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    let store = SessionStore::create(&empty, snapshot()).unwrap();
+    assert!(store.discard_unused().unwrap());
+    assert_eq!(std::fs::read_dir(&empty).unwrap().count(), 0);
+    let mut store = SessionStore::create(&dir, snapshot()).unwrap();
+    store.record_missed("c", "head stalled", Utc::now()).unwrap();
+    assert!(!store.discard_unused().unwrap());
+    let (store, _) = SessionStore::resume(&dir).unwrap();
+    assert!(!store.discard_unused().unwrap());
+    assert!(dir.join(JOURNAL_FILE).exists());
+}

@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 ///
 /// Mutating operations are [`Storage::create_dir_all`],
 /// [`Storage::write_new`], [`Storage::sync_file`], [`Storage::sync_dir`],
-/// [`Storage::rename`], [`Storage::append`], [`Storage::truncate`] and
-/// [`Storage::remove`]; the rest only read.
+/// [`Storage::rename`], [`Storage::append`], [`Storage::truncate`],
+/// [`Storage::remove`] and [`Storage::remove_dir`]; the rest only read.
 pub trait Storage {
     /// Create a directory and its parents (no error if it exists).
     fn create_dir_all(&self, dir: &Path) -> io::Result<()>;
@@ -52,6 +52,9 @@ pub trait Storage {
 
     /// Remove a file.
     fn remove(&self, path: &Path) -> io::Result<()>;
+
+    /// Remove an empty directory (an error if it holds anything).
+    fn remove_dir(&self, dir: &Path) -> io::Result<()>;
 }
 
 impl<S: Storage + ?Sized> Storage for &S {
@@ -87,6 +90,9 @@ impl<S: Storage + ?Sized> Storage for &S {
     }
     fn remove(&self, path: &Path) -> io::Result<()> {
         (**self).remove(path)
+    }
+    fn remove_dir(&self, dir: &Path) -> io::Result<()> {
+        (**self).remove_dir(dir)
     }
 }
 
@@ -202,6 +208,10 @@ impl Storage for FsStorage {
 
     fn remove(&self, path: &Path) -> io::Result<()> {
         fs::remove_file(path)
+    }
+
+    fn remove_dir(&self, dir: &Path) -> io::Result<()> {
+        fs::remove_dir(dir)
     }
 }
 

@@ -82,7 +82,7 @@ impl LightsPort {
         let open = |r: std::io::Result<HostStream>| {
             r.map_err(|source| SimError::Open {
                 port: port.clone(),
-                source,
+                error: source,
             })
         };
         match self {
@@ -92,7 +92,7 @@ impl LightsPort {
                     .await
                     .map_err(|source| SimError::Connect {
                         port: port.clone(),
-                        source,
+                        error: source,
                     })?;
                 Ok(SimLights::Link(Box::new(c)))
             }

@@ -72,12 +72,12 @@ impl WheelPort {
         let open = |r: std::io::Result<HostStream>| {
             r.map_err(|source| SimError::Open {
                 port: port.clone(),
-                source,
+                error: source,
             })
         };
         let connect = |source| SimError::Connect {
             port: port.clone(),
-            source,
+            error: source,
         };
         match self {
             WheelPort::Link(p) => {
