@@ -59,6 +59,11 @@ fn a_noisy_cie_clear_sky_is_fitted_as_cie_type_12_and_evaluates_back() {
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     let text = std::fs::read_to_string(&sky).expect("written");
     assert_eq!(text.matches("chosen: \"Cie(12)\"").count(), 3, "{text}");
+    // Its verdict beside it: a 1%-noise clear sky fits within the gates.
+    let q: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir_tmp.path().join("sky.quality.json")).expect("verdicts")).unwrap();
+    assert_eq!(q["verdict"], "ok", "{q}");
+    assert_eq!(q["products"][0]["checks"].as_array().unwrap().len(), 6, "{q}");
 
     // The residual map: a 256² fisheye, grey where no sample fell, and
     // within ±1.5% where one did (the noise is ±1%): the false colour's
@@ -175,6 +180,32 @@ fn predict_interpolates_fitted_skies_to_a_new_sun() {
     let gamma = (v[0] * sun[0] + v[1] * sun[1] + v[2] * sun[2]).clamp(-1.0, 1.0).acos();
     let want = model(60f64.to_radians(), gamma);
     assert!((rows[1] / want - 1.0).abs() < 2e-3, "{} vs {want}", rows[1]);
+
+    // A sky whose fit failed its gate is not used in silence: the
+    // prediction inherits its verdict and exits 3.
+    std::fs::write(
+        dir_tmp.path().join("morning.quality.json"),
+        r#"{"verdict": "failed", "counts": {"ok": 0, "poor": 0, "failed": 1}, "thresholds": {}, "products": []}"#,
+    )
+    .expect("write");
+    let out = campanile(&[
+        "sky",
+        "predict",
+        morning.to_str().expect("utf-8"),
+        evening.to_str().expect("utf-8"),
+        "--sun-zenith-deg",
+        "35",
+        "--sun-azimuth-deg",
+        "180",
+        "--out",
+        predicted.to_str().expect("utf-8"),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(3), "{stdout}");
+    assert!(
+        stdout.contains("sky predicted (inherited from ") && stdout.contains("morning.ron: failed"),
+        "{stdout}"
+    );
 
     // Skies with different channels are refused.
     std::fs::write(&evening, sky_ron(55.0, 250.0).replace("\"g\"", "\"r\"")).expect("write");

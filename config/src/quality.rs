@@ -219,7 +219,12 @@ impl Default for EnvironmentGates {
 #[serde(default, deny_unknown_fields)]
 pub struct IgiGates {
     /// RMS relative residual of the surface's fit (lower is better).
-    /// Default poor 0.15, failed 0.5.
+    /// Default poor 0.5, failed 2. It is a weak figure: one BRDF per
+    /// surface leaves the surface's texture (which the albedo maps take up,
+    /// §4.6) and the photographs' noise in it. Measured in the quick demo's
+    /// room (8-path photographs): 0.15–0.57 for wood, paper, plastic and
+    /// metal, 1.08 for the paint, whose recovered ρd is within 0.4% on the
+    /// simulated room; beyond 2 the model explains less than the noise.
     pub residual: Gate,
     /// Directional albedo ρd + ρs, worst channel: reflecting more than
     /// falls on it breaks energy conservation (lower is better). Default
@@ -230,7 +235,7 @@ pub struct IgiGates {
 impl Default for IgiGates {
     fn default() -> Self {
         IgiGates {
-            residual: Gate::new(0.15, 0.5),
+            residual: Gate::new(0.5, 2.0),
             energy: Gate::new(0.95, 1.0),
         }
     }

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use campanile_process::exr_io::write_radiance_exr;
 use campanile_process::hdr::merge::RadianceMap;
-use campanile_process::quality::{QualityReport, gates};
+use campanile_process::quality::{ProductQuality, QualityReport, gates};
 use campanile_process::sky::{
     ChannelSky, KnownSky, SkyFile, angle_between, direction, fit_sky_robust, predict_sky, read_directions,
     read_samples, render_latlong,
@@ -260,7 +260,22 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
                     channels,
                 },
                 out.as_deref(),
-            )
+            )?;
+            // The prediction carries the verdicts its skies were fitted
+            // with (`NAME.quality.json` beside each): a failed fit is not
+            // used in silence.
+            let mut predicted = ProductQuality::new("sky predicted", Vec::new());
+            for path in &skies {
+                if let Some(input) = super::verdicts::of_input(path)? {
+                    predicted.inherit(&input);
+                }
+            }
+            let q = campanile_process::quality::Quality::default();
+            let quality = QualityReport::new(vec![predicted], &q);
+            match &out {
+                Some(path) => super::verdicts::finish(&quality, &super::verdicts::beside(path)),
+                None => super::verdicts::finish_on_stderr(&quality),
+            }
         }
         SkyCommand::Map { sky, out, width } => {
             let sky_file = read_sky(&sky)?;
