@@ -249,9 +249,9 @@ pub fn write_material_files(
 pub fn write_products(r: &Recovered, out: &Path) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let table = format_table(&r.result, &[], None);
-    print!("{table}");
+    out!("{table}")?;
     for (n, t) in &r.loaded.triangulated {
-        println!(
+        outln!(
             "light {n:?} triangulated from {} images: position ({:.4}, {:.4}, {:.4}) m, radius {:.4} m, intensity {:.3?} W/sr, ray rms {:.2} mm",
             t.sightings.len(),
             t.light.position.x,
@@ -260,7 +260,7 @@ pub fn write_products(r: &Recovered, out: &Path) -> Result<()> {
             t.light.radius,
             t.light.intensity,
             t.ray_rms_m * 1e3
-        );
+        )?;
     }
     let materials = out.join("materials.txt");
     std::fs::write(&materials, &table).with_context(|| format!("writing {}", materials.display()))?;
@@ -271,13 +271,13 @@ pub fn write_products(r: &Recovered, out: &Path) -> Result<()> {
     let json = out.join("summary.json");
     std::fs::write(&json, serde_json::to_string_pretty(&summary(r, &albedo))?)
         .with_context(|| format!("writing {}", json.display()))?;
-    println!(
+    outln!(
         "wrote {}, materials.rad (RADIANCE), materials.xml (Mitsuba 3), {}, {} albedo maps under {}",
         materials.display(),
         json.display(),
         albedo.len(),
         out.join("albedo").display()
-    );
+    )?;
     Ok(())
 }
 
@@ -295,7 +295,7 @@ pub fn run(args: IgiArgs) -> Result<()> {
             let img = r.relight(&lights, &cam, args.quick)?;
             let path = args.out.join(format!("relit-{cam}.exr"));
             write_exr(&img, &path)?;
-            println!("relit {}", path.display());
+            outln!("relit {}", path.display())?;
         }
     }
     Ok(())

@@ -62,31 +62,28 @@ pub struct CheckArgs {
     ron: Option<PathBuf>,
 }
 
-pub fn run(cmd: PlanCommand) -> u8 {
+pub fn run(cmd: PlanCommand) -> Result<u8> {
     match cmd {
         PlanCommand::Check(args) => check(&args),
     }
 }
 
-fn check(args: &CheckArgs) -> u8 {
+fn check(args: &CheckArgs) -> Result<u8> {
     let (t, station, plan_name) = match simulate(args) {
         Ok(v) => v,
         Err(e) => {
             eprintln!("error: {e:#}");
-            return EXIT_USAGE;
+            return Ok(EXIT_USAGE);
         }
     };
-    if let Err(e) = print(&t, &station, &plan_name, args) {
-        eprintln!("error: {e:#}");
-        return EXIT_FAILURE;
-    }
+    print(&t, &station, &plan_name, args)?;
     if let Some(out) = &args.ron
         && let Err(e) = super::ron_output::write_ron(&t, Some(out))
     {
         eprintln!("error: {e:#}");
-        return EXIT_FAILURE;
+        return Ok(EXIT_FAILURE);
     }
-    if t.is_covered() { EXIT_OK } else { EXIT_FAILURE }
+    Ok(if t.is_covered() { EXIT_OK } else { EXIT_FAILURE })
 }
 
 fn simulate(args: &CheckArgs) -> Result<(Timeline, Station, String)> {

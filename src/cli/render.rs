@@ -217,7 +217,7 @@ fn run_room(args: &RenderArgs, scene: &Path, lights: &Path) -> Result<()> {
         let img = r.relight(&lights, &cam, args.quick)?;
         let path = args.out.join(format!("relit-{cam}.exr"));
         write_exr(&img, &path)?;
-        println!("relit {}", path.display());
+        outln!("relit {}", path.display())?;
     }
     Ok(())
 }
@@ -333,11 +333,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
             let z = zoom_albedo(scene, &refl, &photo, &light, &ZoomSettings::default())
                 .map_err(|e| anyhow::anyhow!("{e}"))
                 .with_context(|| format!("--zoom {}", path.display()))?;
-            println!("zoom: {}", z.report);
+            outln!("zoom: {}", z.report)?;
             for (name, rho) in [("zoom-albedo-sun", &z.rho_sun), ("zoom-albedo-se", &z.rho_se)] {
                 let exr = args.out.join(format!("{name}.exr"));
                 write_exr(&albedo_image(rho, &z.rig), &exr)?;
-                println!("{}", exr.display());
+                outln!("{}", exr.display())?;
             }
             Some(z)
         }
@@ -362,12 +362,12 @@ pub fn run(args: RenderArgs) -> Result<()> {
         let stem = format!("{prefix}-{}", t.format("%Y%m%dT%H%M%SZ"));
         let exr = args.out.join(format!("{stem}.exr"));
         write_exr(&image, &exr)?;
-        println!(
+        outln!(
             "{}  sun elevation {:.1}°  {}",
             t.to_rfc3339(),
             elevation.to_degrees(),
             exr.display()
-        );
+        )?;
         if let Some(c) = &curve {
             let png = args.out.join(format!("{stem}.png"));
             write_png(&photograph(&image, c, args.shutter_s, args.scale), &png)

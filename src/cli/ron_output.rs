@@ -15,7 +15,7 @@ pub fn write_ron<T: Serialize>(value: &T, out: Option<&Path>) -> Result<()> {
             std::fs::write(&tmp, text + "\n").with_context(|| format!("{}: cannot write", tmp.display()))?;
             std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot write", path.display()))?;
         }
-        None => println!("{text}"),
+        None => outln!("{text}")?,
     }
     Ok(())
 }

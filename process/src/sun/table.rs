@@ -93,9 +93,9 @@ pub enum SunTableError {
         /// Why.
         source: SunError,
     },
-    /// Writing failed.
+    /// Writing failed (a closed pipe is `BrokenPipe`, so a caller can tell it).
     #[error("cannot write the output: {0}")]
-    Write(String),
+    Write(#[source] std::io::Error),
 }
 
 impl From<CellError> for SunTableError {
@@ -160,7 +160,7 @@ pub fn sun_table(input: impl Read, output: impl Write) -> Result<usize, SunTable
         out_header.push_field(h);
     }
     wr.write_record(&out_header)
-        .map_err(|e| SunTableError::Write(e.to_string()))?;
+        .map_err(|e| SunTableError::Write(e.into()))?;
     for (k, (rec, ans)) in rows.iter().zip(answers).enumerate() {
         let a = ans.map_err(|source| SunTableError::Sun {
             row: k as u64 + 2,
@@ -171,9 +171,9 @@ pub fn sun_table(input: impl Read, output: impl Write) -> Result<usize, SunTable
         rec.push_field(&format!("{:.7}", a.position.azimuth_rad.to_degrees()));
         rec.push_field(&format!("{:.7}", a.position.elevation_rad().to_degrees()));
         rec.push_field(&format!("{:.10}", a.earth_sun_distance_au));
-        wr.write_record(&rec).map_err(|e| SunTableError::Write(e.to_string()))?;
+        wr.write_record(&rec).map_err(|e| SunTableError::Write(e.into()))?;
     }
-    wr.flush().map_err(|e| SunTableError::Write(e.to_string()))?;
+    wr.flush().map_err(SunTableError::Write)?;
     Ok(rows.len())
 }
 

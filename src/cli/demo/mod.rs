@@ -98,7 +98,7 @@ pub fn capture_simulated(plan: &Path, station: &Path, session: &Path, extra: &[&
     ];
     line.extend(extra.iter().map(std::ffi::OsStr::new));
     let line = CaptureLine::try_parse_from(line)?;
-    if super::capture::run(line.args) != super::EXIT_OK {
+    if super::capture::run(line.args)? != super::EXIT_OK {
         bail!(
             "the simulated capture of {} did not complete (see above)",
             plan.display()
@@ -278,12 +278,12 @@ pub fn run(args: DemoArgs) -> Result<()> {
     };
     let path = args.out.join("report.html");
     process::write_report(&report, &path)?;
-    println!(
+    outln!(
         "demo finished in {:.1} s: {} ({} figures)",
         wall.elapsed().as_secs_f64(),
         path.display(),
         report.figure_count()
-    );
+    )?;
     Ok(())
 }
 
