@@ -10,8 +10,8 @@ use campanile_capture::station::{SerialOpener, StationOptions as RigOptions, Sta
 use campanile_capture::store::{JournalEntry, SessionReader};
 use campanile_capture::unattended::day_rollover::existing_days;
 use campanile_capture::unattended::{
-    self, DeviceState, Heartbeat, NoProcessing, StationEnd, StationInputs, StationOptions, StationReport, StopHandle,
-    StorageBudget, parse_bytes,
+    self, DeviceState, Heartbeat, Liveness, NoProcessing, StationEnd, StationInputs, StationOptions, StationReport,
+    StopHandle, StorageBudget, parse_bytes,
 };
 use campanile_sim::faults::{Device, FaultPlan, Outage};
 use campanile_sim::station::{SimOptions, SimStation};
@@ -161,7 +161,11 @@ impl std::str::FromStr for StationOutageArg {
 /// Exit status: 0 when the heartbeat was written less than --max-age
 /// seconds ago (wall clock); 1 when it is older (stale: the station is not
 /// running, or stuck; a stopped or finished station is stale too) or
-/// cannot be read. A running station rewrites it at every frame and at
+/// cannot be read, and 1 at once when it says the station runs but its
+/// process does not (same host, and the PID is gone or is another process
+/// now: "not running (killed?)"). A heartbeat written on another host, or
+/// by an older version without host and start time, is judged by its age
+/// only. A running station rewrites it at every frame and at
 /// least every 60 s while it waits.
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
@@ -484,6 +488,24 @@ fn status(args: &StatusArgs) -> Result<u8> {
         beat.budget_bytes
             .map_or(String::new(), |b| format!(" of a {} budget", mb(b)))
     )?;
+    // A station that ends on its own writes `stopped`, `finished` or
+    // `failed`; one whose heartbeat says it runs must still run.
+    let live = beat.liveness();
+    match &live {
+        Liveness::Running => outln!("  process      pid {} on this host: running", beat.pid)?,
+        Liveness::NotRunning(why) => outln!("  process      {why}")?,
+        Liveness::OtherHost(host) => outln!(
+            "  process      pid {} on host {host}, not this one: judged by the heartbeat's age only",
+            beat.pid
+        )?,
+        Liveness::Unknown(why) => outln!("  process      {why}; judged by the heartbeat's age only")?,
+    }
+    if beat.state.claims_running()
+        && let Liveness::NotRunning(why) = &live
+    {
+        outln!("not running (killed?): the heartbeat says {state}, but {why}")?;
+        return Ok(EXIT_FAILURE);
+    }
     if age > args.max_age {
         outln!(
             "STALE: written {age:.0} s ago, more than --max-age {:.0} s: the station is not running or is stuck",
