@@ -80,7 +80,7 @@ pub struct Recovered {
 
 /// Loads `scene` and recovers its materials and albedo maps.
 pub fn recover_scene(scene: &Path, quick: bool) -> Result<Recovered> {
-    let loaded = load(scene).map_err(|e| anyhow!("{e}"))?;
+    let loaded = load(scene)?;
     let (opts, map_opts, _) = settings(quick);
     let result = recover(&loaded.input, &opts).map_err(|e| anyhow!("inverse global illumination: {e}"))?;
     let map = AlbedoMap::build(&loaded.input, &result, &map_opts).map_err(|e| anyhow!("albedo maps: {e}"))?;

@@ -11,6 +11,7 @@ pub mod exit;
 mod hdr;
 mod igi;
 mod logging;
+mod partial_file;
 mod plan;
 mod process;
 mod render;

@@ -174,7 +174,7 @@ pub struct StatusArgs {
     #[arg(value_name = "DIR")]
     store: PathBuf,
     /// Stale beyond this many seconds.
-    #[arg(long, value_name = "SECONDS", default_value_t = 300.0)]
+    #[arg(long, value_name = "SECONDS", default_value_t = 300.0, allow_negative_numbers = true)]
     max_age: f64,
 }
 
@@ -432,6 +432,12 @@ fn summary(store: &Path, r: &StationReport, wall: Duration) -> Result<()> {
 }
 
 fn status(args: &StatusArgs) -> Result<u8> {
+    if !(args.max_age.is_finite() && args.max_age >= 0.0) {
+        return Err(super::exit::bad_input(format!(
+            "--max-age: found {}; expected a number of seconds, 0 or more",
+            super::exit::shown(args.max_age)
+        )));
+    }
     let beat = match Heartbeat::read(&args.store) {
         Ok(b) => b,
         Err(e) => {

@@ -116,6 +116,15 @@ pub fn run(args: DemoArgs) -> Result<()> {
             examples.display()
         );
     }
+    let session = args.out.join("campanile-session");
+    if args.reuse_session && !session.join("journal.jsonl").is_file() {
+        return Err(super::exit::bad_input(format!(
+            "--reuse-session: {} holds no captured session ({} is missing); run the demo once without \
+             --reuse-session to capture one",
+            args.out.display(),
+            session.join("journal.jsonl").display()
+        )));
+    }
     std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create", args.out.display()))?;
     let station = examples.join("sim-station.ron");
     let plan = examples.join(if args.quick {
@@ -126,7 +135,6 @@ pub fn run(args: DemoArgs) -> Result<()> {
     let scene = examples.join("campanile-scene.ron");
 
     // 1–2. Capture.
-    let session = args.out.join("campanile-session");
     eprintln!("capturing {} on the simulated station …", plan.display());
     let t = Instant::now();
     // Three bounces: the light the ground reflects onto shaded walls,

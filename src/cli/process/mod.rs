@@ -241,10 +241,10 @@ pub fn run(args: ProcessArgs) -> Result<()> {
         return run_sky_series(&args, out, debevec);
     }
     if args.response.is_some() || args.shard.is_some() || args.merge_shards.is_some() || args.occurrence.is_some() {
-        anyhow::bail!(
+        return Err(super::exit::bad_input(format!(
             "{}: --response, --shard, --merge-shards and --occurrence are for sky-only sessions (sun shots, sky scans and brackets at head angles); this session's plan has views of a scene",
             args.session.display()
-        );
+        )));
     }
     let room = room::is_room_session(&inputs.plan);
     drop(inputs);
@@ -627,9 +627,7 @@ pub fn outdoor_sections(
 
 /// Writes a report page (through a temporary file).
 pub fn write_report(report: &Report, path: &Path) -> Result<()> {
-    let tmp = path.with_extension("html.partial");
-    std::fs::write(&tmp, report.to_html()).with_context(|| format!("{}: cannot write", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot write", path.display()))
+    super::partial_file::write(path, report.to_html().as_bytes())
 }
 
 /// The sky fits of an occurrence as a sky file.
@@ -658,11 +656,7 @@ pub fn write_outputs(p: &Processed, out: &Path) -> Result<()> {
     mkdir(out)?;
     mkdir(&out.join("radiance"))?;
     mkdir(&out.join("light"))?;
-    let write = |path: PathBuf, bytes: &[u8]| -> Result<()> {
-        let tmp = path.with_extension("partial");
-        std::fs::write(&tmp, bytes).with_context(|| format!("{}: cannot write", tmp.display()))?;
-        std::fs::rename(&tmp, &path).with_context(|| format!("{}: cannot write", path.display()))
-    };
+    let write = |path: PathBuf, bytes: &[u8]| super::partial_file::write(&path, bytes);
     write(
         out.join("response.csv"),
         p.calibration.curve.to_csv(&p.calibration.method).as_bytes(),
