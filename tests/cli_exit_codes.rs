@@ -313,7 +313,14 @@ fn a_failed_out_leaves_no_partial_file() {
         "--out",
         out_csv.to_str().expect("utf-8"),
     ]);
-    assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    // The row's reason once, not twice (message and source).
+    assert_eq!(stderr.matches("invalid latitude 95").count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("row 3: site latitude_deg = 95: invalid latitude 95"),
+        "{stderr}"
+    );
     let left: Vec<String> = std::fs::read_dir(tmp.path())
         .expect("dir")
         .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())

@@ -85,16 +85,18 @@ pub enum SunTableError {
     /// The table or one of its cells.
     #[error(transparent)]
     Table(#[from] TableError),
-    /// The ephemeris refused a row.
-    #[error("row {row}: {source}")]
+    /// The ephemeris refused a row. (Its reason is in the message, not a
+    /// `source`, so that an error chain prints it once.)
+    #[error("row {row}: {reason}")]
     Sun {
         /// Row.
         row: u64,
         /// Why.
-        source: SunError,
+        reason: SunError,
     },
-    /// Writing failed (a closed pipe is `BrokenPipe`, so a caller can tell it).
-    #[error("cannot write the output: {0}")]
+    /// Writing failed; the `io::Error` is the source (printed by the chain;
+    /// a closed pipe is `BrokenPipe`, so a caller can tell it).
+    #[error("cannot write the output")]
     Write(#[source] std::io::Error),
 }
 
@@ -162,9 +164,9 @@ pub fn sun_table(input: impl Read, output: impl Write) -> Result<usize, SunTable
     wr.write_record(&out_header)
         .map_err(|e| SunTableError::Write(e.into()))?;
     for (k, (rec, ans)) in rows.iter().zip(answers).enumerate() {
-        let a = ans.map_err(|source| SunTableError::Sun {
+        let a = ans.map_err(|reason| SunTableError::Sun {
             row: k as u64 + 2,
-            source,
+            reason,
         })?;
         let mut rec = rec.clone();
         rec.push_field(&format!("{:.7}", a.position.zenith_rad.to_degrees()));
