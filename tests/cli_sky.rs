@@ -116,7 +116,7 @@ fn a_sun_below_the_horizon_is_refused_with_a_reason() {
         "--station",
         "examples/sim-station.ron",
     ]);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
     assert!(
         String::from_utf8_lossy(&out.stderr).contains("below the horizon"),
         "{}",
@@ -219,7 +219,7 @@ fn predict_interpolates_fitted_skies_to_a_new_sun() {
         "--sun-azimuth-deg",
         "180",
     ]);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
     assert!(
         String::from_utf8_lossy(&out.stderr).contains("differ from"),
         "{}",
@@ -268,5 +268,5 @@ fn map_writes_a_lat_long_exr_of_the_fitted_sky() {
         "--out",
         exr.to_str().expect("utf-8"),
     ]);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
 }

@@ -85,7 +85,7 @@ fn a_csv_table_round_trips_and_bad_rows_are_named() {
 
     std::fs::write(&input, "time_utc,latitude_deg,longitude_deg\nyesterday,10,10\n").expect("write");
     let out = campanile(&["sun", "--csv", input.to_str().expect("utf-8")]);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("row 2, column `time_utc`: found \"yesterday\""), "{err}");
 }

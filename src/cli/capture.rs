@@ -168,12 +168,12 @@ impl std::str::FromStr for OutageArg {
     }
 }
 
-pub fn run(args: CaptureArgs) -> u8 {
+pub fn run(args: CaptureArgs) -> Result<u8> {
     let inputs = match Inputs::load(&args) {
         Ok(i) => i,
         Err(e) => {
             eprintln!("error: {e:#}");
-            return EXIT_USAGE;
+            return Ok(EXIT_USAGE);
         }
     };
     let sim_flags = args.sim_drop_chance.is_some()
@@ -187,16 +187,13 @@ pub fn run(args: CaptureArgs) -> u8 {
             "error: the --sim-* fault flags are for simulated stations; station {:?} ({}) has real devices",
             inputs.station.name, inputs.station_label
         );
-        return EXIT_USAGE;
+        return Ok(EXIT_USAGE);
     }
-    match capture(&args, &inputs) {
-        Ok(true) => EXIT_OK,
-        Ok(false) => EXIT_FAILURE,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            EXIT_FAILURE
-        }
-    }
+    Ok(if capture(&args, &inputs)? {
+        EXIT_OK
+    } else {
+        EXIT_FAILURE
+    })
 }
 
 /// The plan, station and scene, as `plan check` reads them.
@@ -474,7 +471,7 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
         (None, None) => bail!("give --out DIR or --resume DIR"),
     };
     if inputs.timeline.occurrences.is_empty() {
-        println!("the plan has no occurrences: nothing to capture");
+        outln!("the plan has no occurrences: nothing to capture")?;
         return Ok(true);
     }
     let promised = inputs.timeline.frames_promised();
@@ -530,13 +527,13 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
             _ => extra += 1,
         }
     }
-    println!("session {}", store.dir().display());
-    println!("  frames promised      {promised}");
-    println!("  frames stored        {stored} (of which late: {late})");
-    println!("  auto-bracket extras  {extra}");
+    outln!("session {}", store.dir().display())?;
+    outln!("  frames promised      {promised}")?;
+    outln!("  frames stored        {stored} (of which late: {late})")?;
+    outln!("  auto-bracket extras  {extra}")?;
     let missed = missed_keys.len();
-    println!("  shots missed         {missed}");
-    println!(
+    outln!("  shots missed         {missed}")?;
+    outln!(
         "  this run             {} frames, {} missed, {} retries, {} reconnects, {} metering captures, {} sun retakes",
         report.frames,
         report.missed,
@@ -544,8 +541,8 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
         report.reconnects,
         report.metering_captures,
         report.saturation_retakes
-    );
-    println!("  wall time            {}", seconds(elapsed));
+    )?;
+    outln!("  wall time            {}", seconds(elapsed))?;
     if let Some(e) = stopped {
         eprintln!("error: {e:#}");
         eprintln!("resume with: campanile capture --resume {}", store.dir().display());

@@ -28,13 +28,13 @@ pub enum ConfigCommand {
     },
 }
 
-pub fn run(cmd: ConfigCommand) -> u8 {
+pub fn run(cmd: ConfigCommand) -> anyhow::Result<u8> {
     match cmd {
         ConfigCommand::Check { files } => check(&files),
     }
 }
 
-fn check(files: &[PathBuf]) -> u8 {
+fn check(files: &[PathBuf]) -> anyhow::Result<u8> {
     let mut failed = false;
     let mut docs = Vec::new();
     for path in files {
@@ -54,23 +54,23 @@ fn check(files: &[PathBuf]) -> u8 {
         })
         .collect();
     for (path, doc) in &docs {
-        println!("{}: valid {}", path.display(), doc.kind());
-        print!("{}", doc.summary());
+        outln!("{}: valid {}", path.display(), doc.kind())?;
+        out!("{}", doc.summary())?;
         if let Document::Plan(plan) = doc {
             if stations.is_empty() {
-                println!("  (not checked against a station: give a station file in the same command)");
+                outln!("  (not checked against a station: give a station file in the same command)")?;
             }
             for (spath, station) in &stations {
                 match check_plan_on_station(plan, station) {
-                    Ok(()) => println!("  runs on station {:?} ({})", station.name, spath.display()),
+                    Ok(()) => outln!("  runs on station {:?} ({})", station.name, spath.display())?,
                     Err(errors) => {
                         failed = true;
                         eprintln!("{errors}");
-                        println!("  does NOT run on station {:?} ({})", station.name, spath.display());
+                        outln!("  does NOT run on station {:?} ({})", station.name, spath.display())?;
                     }
                 }
             }
         }
     }
-    if failed { EXIT_USAGE } else { EXIT_OK }
+    Ok(if failed { EXIT_USAGE } else { EXIT_OK })
 }

@@ -68,44 +68,38 @@ struct TestArgs {
     move_limit_s: f64,
 }
 
-pub fn run(args: DevicesArgs) -> u8 {
+pub fn run(args: DevicesArgs) -> Result<u8> {
     match args.action {
-        None => match list() {
-            Ok(()) => EXIT_OK,
-            Err(e) => {
-                eprintln!("error: {e:#}");
-                EXIT_FAILURE
-            }
-        },
+        None => list().map(|()| EXIT_OK),
         Some(DevicesCommand::Test(t)) => test(&t),
     }
 }
 
 fn list() -> Result<()> {
     let ports = serial::list().context("listing serial ports")?;
-    println!("serial ports:");
+    outln!("serial ports:")?;
     if ports.is_empty() {
-        println!("  (none found)");
+        outln!("  (none found)")?;
     }
     for p in &ports {
-        println!("  {p}");
+        outln!("  {p}")?;
     }
     let cameras = list_cameras().context("listing cameras")?;
-    println!("cameras:");
+    outln!("cameras:")?;
     if cameras.is_empty() {
-        println!("  (none found)");
+        outln!("  (none found)")?;
     }
     for c in &cameras {
         match &c.name {
-            Some(n) => println!("  {}  {n}", c.path.display()),
-            None => println!("  {}", c.path.display()),
+            Some(n) => outln!("  {}  {n}", c.path.display())?,
+            None => outln!("  {}", c.path.display())?,
         }
     }
     if !cfg!(feature = "v4l") {
-        println!(
+        outln!(
             "note: built without the `v4l` feature: cameras are the /dev/video* nodes, named from /sys; \
              rebuild with `--features v4l` to open them"
-        );
+        )?;
     }
     Ok(())
 }
@@ -119,12 +113,12 @@ enum Outcome {
     Skipped(String),
 }
 
-fn test(args: &TestArgs) -> u8 {
+fn test(args: &TestArgs) -> Result<u8> {
     let station = match load_station(&args.station) {
         Ok(s) => s.value,
         Err(e) => {
             eprintln!("error: {e}");
-            return EXIT_USAGE;
+            return Ok(EXIT_USAGE);
         }
     };
     if !(args.move_limit_s.is_finite() && args.move_limit_s > 0.0) {
@@ -132,7 +126,7 @@ fn test(args: &TestArgs) -> u8 {
             "error: --move-limit-s: found {}; expected a positive number of seconds",
             args.move_limit_s
         );
-        return EXIT_USAGE;
+        return Ok(EXIT_USAGE);
     }
     let head_options = conformance::pan_tilt::Options {
         move_limit: Duration::from_secs_f64(args.move_limit_s),
@@ -143,7 +137,7 @@ fn test(args: &TestArgs) -> u8 {
     } else {
         if let Err(e) = check_ports(&station) {
             eprintln!("error: {}: {e}", args.station.display());
-            return EXIT_USAGE;
+            return Ok(EXIT_USAGE);
         }
         test_real(&station, head_options)
     };
@@ -151,30 +145,30 @@ fn test(args: &TestArgs) -> u8 {
         Ok(o) => o,
         Err(e) => {
             eprintln!("error: {e:#}");
-            return EXIT_FAILURE;
+            return Ok(EXIT_FAILURE);
         }
     };
     let (mut checks, mut failed) = (0, 0);
     for (device, outcome) in &outcomes {
-        println!("{device}:");
+        outln!("{device}:")?;
         match outcome {
             Outcome::Tested(report) => {
                 for line in report.to_string().lines() {
-                    println!("  {line}");
+                    outln!("  {line}")?;
                 }
                 checks += report.checks.len();
                 failed += report.failures().len();
             }
             Outcome::Failed(why) => {
-                println!("  FAIL  connect: {why}");
+                outln!("  FAIL  connect: {why}")?;
                 checks += 1;
                 failed += 1;
             }
-            Outcome::Skipped(why) => println!("  skipped: {why}"),
+            Outcome::Skipped(why) => outln!("  skipped: {why}")?,
         }
     }
-    println!("{checks} checks, {failed} failed");
-    if failed == 0 { EXIT_OK } else { EXIT_FAILURE }
+    outln!("{checks} checks, {failed} failed")?;
+    Ok(if failed == 0 { EXIT_OK } else { EXIT_FAILURE })
 }
 
 fn label(kind: &str, protocol: impl std::fmt::Debug, port: &str) -> String {

@@ -5,7 +5,7 @@ use std::fs::File;
 use std::io::{BufReader, Write};
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use campanile_process::environment::{EnvironmentFile, RegionRecord, fit_region, read_observations};
 use campanile_process::quality::{QualityReport, gates};
 use clap::Subcommand;
@@ -64,7 +64,9 @@ fn rgb(flag: &str, text: &str) -> Result<[f64; 3]> {
         .with_context(|| format!("--{flag} {text:?}: expected three numbers \"r,g,b\""))?;
     match v.as_slice() {
         &[r, g, b] if v.iter().all(|x| x.is_finite() && *x >= 0.0) => Ok([r, g, b]),
-        _ => bail!("--{flag} {text:?}: expected three non-negative numbers \"r,g,b\""),
+        _ => Err(super::exit::bad_input(format!(
+            "--{flag} {text:?}: expected three non-negative numbers \"r,g,b\""
+        ))),
     }
 }
 

@@ -8,8 +8,9 @@
 //! | 3 | finished, but a product failed its quality gate (`quality.json` names it) |
 //!
 //! Subcommands return `anyhow::Result`. An error whose chain holds a
-//! [`BadInput`] exits 2, one that holds a [`QualityFailed`] exits 3, any
-//! other exits 1.
+//! [`BadInput`], or a library error that means bad input (see
+//! [`is_bad_input`]), exits 2; one that holds a [`QualityFailed`] exits 3;
+//! any other exits 1.
 
 use std::fmt;
 
@@ -35,7 +36,6 @@ impl fmt::Display for BadInput {
 impl std::error::Error for BadInput {}
 
 /// An `anyhow` error that exits 2, with `message` as its text.
-#[allow(dead_code)] // until the subcommands use it (issue 21)
 pub fn bad_input(message: impl Into<String>) -> anyhow::Error {
     anyhow::Error::new(BadInput(message.into()))
 }
@@ -63,15 +63,49 @@ impl std::error::Error for QualityFailed {}
 /// The exit status for an error: 2 for bad input, 3 for a failed quality
 /// gate, 1 otherwise.
 pub fn code_of(err: &anyhow::Error) -> u8 {
-    for cause in err.chain() {
-        if cause.is::<BadInput>() {
-            return EXIT_USAGE;
-        }
-        if cause.is::<QualityFailed>() {
-            return EXIT_QUALITY;
-        }
+    if err.chain().any(is_bad_input) {
+        return EXIT_USAGE;
+    }
+    if err.chain().any(|c| c.is::<QualityFailed>()) {
+        return EXIT_QUALITY;
     }
     EXIT_FAILURE
+}
+
+/// Whether `cause` means bad input: a [`BadInput`], or a library error
+/// about what the user gave: a configuration file, a table, a site, a
+/// session directory, a RON file, or an input path that does not exist.
+pub fn is_bad_input(cause: &(dyn std::error::Error + 'static)) -> bool {
+    use campanile_capture::store::StoreError;
+    use campanile_process::sun::{SunError, SunTableError};
+    cause.is::<BadInput>()
+        || cause.is::<campanile_config::ConfigError>()
+        || cause.is::<campanile_config::ConfigErrors>()
+        || cause.is::<SunError>()
+        || cause.is::<campanile_process::sky::SampleTableError>()
+        || cause.is::<campanile_process::csv_cell::TableError>()
+        || cause.is::<campanile_process::igi::scene_file::SceneFileError>()
+        || cause.is::<ron::error::SpannedError>()
+        || cause
+            .downcast_ref::<SunTableError>()
+            .is_some_and(|e| !matches!(e, SunTableError::Write(_)))
+        || cause
+            .downcast_ref::<StoreError>()
+            .is_some_and(|e| matches!(e, StoreError::NotASession { .. } | StoreError::InvalidKey { .. }))
+        || cause
+            .downcast_ref::<std::io::Error>()
+            .is_some_and(|e| e.kind() == std::io::ErrorKind::NotFound)
+}
+
+/// A number as an error message shows it: the shortest text that reads
+/// back as `x`, in scientific notation when huge or tiny (`1e308`, not
+/// 309 digits).
+pub fn shown(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e15).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
 }
 
 #[cfg(test)]
@@ -94,5 +128,20 @@ mod tests {
             q.to_string()
                 .starts_with("finished, but products failed their quality checks: response")
         );
+        let missing = std::fs::read("/no/such/input.csv")
+            .map_err(anyhow::Error::from)
+            .unwrap_err();
+        assert_eq!(code_of(&missing.context("reading the table")), EXIT_USAGE);
+        let denied = std::io::Error::from(std::io::ErrorKind::PermissionDenied);
+        assert_eq!(code_of(&anyhow::Error::from(denied)), EXIT_FAILURE);
+    }
+
+    #[test]
+    fn numbers_in_errors_are_short() {
+        assert_eq!(shown(1e308), "1e308");
+        assert_eq!(shown(-2.5e-7), "-2.5e-7");
+        assert_eq!(shown(95.0), "95");
+        assert_eq!(shown(-1013.25), "-1013.25");
+        assert_eq!(shown(f64::NAN), "NaN");
     }
 }

@@ -159,6 +159,7 @@ pub fn run(cmd: HdrCommand) -> u8 {
     };
     match result {
         Ok(()) => EXIT_OK,
+        Err(e) if super::output::is_broken_pipe(&e) => EXIT_OK,
         Err(e) => {
             eprintln!("error: {e:#}");
             exit_code(&e)
@@ -231,7 +232,7 @@ fn calibrate(a: &CalibrateArgs) -> Result<()> {
             };
             let cal = calibrate_debevec(&bracket, &opts).context("recovering the response (Debevec–Malik)")?;
             for (c, d) in cal.channels.iter().enumerate() {
-                println!(
+                outln!(
                     "channel {}: {} samples, {} observations, residual RMS {:.4}, {} nodes made monotone, \
                      condition ≈ {:.1e}, dark-end bias correction up to {:.3}",
                     ["R", "G", "B"][c],
@@ -241,14 +242,14 @@ fn calibrate(a: &CalibrateArgs) -> Result<()> {
                     d.monotone_adjustments,
                     d.condition_estimate,
                     d.noise_bias.max_correction
-                );
+                )?;
             }
             if a.fit_times {
                 for (label, fitted) in bracket.times_s().iter().zip(&cal.times_s) {
-                    println!(
+                    outln!(
                         "exposure labelled {label} s: fitted {fitted:.6} s ({:+.2} %)",
                         100.0 * (fitted / label - 1.0)
-                    );
+                    )?;
                 }
             }
             let quality = gates::response(&cal, bracket.len(), bracket.len(), &q);
@@ -261,7 +262,7 @@ fn calibrate(a: &CalibrateArgs) -> Result<()> {
                 ..Default::default()
             };
             let (curve, iters) = calibrate_robertson(&bracket, &opts).context("recovering the response (Robertson)")?;
-            println!("Robertson: {iters:?} iterations (R, G, B)");
+            outln!("Robertson: {iters:?} iterations (R, G, B)")?;
             let quality = gates::response_curve(&curve, bracket.len(), bracket.len(), &q);
             (
                 curve,
@@ -274,7 +275,7 @@ fn calibrate(a: &CalibrateArgs) -> Result<()> {
     let plot = a.plot.clone().unwrap_or_else(|| a.out.with_extension("svg"));
     let svg = curve_plot_svg(&curve, &format!("Response curve ({method})")).context("plotting the curve")?;
     write(&plot, &svg)?;
-    println!("wrote {} and {}", a.out.display(), plot.display());
+    outln!("wrote {} and {}", a.out.display(), plot.display())?;
     verdicts::finish(&QualityReport::new(vec![quality], &q), &verdicts::beside(&a.out))
 }
 
@@ -318,13 +319,13 @@ fn merge_cmd(a: &MergeArgs) -> Result<()> {
     }
     write_radiance_exr(&map, &a.out).context("writing the radiance map")?;
     let invalid = map.mask.iter().filter(|&&m| m != 0).count();
-    println!(
+    outln!(
         "wrote {} ({}×{}, {} exposures; {invalid} pixels clipped in some channel in every exposure)",
         a.out.display(),
         map.width,
         map.height,
         bracket.len()
-    );
+    )?;
     let name = a
         .out
         .file_name()
@@ -344,10 +345,12 @@ fn lens(a: &LensArgs) -> Result<()> {
     if let Some(flat) = &a.flat {
         let img = read_rgb_exr(flat).with_context(|| format!("reading flat field {}", flat.display()))?;
         let (falloff, rms) = fit_falloff(&img).context("fitting the falloff")?;
-        println!(
+        outln!(
             "falloff: a = {:.6}, b = {:.6} (RMS relative residual {:.4})",
-            falloff.a, falloff.b, rms
-        );
+            falloff.a,
+            falloff.b,
+            rms
+        )?;
         model.falloff = falloff;
     }
     if let Some(pairs) = &a.pairs {
@@ -373,14 +376,14 @@ fn lens(a: &LensArgs) -> Result<()> {
             v.push((num(d)?, num(u)?));
         }
         model.distortion = fit_distortion(&v).context("fitting the distortion")?;
-        println!(
+        outln!(
             "distortion: a = {:.6}, b = {:.6} ({} pairs)",
             model.distortion.a,
             model.distortion.b,
             v.len()
-        );
+        )?;
     }
     write(&a.out, &model.to_text())?;
-    println!("wrote {}", a.out.display());
+    outln!("wrote {}", a.out.display())?;
     Ok(())
 }

@@ -86,7 +86,7 @@ pub struct Recovered {
 
 /// Loads `scene` and recovers its materials and albedo maps.
 pub fn recover_scene(scene: &Path, quick: bool) -> Result<Recovered> {
-    let loaded = load(scene).map_err(|e| anyhow!("{e}"))?;
+    let loaded = load(scene)?;
     let (opts, map_opts, _) = settings(quick);
     let result = recover(&loaded.input, &opts).map_err(|e| anyhow!("inverse global illumination: {e}"))?;
     let map = AlbedoMap::build(&loaded.input, &result, &map_opts).map_err(|e| anyhow!("albedo maps: {e}"))?;
@@ -255,9 +255,9 @@ pub fn write_material_files(
 pub fn write_products(r: &Recovered, out: &Path) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let table = format_table(&r.result, &[], None);
-    print!("{table}");
+    out!("{table}")?;
     for (n, t) in &r.loaded.triangulated {
-        println!(
+        outln!(
             "light {n:?} triangulated from {} images: position ({:.4}, {:.4}, {:.4}) m, radius {:.4} m, intensity {:.3?} W/sr, ray rms {:.2} mm",
             t.sightings.len(),
             t.light.position.x,
@@ -266,7 +266,7 @@ pub fn write_products(r: &Recovered, out: &Path) -> Result<()> {
             t.light.radius,
             t.light.intensity,
             t.ray_rms_m * 1e3
-        );
+        )?;
     }
     let materials = out.join("materials.txt");
     std::fs::write(&materials, &table).with_context(|| format!("writing {}", materials.display()))?;
@@ -277,13 +277,13 @@ pub fn write_products(r: &Recovered, out: &Path) -> Result<()> {
     let json = out.join("summary.json");
     std::fs::write(&json, serde_json::to_string_pretty(&summary(r, &albedo))?)
         .with_context(|| format!("writing {}", json.display()))?;
-    println!(
+    outln!(
         "wrote {}, materials.rad (RADIANCE), materials.xml (Mitsuba 3), {}, {} albedo maps under {}",
         materials.display(),
         json.display(),
         albedo.len(),
         out.join("albedo").display()
-    );
+    )?;
     Ok(())
 }
 
@@ -303,7 +303,7 @@ pub fn run(args: IgiArgs) -> Result<()> {
             let img = r.relight(&lights, &cam, args.quick)?;
             let path = args.out.join(format!("relit-{cam}.exr"));
             write_exr(&img, &path)?;
-            println!("relit {}", path.display());
+            outln!("relit {}", path.display())?;
         }
     }
     super::verdicts::finish(&quality, &args.out.join("quality.json"))

@@ -1,5 +1,7 @@
 //! Argument parsing and dispatch. One module per subcommand.
 
+#[macro_use]
+mod output;
 mod capture;
 mod config_check;
 mod demo;
@@ -9,6 +11,7 @@ pub mod exit;
 mod hdr;
 mod igi;
 mod logging;
+mod partial_file;
 mod plan;
 mod process;
 mod render;
@@ -103,8 +106,15 @@ pub enum Command {
 
 /// Prints an error chain and maps it to an exit code (see [`exit`]).
 fn report(result: anyhow::Result<()>) -> u8 {
+    finish(result.map(|()| EXIT_OK))
+}
+
+/// The exit code of a subcommand that chose its own, or the error's
+/// (printed). A closed standard output ends the output: exit 0, silently.
+fn finish(result: anyhow::Result<u8>) -> u8 {
     match result {
-        Ok(()) => EXIT_OK,
+        Ok(code) => code,
+        Err(e) if output::is_broken_pipe(&e) => EXIT_OK,
         Err(e) => {
             eprintln!("error: {e:#}");
             exit::code_of(&e)
@@ -124,17 +134,17 @@ pub fn run() -> ExitCode {
     };
     logging::init(&cli.logging);
     let code = match cli.command {
-        Command::Config { action } => config_check::run(action),
+        Command::Config { action } => finish(config_check::run(action)),
         Command::Hdr { action } => hdr::run(action),
         Command::Sun(args) => report(sun::run(args)),
         Command::Sky { action } => report(sky::run(action)),
         Command::Env { action } => report(env::run(action)),
-        Command::Plan { action } => plan::run(action),
-        Command::Capture(args) => capture::run(args),
-        Command::Station { action } => station::run(action),
+        Command::Plan { action } => finish(plan::run(action)),
+        Command::Capture(args) => finish(capture::run(args)),
+        Command::Station { action } => finish(station::run(action)),
         Command::Demo(args) => report(demo::run(args)),
         Command::Process(args) => report(process::run(args)),
-        Command::Devices(args) => devices::run(args),
+        Command::Devices(args) => finish(devices::run(args)),
         Command::Render(args) => report(render::run(args)),
         Command::Igi(args) => report(igi::run(args)),
     };

@@ -35,8 +35,11 @@ pub enum PlanCommand {
     ///
     /// The plan is first checked against the station as `config check` does.
     ///
-    /// Exit status: 0 when the plan is fully covered; 1 when something will
-    /// not be covered (or the --ron file cannot be written); 2 for bad input
+    /// Exit status: 0 when the plan is fully covered, or when all it will
+    /// not cover are warnings (a face never sunlit at its times: every shot
+    /// is taken, but that face's sun reflectance is not measured); 1 when
+    /// shots will be missed or late (or the --ron file cannot be written);
+    /// 2 for bad input
     /// (unreadable or invalid files, a plan that does not run on the station).
     ///
     /// Examples:
@@ -62,31 +65,28 @@ pub struct CheckArgs {
     ron: Option<PathBuf>,
 }
 
-pub fn run(cmd: PlanCommand) -> u8 {
+pub fn run(cmd: PlanCommand) -> Result<u8> {
     match cmd {
         PlanCommand::Check(args) => check(&args),
     }
 }
 
-fn check(args: &CheckArgs) -> u8 {
+fn check(args: &CheckArgs) -> Result<u8> {
     let (t, station, plan_name) = match simulate(args) {
         Ok(v) => v,
         Err(e) => {
             eprintln!("error: {e:#}");
-            return EXIT_USAGE;
+            return Ok(EXIT_USAGE);
         }
     };
-    if let Err(e) = print(&t, &station, &plan_name, args) {
-        eprintln!("error: {e:#}");
-        return EXIT_FAILURE;
-    }
+    print(&t, &station, &plan_name, args)?;
     if let Some(out) = &args.ron
         && let Err(e) = super::ron_output::write_ron(&t, Some(out))
     {
         eprintln!("error: {e:#}");
-        return EXIT_FAILURE;
+        return Ok(EXIT_FAILURE);
     }
-    if t.is_covered() { EXIT_OK } else { EXIT_FAILURE }
+    Ok(if t.is_covered() { EXIT_OK } else { EXIT_FAILURE })
 }
 
 fn simulate(args: &CheckArgs) -> Result<(Timeline, Station, String)> {
@@ -203,7 +203,12 @@ fn print(t: &Timeline, station: &Station, plan_name: &str, args: &CheckArgs) -> 
     } else {
         writeln!(out, "Will not cover ({})", t.uncovered.len())?;
         for u in &t.uncovered {
-            writeln!(out, "  - {u}")?;
+            let warning = if u.is_warning() {
+                " (a warning: every shot is still taken; exit status 0 if nothing else is listed)"
+            } else {
+                ""
+            };
+            writeln!(out, "  - {u}{warning}")?;
         }
     }
     Ok(())

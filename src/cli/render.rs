@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use campanile_process::camera::image::RadianceImage;
 use campanile_process::exr_io::{read_radiance_exr, read_rgb_exr, write_radiance_exr};
 use campanile_process::hdr::curve::ResponseCurve;
@@ -23,6 +23,8 @@ use campanile_sim::world::load_scene;
 use campanile_sim::world::rig::{mount, pinhole_at};
 use chrono::{DateTime, Duration, NaiveDate, Utc};
 use clap::Args;
+
+use super::exit::{bad_input, shown};
 use nalgebra::Vector3;
 
 /// Overcast zenith radiance per channel (W·m⁻²·sr⁻¹) blended in with --overcast.
@@ -140,7 +142,9 @@ pub struct RenderArgs {
 /// aim, with its own size and focal length.
 fn zoom_photo(path: &Path, rig: &CameraRig, focal_px: f64, time: DateTime<Utc>) -> Result<Photo> {
     if !(focal_px.is_finite() && focal_px > 0.0) {
-        bail!("--zoom-focal-px {focal_px}: expected a focal length > 0 pixels");
+        return Err(super::exit::bad_input(format!(
+            "--zoom-focal-px {focal_px}: expected a focal length > 0 pixels"
+        )));
     }
     let (image, mask) = match read_radiance_exr(path) {
         Ok(m) => {
@@ -163,7 +167,10 @@ fn zoom_photo(path: &Path, rig: &CameraRig, focal_px: f64, time: DateTime<Utc>) 
     };
     let (w, h) = (image.width, image.height);
     if w == 0 || h == 0 {
-        bail!("--zoom {}: the image is empty", path.display());
+        return Err(super::exit::bad_input(format!(
+            "--zoom {}: the image is empty",
+            path.display()
+        )));
     }
     let mut zrig = *rig;
     zrig.pinhole.principal_px = (w as f64 / 2.0, h as f64 / 2.0);
@@ -217,7 +224,7 @@ fn run_room(args: &RenderArgs, scene: &Path, lights: &Path) -> Result<()> {
         let img = r.relight(&lights, &cam, args.quick)?;
         let path = args.out.join(format!("relit-{cam}.exr"));
         write_exr(&img, &path)?;
-        println!("relit {}", path.display());
+        outln!("relit {}", path.display())?;
     }
     Ok(())
 }
@@ -229,20 +236,27 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let (Some(station_path), Some(scene_path), Some(materials_path), Some(pose_name)) =
         (&args.station, &args.scene, &args.materials, &args.pose)
     else {
-        bail!("give --scene, --station, --materials and --pose (or --igi and --lights for the room)");
+        return Err(super::exit::bad_input(
+            "give --scene, --station, --materials and --pose (or --igi and --lights for the room)",
+        ));
     };
     if !(0.0..=1.0).contains(&args.overcast) {
-        bail!("--overcast {} must be a fraction in [0, 1]", args.overcast);
+        return Err(bad_input(format!(
+            "--overcast: found {}; expected a fraction from 0 to 1",
+            shown(args.overcast)
+        )));
     }
-    if args.width == 0 || args.height == 0 || args.width * args.height > 4096 * 4096 {
-        bail!(
+    if !(1..=4096).contains(&args.width) || !(1..=4096).contains(&args.height) {
+        return Err(bad_input(format!(
             "--width {} --height {}: expected 1 to 4096 pixels each",
-            args.width,
-            args.height
-        );
+            args.width, args.height
+        )));
     }
     if !(args.step_min.is_finite() && args.step_min >= 1.0) {
-        bail!("--step-min {} must be at least 1 minute", args.step_min);
+        return Err(bad_input(format!(
+            "--step-min: found {}; expected at least 1 minute",
+            shown(args.step_min)
+        )));
     }
     let station = campanile_config::document::load_station(station_path)
         .map_err(|e| anyhow::anyhow!("{e}"))
@@ -302,7 +316,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             }
             out
         }
-        _ => bail!("give --time or --sequence"),
+        _ => return Err(super::exit::bad_input("give --time or --sequence")),
     };
     let curve = match &args.curve {
         Some(p) => {
@@ -315,10 +329,10 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let clear_day = |t: DateTime<Utc>| -> Result<(Daylight, f64)> {
         let sun = sun_position(t, &observer, site.delta_t_s).map_err(|e| anyhow::anyhow!("{e}"))?;
         if sun.elevation_rad() <= 0.0 {
-            bail!(
+            return Err(super::exit::bad_input(format!(
                 "the sun is below the horizon at {t} ({:.1}°): nothing to render in daylight",
                 sun.elevation_rad().to_degrees()
-            );
+            )));
         }
         Ok((
             Daylight::clear(sun.direction(), &Atmosphere::clear()),
@@ -333,11 +347,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
             let z = zoom_albedo(scene, &refl, &photo, &light, &ZoomSettings::default())
                 .map_err(|e| anyhow::anyhow!("{e}"))
                 .with_context(|| format!("--zoom {}", path.display()))?;
-            println!("zoom: {}", z.report);
+            outln!("zoom: {}", z.report)?;
             for (name, rho) in [("zoom-albedo-sun", &z.rho_sun), ("zoom-albedo-se", &z.rho_se)] {
                 let exr = args.out.join(format!("{name}.exr"));
                 write_exr(&albedo_image(rho, &z.rig), &exr)?;
-                println!("{}", exr.display());
+                outln!("{}", exr.display())?;
             }
             Some(z)
         }
@@ -362,12 +376,12 @@ pub fn run(args: RenderArgs) -> Result<()> {
         let stem = format!("{prefix}-{}", t.format("%Y%m%dT%H%M%SZ"));
         let exr = args.out.join(format!("{stem}.exr"));
         write_exr(&image, &exr)?;
-        println!(
+        outln!(
             "{}  sun elevation {:.1}°  {}",
             t.to_rfc3339(),
             elevation.to_degrees(),
             exr.display()
-        );
+        )?;
         if let Some(c) = &curve {
             let png = args.out.join(format!("{stem}.png"));
             write_png(&photograph(&image, c, args.shutter_s, args.scale), &png)

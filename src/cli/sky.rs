@@ -4,7 +4,7 @@ use std::fs::File;
 use std::io::{BufReader, Write};
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use campanile_process::exr_io::write_radiance_exr;
 use campanile_process::hdr::merge::RadianceMap;
 use campanile_process::quality::{ProductQuality, QualityReport, gates};
@@ -131,14 +131,19 @@ impl SunArgs {
     pub fn resolve_any(&self) -> Result<(f64, f64)> {
         match (self.sun_zenith_deg, self.sun_azimuth_deg, self.time, &self.station) {
             (Some(z), Some(a), _, _) if (0.0..=180.0).contains(&z) => Ok((z.to_radians(), a.to_radians())),
-            (Some(z), Some(_), _, _) => bail!("--sun-zenith-deg {z}: expected a zenith angle in [0, 180] degrees"),
+            (Some(z), Some(_), _, _) => Err(super::exit::bad_input(format!(
+                "--sun-zenith-deg: found {}; expected a zenith angle from 0 to 180 degrees",
+                super::exit::shown(z)
+            ))),
             (_, _, Some(t), Some(path)) => {
                 let s = super::site::station_site(path)?;
                 let obs = super::site::observer(&s);
                 let p = Ephemeris::at(t, s.delta_t_s)?.position(&obs)?;
                 Ok((p.zenith_rad, p.azimuth_rad))
             }
-            _ => bail!("give the sun: --sun-zenith-deg and --sun-azimuth-deg, or --time and --station"),
+            _ => Err(super::exit::bad_input(
+                "give the sun: --sun-zenith-deg and --sun-azimuth-deg, or --time and --station",
+            )),
         }
     }
 
@@ -146,10 +151,10 @@ impl SunArgs {
     fn resolve(&self) -> Result<(f64, f64)> {
         let (z, a) = self.resolve_any()?;
         if z > std::f64::consts::FRAC_PI_2 {
-            bail!(
+            return Err(super::exit::bad_input(format!(
                 "the sun is {:.2}° below the horizon then: no daylight sky to fit or predict",
                 (z - std::f64::consts::FRAC_PI_2).to_degrees()
-            );
+            )));
         }
         Ok((z, a))
     }
@@ -157,7 +162,7 @@ impl SunArgs {
 
 fn read_sky(path: &PathBuf) -> Result<SkyFile> {
     let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
-    ron::from_str(&text).map_err(|e| anyhow::anyhow!("{}:{}: {}", path.display(), e.span.start, e.code))
+    ron::from_str(&text).map_err(|e| super::exit::bad_input(format!("{}:{}: {}", path.display(), e.span.start, e.code)))
 }
 
 pub fn run(cmd: SkyCommand) -> Result<()> {
@@ -233,11 +238,11 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
             for (path, k) in skies.iter().zip(&known) {
                 let these: Vec<&str> = k.channels.iter().map(|c| c.channel.as_str()).collect();
                 if these != names {
-                    bail!(
+                    return Err(super::exit::bad_input(format!(
                         "{}: channels {these:?} differ from {}'s {names:?}",
                         path.display(),
                         skies[0].display()
-                    );
+                    )));
                 }
             }
             let sun_dir = direction(zs, az);
@@ -280,11 +285,11 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
         SkyCommand::Map { sky, out, width } => {
             let sky_file = read_sky(&sky)?;
             let [r, g, b] = sky_file.channels.as_slice() else {
-                bail!(
+                return Err(super::exit::bad_input(format!(
                     "{}: {} channels; a map needs exactly three (r, g, b)",
                     sky.display(),
                     sky_file.channels.len()
-                );
+                )));
             };
             let sun = direction(
                 sky_file.sun_zenith_deg.to_radians(),

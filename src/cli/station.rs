@@ -10,8 +10,8 @@ use campanile_capture::station::{SerialOpener, StationOptions as RigOptions, Sta
 use campanile_capture::store::{JournalEntry, SessionReader};
 use campanile_capture::unattended::day_rollover::existing_days;
 use campanile_capture::unattended::{
-    self, DeviceState, Heartbeat, NoProcessing, StationEnd, StationInputs, StationOptions, StationReport, StopHandle,
-    StorageBudget, parse_bytes,
+    self, DeviceState, Heartbeat, Liveness, NoProcessing, StationEnd, StationInputs, StationOptions, StationReport,
+    StopHandle, StorageBudget, parse_bytes,
 };
 use campanile_sim::faults::{Device, FaultPlan, Outage};
 use campanile_sim::station::{SimOptions, SimStation};
@@ -162,7 +162,11 @@ impl std::str::FromStr for StationOutageArg {
 /// Exit status: 0 when the heartbeat was written less than --max-age
 /// seconds ago (wall clock); 1 when it is older (stale: the station is not
 /// running, or stuck; a stopped or finished station is stale too) or
-/// cannot be read. A running station rewrites it at every frame and at
+/// cannot be read, and 1 at once when it says the station runs but its
+/// process does not (same host, and the PID is gone or is another process
+/// now: "not running (killed?)"). A heartbeat written on another host, or
+/// by an older version without host and start time, is judged by its age
+/// only. A running station rewrites it at every frame and at
 /// least every 60 s while it waits.
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
@@ -171,23 +175,23 @@ pub struct StatusArgs {
     #[arg(value_name = "DIR")]
     store: PathBuf,
     /// Stale beyond this many seconds.
-    #[arg(long, value_name = "SECONDS", default_value_t = 300.0)]
+    #[arg(long, value_name = "SECONDS", default_value_t = 300.0, allow_negative_numbers = true)]
     max_age: f64,
 }
 
-pub fn run(command: StationCommand) -> u8 {
+pub fn run(command: StationCommand) -> Result<u8> {
     match command {
         StationCommand::Run(args) => run_station(&args),
         StationCommand::Status(args) => status(&args),
     }
 }
 
-fn run_station(args: &RunArgs) -> u8 {
+fn run_station(args: &RunArgs) -> Result<u8> {
     let inputs = match Inputs::from_files(&args.plan, &args.station, args.days) {
         Ok(i) => i,
         Err(e) => {
             eprintln!("error: {e:#}");
-            return EXIT_USAGE;
+            return Ok(EXIT_USAGE);
         }
     };
     if !inputs.station.uses_simulation() && !args.sim_outage.is_empty() {
@@ -195,7 +199,7 @@ fn run_station(args: &RunArgs) -> u8 {
             "error: --sim-outage is for simulated stations; station {:?} ({}) has real devices",
             inputs.station.name, inputs.station_label
         );
-        return EXIT_USAGE;
+        return Ok(EXIT_USAGE);
     }
     let options = StationOptions {
         budget: args.budget.map(|max_bytes| StorageBudget { max_bytes }),
@@ -209,18 +213,18 @@ fn run_station(args: &RunArgs) -> u8 {
     };
     match result {
         Ok(Ok(report)) => {
-            summary(&args.store, &report, wall.elapsed());
-            EXIT_OK
+            summary(&args.store, &report, wall.elapsed())?;
+            Ok(EXIT_OK)
         }
         Ok(Err(failure)) => {
-            summary(&args.store, &failure.report, wall.elapsed());
+            summary(&args.store, &failure.report, wall.elapsed())?;
             eprintln!("error: {:#}", anyhow::Error::new(failure.error));
             eprintln!("continue with the same command once it is fixed");
-            EXIT_FAILURE
+            Ok(EXIT_FAILURE)
         }
         Err(e) => {
             eprintln!("error: {e:#}");
-            EXIT_FAILURE
+            Ok(EXIT_FAILURE)
         }
     }
 }
@@ -400,79 +404,91 @@ fn run_real(args: &RunArgs, inputs: &Inputs, options: &StationOptions) -> Result
     })
 }
 
-fn summary(store: &Path, r: &StationReport, wall: Duration) {
-    println!("store {}", store.display());
-    println!(
+fn summary(store: &Path, r: &StationReport, wall: Duration) -> Result<()> {
+    outln!("store {}", store.display())?;
+    outln!(
         "  ended                {}",
         match r.end {
             StationEnd::Finished => "every occurrence of the plan's days is settled",
             StationEnd::Stopped => "stopped on request (run the same command to continue)",
         }
-    );
+    )?;
     let days: Vec<String> = r.days.iter().map(|d| d.to_string()).collect();
-    println!("  day sessions         {}", days.join(", "));
-    println!(
+    outln!("  day sessions         {}", days.join(", "))?;
+    outln!(
         "  scans                {} run, {} settled earlier",
-        r.occurrences_run, r.occurrences_skipped
-    );
-    println!(
+        r.occurrences_run,
+        r.occurrences_skipped
+    )?;
+    outln!(
         "  this run             {} frames, {} missed, {} missed in outages, {} metering captures",
-        r.frames, r.missed, r.missed_in_outages, r.metering_captures
-    );
+        r.frames,
+        r.missed,
+        r.missed_in_outages,
+        r.metering_captures
+    )?;
     for o in &r.outages {
-        println!(
+        outln!(
             "  outage               {} from {} to {} ({:.1} min)",
             o.device,
             o.start.format("%Y-%m-%d %H:%M:%S UTC"),
             o.end.format("%Y-%m-%d %H:%M:%S UTC"),
             (o.end - o.start).num_seconds() as f64 / 60.0
-        );
+        )?;
     }
-    println!(
+    outln!(
         "  pruned               {} frames, {} bytes",
-        r.pruned_frames, r.pruned_bytes
-    );
-    println!("  wall time            {:.1} s", wall.as_secs_f64());
+        r.pruned_frames,
+        r.pruned_bytes
+    )?;
+    outln!("  wall time            {:.1} s", wall.as_secs_f64())?;
+    Ok(())
 }
 
-fn status(args: &StatusArgs) -> u8 {
+fn status(args: &StatusArgs) -> Result<u8> {
+    if !(args.max_age.is_finite() && args.max_age >= 0.0) {
+        return Err(super::exit::bad_input(format!(
+            "--max-age: found {}; expected a number of seconds, 0 or more",
+            super::exit::shown(args.max_age)
+        )));
+    }
     let beat = match Heartbeat::read(&args.store) {
         Ok(b) => b,
         Err(e) => {
             eprintln!("error: {e}");
-            return EXIT_FAILURE;
+            return Ok(EXIT_FAILURE);
         }
     };
     let age = beat.age_s(Utc::now());
     let t = |d: DateTime<Utc>| d.format("%Y-%m-%d %H:%M:%S UTC").to_string();
-    println!(
+    outln!(
         "station heartbeat {}",
         args.store.join(unattended::HEARTBEAT_FILE).display()
-    );
+    )?;
     let state = serde_json::to_value(beat.state)
         .ok()
         .and_then(|v| v.as_str().map(str::to_owned))
         .unwrap_or_default();
     if beat.detail.is_empty() {
-        println!("  state        {state}");
+        outln!("  state        {state}")?;
     } else {
-        println!("  state        {state}: {}", beat.detail);
+        outln!("  state        {state}: {}", beat.detail)?;
     }
-    println!(
+    outln!(
         "  written      {} station time; {age:.0} s ago on this computer's clock (pid {})",
         t(beat.written_utc),
         beat.pid
-    );
+    )?;
     match (&beat.last_frame_utc, &beat.last_frame_key) {
-        (Some(at), Some(key)) => println!("  last frame   {} {key}", t(*at)),
-        _ => println!("  last frame   none in this run"),
+        (Some(at), Some(key)) => outln!("  last frame   {} {key}", t(*at))?,
+        _ => outln!("  last frame   none in this run")?,
     }
     if let (Some(day), Some(dir)) = (beat.day, &beat.session_dir) {
-        println!(
+        outln!(
             "  today        {day}: {} frames in {}",
             beat.frames_today,
             dir.display()
-        );
+        )?;
     }
     for d in &beat.devices {
         let line = match &d.state {
@@ -482,24 +498,42 @@ fn status(args: &StatusArgs) -> u8 {
                 format!("DOWN since {} ({probes} failed probes): {error}", t(*since))
             }
         };
-        println!("  {:<12} {line}", d.device);
+        outln!("  {:<12} {line}", d.device)?;
     }
     let mb = |b: u64| format!("{:.1} MB", b as f64 / 1e6);
-    println!(
+    outln!(
         "  disk         {} free; the store holds {}{}",
         beat.free_disk_bytes.map_or("unknown".to_owned(), mb),
         mb(beat.store_bytes),
         beat.budget_bytes
             .map_or(String::new(), |b| format!(" of a {} budget", mb(b)))
-    );
+    )?;
+    // A station that ends on its own writes `stopped`, `finished` or
+    // `failed`; one whose heartbeat says it runs must still run.
+    let live = beat.liveness();
+    match &live {
+        Liveness::Running => outln!("  process      pid {} on this host: running", beat.pid)?,
+        Liveness::NotRunning(why) => outln!("  process      {why}")?,
+        Liveness::OtherHost(host) => outln!(
+            "  process      pid {} on host {host}, not this one: judged by the heartbeat's age only",
+            beat.pid
+        )?,
+        Liveness::Unknown(why) => outln!("  process      {why}; judged by the heartbeat's age only")?,
+    }
+    if beat.state.claims_running()
+        && let Liveness::NotRunning(why) = &live
+    {
+        outln!("not running (killed?): the heartbeat says {state}, but {why}")?;
+        return Ok(EXIT_FAILURE);
+    }
     if age > args.max_age {
-        println!(
+        outln!(
             "STALE: written {age:.0} s ago, more than --max-age {:.0} s: the station is not running or is stuck",
             args.max_age
-        );
-        EXIT_FAILURE
+        )?;
+        Ok(EXIT_FAILURE)
     } else {
-        println!("fresh: written {age:.0} s ago (--max-age {:.0} s)", args.max_age);
-        EXIT_OK
+        outln!("fresh: written {age:.0} s ago (--max-age {:.0} s)", args.max_age)?;
+        Ok(EXIT_OK)
     }
 }

@@ -1,10 +1,12 @@
 //! `campanile sun`: where the sun is, for one instant or a CSV table.
 
 use std::fs::File;
-use std::io::{BufReader, BufWriter, Write};
+use std::io::{BufReader, Write};
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
+
+use super::exit::{bad_input, shown};
 use campanile_process::sun::{Ephemeris, Observer, SolarDay, solar_day, sun_table};
 use chrono::{DateTime, Utc};
 use clap::Args;
@@ -46,7 +48,7 @@ pub struct SunArgs {
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     elevation_m: f64,
     /// Air pressure in millibars (for refraction).
-    #[arg(long, default_value_t = 1013.25)]
+    #[arg(long, default_value_t = 1013.25, allow_negative_numbers = true)]
     pressure_mbar: f64,
     /// Air temperature in °C (for refraction).
     #[arg(long, default_value_t = 12.0, allow_negative_numbers = true)]
@@ -69,14 +71,9 @@ pub fn run(args: SunArgs) -> Result<()> {
     if let Some(input) = &args.csv {
         let file = File::open(input).with_context(|| format!("{}: cannot open", input.display()))?;
         let n = match &args.out {
-            Some(out) => {
-                let tmp = out.with_extension("csv.partial");
-                let w =
-                    BufWriter::new(File::create(&tmp).with_context(|| format!("{}: cannot create", tmp.display()))?);
-                let n = sun_table(BufReader::new(file), w).with_context(|| format!("{}", input.display()))?;
-                std::fs::rename(&tmp, out).with_context(|| format!("{}: cannot write", out.display()))?;
-                n
-            }
+            Some(out) => super::partial_file::write_with(out, |w| {
+                sun_table(BufReader::new(file), w).with_context(|| format!("{}", input.display()))
+            })?,
             None => sun_table(BufReader::new(file), std::io::stdout().lock())
                 .with_context(|| format!("{}", input.display()))?,
         };
@@ -84,7 +81,7 @@ pub fn run(args: SunArgs) -> Result<()> {
         return Ok(());
     }
     let Some(time) = args.time else {
-        bail!("--time is required without --csv")
+        return Err(bad_input("--time is required without --csv"));
     };
     let (observer, delta_t, zone, site_name) = match (&args.station, args.lat, args.lon) {
         (Some(path), _, _) => {
@@ -93,12 +90,13 @@ pub fn run(args: SunArgs) -> Result<()> {
             (super::site::observer(&s), s.delta_t_s, zone, s.name)
         }
         (None, Some(lat), Some(lon)) => (
-            Observer::from_degrees(lat, lon, args.elevation_m, args.pressure_mbar, args.temperature_c),
+            check_site(&args)
+                .map(|()| Observer::from_degrees(lat, lon, args.elevation_m, args.pressure_mbar, args.temperature_c))?,
             args.delta_t_s,
             args.time_zone,
             format!("{lat}°, {lon}°"),
         ),
-        _ => bail!("give a site: --station FILE, or --lat and --lon"),
+        _ => return Err(bad_input("give a site: --station FILE, or --lat and --lon")),
     };
     let delta_t = args.delta_t_s.or(delta_t);
     let eph = Ephemeris::at(time, delta_t)?;
@@ -137,6 +135,50 @@ pub fn run(args: SunArgs) -> Result<()> {
         SolarDay::PolarDay { transit } => writeln!(out, "polar day       the sun stays up; transit {}", show(transit))?,
         SolarDay::PolarNight { transit } => {
             writeln!(out, "polar night     the sun stays down; transit {}", show(transit))?
+        }
+    }
+    Ok(())
+}
+
+/// The site's arguments against their domains (those of the NREL SPA).
+fn check_site(args: &SunArgs) -> Result<()> {
+    let checks = [
+        ("--lat", args.lat.unwrap_or(0.0), -90.0, 90.0, "degrees from -90 to 90"),
+        (
+            "--lon",
+            args.lon.unwrap_or(0.0),
+            -180.0,
+            180.0,
+            "degrees from -180 to 180",
+        ),
+        (
+            "--elevation-m",
+            args.elevation_m,
+            -6_500_000.0,
+            1e7,
+            "metres above sea level, -6500000 to 10000000",
+        ),
+        (
+            "--pressure-mbar",
+            args.pressure_mbar,
+            f64::MIN_POSITIVE,
+            2000.0,
+            "more than 0 and at most 2000 mbar",
+        ),
+        (
+            "--temperature-c",
+            args.temperature_c,
+            -273.0 + 1e-9,
+            100.0,
+            "more than -273 and at most 100 °C",
+        ),
+    ];
+    for (flag, value, low, high, expected) in checks {
+        if !(low..=high).contains(&value) {
+            return Err(bad_input(format!(
+                "{flag}: found {}; expected {expected}",
+                shown(value)
+            )));
         }
     }
     Ok(())

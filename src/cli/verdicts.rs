@@ -52,7 +52,7 @@ pub fn of_input(product: &Path) -> Result<Option<ProductQuality>> {
 /// a failed product into the error that exits 3.
 pub fn finish(report: &QualityReport, path: &Path) -> Result<()> {
     write(report, path)?;
-    println!("{}", report.summary_line());
+    outln!("{}", report.summary_line())?;
     gate(report, &path.display().to_string())
 }
 

@@ -167,6 +167,18 @@ impl fmt::Display for Uncovered {
     }
 }
 
+impl Uncovered {
+    /// A warning, not a fault of the plan: every shot is taken as planned,
+    /// but the products will lack something. A face never sunlit at the
+    /// plan's times (the north face of a tower on a short summer plan)
+    /// is one: its sun reflectance is not measured, and the processing
+    /// says so and fills it (sky-only environment regions, face ratios);
+    /// a plan cannot always avoid it.
+    pub fn is_warning(&self) -> bool {
+        matches!(self, Uncovered::FaceNeverSunlit { .. })
+    }
+}
+
 /// The plan simulated forward.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Timeline {
@@ -192,9 +204,10 @@ impl Timeline {
         self.occurrences.iter().map(|o| o.estimated_duration).sum()
     }
 
-    /// Whether everything is covered.
+    /// Whether everything is covered: nothing uncovered but warnings (see
+    /// [`Uncovered::is_warning`]).
     pub fn is_covered(&self) -> bool {
-        self.uncovered.is_empty()
+        self.uncovered.iter().all(Uncovered::is_warning)
     }
 }
 

@@ -20,7 +20,10 @@
 //!   "budget_bytes": 2000000,
 //!   "frames_today": 812,
 //!   "day": "2026-06-22",
-//!   "session_dir": "/data/sky/2026-06-22"
+//!   "session_dir": "/data/sky/2026-06-22",
+//!   "host": "station-1",                      who wrote it (see `super::liveness`);
+//!   "boot_id": "0c2f…",                       absent in older heartbeats
+//!   "start_ticks": 987654
 //! }
 //! ```
 //!
@@ -34,6 +37,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 use chrono::{DateTime, NaiveDate, Utc};
 use serde::{Deserialize, Serialize};
 
+use super::liveness::{Liveness, ProcessIdentity, liveness};
 use super::outage::{DeviceHealth, DeviceState};
 use crate::clock::Clock;
 use crate::controller::{Progress, ShotOutcome};
@@ -60,6 +64,17 @@ pub enum StationState {
     Finished,
     /// Stopped by an error (e.g. the disk is full); see `detail`.
     Failed,
+}
+
+impl StationState {
+    /// Whether a heartbeat in this state says that its writer runs
+    /// (starting, waiting, capturing or processing).
+    pub fn claims_running(self) -> bool {
+        matches!(
+            self,
+            Self::Starting | Self::Waiting | Self::Capturing | Self::Processing
+        )
+    }
 }
 
 /// One device's line in the heartbeat.
@@ -103,11 +118,21 @@ pub struct Heartbeat {
     pub day: Option<NaiveDate>,
     /// The current day's session directory.
     pub session_dir: Option<PathBuf>,
+    /// The writer's host name (absent in heartbeats of older versions).
+    #[serde(default)]
+    pub host: Option<String>,
+    /// The writer's host's boot id (absent when unknown).
+    #[serde(default)]
+    pub boot_id: Option<String>,
+    /// The writer's start time, clock ticks after boot (absent when unknown).
+    #[serde(default)]
+    pub start_ticks: Option<u64>,
 }
 
 impl Heartbeat {
     /// A first heartbeat: starting, nothing known.
     pub fn starting(now: DateTime<Utc>, budget_bytes: Option<u64>) -> Self {
+        let me = ProcessIdentity::of_self();
         Self {
             written_utc: now,
             wall_utc: Utc::now(),
@@ -123,7 +148,24 @@ impl Heartbeat {
             frames_today: 0,
             day: None,
             session_dir: None,
+            host: me.as_ref().map(|m| m.host.clone()),
+            boot_id: me.as_ref().and_then(|m| m.boot_id.clone()),
+            start_ticks: me.map(|m| m.start_ticks),
         }
+    }
+
+    /// Who wrote it, when the heartbeat says.
+    pub fn writer(&self) -> Option<ProcessIdentity> {
+        Some(ProcessIdentity {
+            host: self.host.clone()?,
+            boot_id: self.boot_id.clone(),
+            start_ticks: self.start_ticks?,
+        })
+    }
+
+    /// Whether its writer still runs (see [`super::liveness`]).
+    pub fn liveness(&self) -> Liveness {
+        liveness(self.pid, self.writer().as_ref())
     }
 
     /// Seconds between `wall_utc` and `now`.

@@ -27,6 +27,7 @@
 pub mod day_rollover;
 pub mod exposure_plan;
 pub mod heartbeat;
+pub mod liveness;
 pub mod outage;
 pub mod run;
 pub mod scan_hook;
@@ -36,6 +37,7 @@ pub mod supervision;
 
 pub use exposure_plan::{ExposureChoice, ExposureDamping, ExposurePlan};
 pub use heartbeat::{HEARTBEAT_FILE, Heartbeat, StationState};
+pub use liveness::Liveness;
 pub use outage::{DeviceHealth, DeviceState, EndedOutage};
 pub use run::{StationEnd, StationError, StationFailure, StationInputs, StationOptions, StationReport, run};
 pub use scan_hook::{NoProcessing, ScanHook};

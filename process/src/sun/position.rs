@@ -17,7 +17,7 @@ pub enum SunError {
         reason: String,
     },
     /// A site parameter is outside its domain.
-    #[error("site {field} = {value} is invalid: {reason}")]
+    #[error("site {field} = {}: {reason}", shown(*.value))]
     Site {
         /// Which parameter.
         field: &'static str,
@@ -26,6 +26,15 @@ pub enum SunError {
         /// Why.
         reason: String,
     },
+}
+
+/// A number as an error shows it: shortest form, scientific when huge or tiny.
+fn shown(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e15).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
 }
 
 /// Where the observer stands. Angles in radians, as everywhere inside the code.
@@ -69,10 +78,17 @@ impl Observer {
     }
 
     fn refraction(&self) -> Result<RefractionCorrection, SunError> {
-        RefractionCorrection::new(self.pressure_mbar, self.temperature_c).map_err(|e| SunError::Site {
-            field: "pressure_mbar/temperature_c",
-            value: self.pressure_mbar,
-            reason: e.to_string(),
+        RefractionCorrection::new(self.pressure_mbar, self.temperature_c).map_err(|e| {
+            let (field, value) = if self.pressure_mbar > 0.0 && self.pressure_mbar <= 2000.0 {
+                ("temperature_c", self.temperature_c)
+            } else {
+                ("pressure_mbar", self.pressure_mbar)
+            };
+            SunError::Site {
+                field,
+                value,
+                reason: e.to_string(),
+            }
         })
     }
 }
@@ -165,10 +181,20 @@ impl Ephemeris {
         let p = self
             .prepared
             .at(observer.location(), observer.elevation_m, refraction)
-            .map_err(|e| SunError::Site {
-                field: "latitude/longitude/elevation",
-                value: observer.latitude_rad.to_degrees(),
-                reason: e.to_string(),
+            .map_err(|e| {
+                let (lat, lon) = (observer.latitude_rad.to_degrees(), observer.longitude_rad.to_degrees());
+                let (field, value) = if !(-90.0..=90.0).contains(&lat) {
+                    ("latitude_deg", lat)
+                } else if !(-180.0..=180.0).contains(&lon) {
+                    ("longitude_deg", lon)
+                } else {
+                    ("elevation_m", observer.elevation_m)
+                };
+                SunError::Site {
+                    field,
+                    value,
+                    reason: e.to_string(),
+                }
             })?;
         Ok(SunPosition {
             zenith_rad: p.zenith_angle().to_radians(),

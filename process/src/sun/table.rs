@@ -85,17 +85,19 @@ pub enum SunTableError {
     /// The table or one of its cells.
     #[error(transparent)]
     Table(#[from] TableError),
-    /// The ephemeris refused a row.
-    #[error("row {row}: {source}")]
+    /// The ephemeris refused a row. (Its reason is in the message, not a
+    /// `source`, so that an error chain prints it once.)
+    #[error("row {row}: {reason}")]
     Sun {
         /// Row.
         row: u64,
         /// Why.
-        source: SunError,
+        reason: SunError,
     },
-    /// Writing failed.
-    #[error("cannot write the output: {0}")]
-    Write(String),
+    /// Writing failed; the `io::Error` is the source (printed by the chain;
+    /// a closed pipe is `BrokenPipe`, so a caller can tell it).
+    #[error("cannot write the output")]
+    Write(#[source] std::io::Error),
 }
 
 impl From<CellError> for SunTableError {
@@ -160,20 +162,20 @@ pub fn sun_table(input: impl Read, output: impl Write) -> Result<usize, SunTable
         out_header.push_field(h);
     }
     wr.write_record(&out_header)
-        .map_err(|e| SunTableError::Write(e.to_string()))?;
+        .map_err(|e| SunTableError::Write(e.into()))?;
     for (k, (rec, ans)) in rows.iter().zip(answers).enumerate() {
-        let a = ans.map_err(|source| SunTableError::Sun {
+        let a = ans.map_err(|reason| SunTableError::Sun {
             row: k as u64 + 2,
-            source,
+            reason,
         })?;
         let mut rec = rec.clone();
         rec.push_field(&format!("{:.7}", a.position.zenith_rad.to_degrees()));
         rec.push_field(&format!("{:.7}", a.position.azimuth_rad.to_degrees()));
         rec.push_field(&format!("{:.7}", a.position.elevation_rad().to_degrees()));
         rec.push_field(&format!("{:.10}", a.earth_sun_distance_au));
-        wr.write_record(&rec).map_err(|e| SunTableError::Write(e.to_string()))?;
+        wr.write_record(&rec).map_err(|e| SunTableError::Write(e.into()))?;
     }
-    wr.flush().map_err(|e| SunTableError::Write(e.to_string()))?;
+    wr.flush().map_err(SunTableError::Write)?;
     Ok(rows.len())
 }
 

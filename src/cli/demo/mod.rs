@@ -98,7 +98,7 @@ pub fn capture_simulated(plan: &Path, station: &Path, session: &Path, extra: &[&
     ];
     line.extend(extra.iter().map(std::ffi::OsStr::new));
     let line = CaptureLine::try_parse_from(line)?;
-    if super::capture::run(line.args) != super::EXIT_OK {
+    if super::capture::run(line.args)? != super::EXIT_OK {
         bail!(
             "the simulated capture of {} did not complete (see above)",
             plan.display()
@@ -116,6 +116,15 @@ pub fn run(args: DemoArgs) -> Result<()> {
             examples.display()
         );
     }
+    let session = args.out.join("campanile-session");
+    if args.reuse_session && !session.join("journal.jsonl").is_file() {
+        return Err(super::exit::bad_input(format!(
+            "--reuse-session: {} holds no captured session ({} is missing); run the demo once without \
+             --reuse-session to capture one",
+            args.out.display(),
+            session.join("journal.jsonl").display()
+        )));
+    }
     std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create", args.out.display()))?;
     let station = examples.join("sim-station.ron");
     let plan = examples.join(if args.quick {
@@ -126,7 +135,6 @@ pub fn run(args: DemoArgs) -> Result<()> {
     let scene = examples.join("campanile-scene.ron");
 
     // 1–2. Capture.
-    let session = args.out.join("campanile-session");
     eprintln!("capturing {} on the simulated station …", plan.display());
     let t = Instant::now();
     // Three bounces: the light the ground reflects onto shaded walls,
@@ -284,12 +292,12 @@ pub fn run(args: DemoArgs) -> Result<()> {
     };
     let path = args.out.join("report.html");
     process::write_report(&report, &path)?;
-    println!(
+    outln!(
         "demo finished in {:.1} s: {} ({} figures)",
         wall.elapsed().as_secs_f64(),
         path.display(),
         report.figure_count()
-    );
+    )?;
     crate::cli::verdicts::finish(&quality, &args.out.join("quality.json"))
 }
 

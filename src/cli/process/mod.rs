@@ -196,14 +196,14 @@ fn run_room(args: &ProcessArgs, out: &Path, debevec: &DebevecOptions) -> Result<
         sections,
     };
     write_report(&report, &out.join("report.html"))?;
-    println!(
+    outln!(
         "processed {} → {} (scene file {})",
         args.session.display(),
         out.display(),
         products.scene_file.display()
-    );
+    )?;
     for (stage, s) in processed.summary.stage_seconds.iter().chain(&products.seconds) {
-        println!("  {stage:<44} {s:>7.2} s");
+        outln!("  {stage:<44} {s:>7.2} s")?;
     }
     verdicts::finish(&quality, &out.join("quality.json"))
 }
@@ -275,10 +275,10 @@ pub fn run(args: ProcessArgs) -> Result<()> {
         return run_sky_series(&args, out, debevec, &q);
     }
     if args.response.is_some() || args.shard.is_some() || args.merge_shards.is_some() || args.occurrence.is_some() {
-        anyhow::bail!(
+        return Err(super::exit::bad_input(format!(
             "{}: --response, --shard, --merge-shards and --occurrence are for sky-only sessions (sun shots, sky scans and brackets at head angles); this session's plan has views of a scene",
             args.session.display()
-        );
+        )));
     }
     let room = room::is_room_session(&inputs.plan);
     drop(inputs);
@@ -310,14 +310,14 @@ pub fn run(args: ProcessArgs) -> Result<()> {
             sections.push(speed);
         }
         for v in &o.products.held_out {
-            println!(
+            outln!(
                 "  held out {:<32} relative RMSE {:.2}% per pixel, {:.2}% per 4×4 block ({} training photos' texture; grid alone {:.2}%)",
                 v.label,
                 100.0 * v.rmse_pixel,
                 100.0 * v.rmse_block,
                 v.references,
                 100.0 * v.rmse_block_grid
-            );
+            )?;
         }
     }
     let mut quality = processed.quality.clone();
@@ -336,9 +336,9 @@ pub fn run(args: ProcessArgs) -> Result<()> {
         sections,
     };
     write_report(&report, &out.join("report.html"))?;
-    println!("processed {} → {}", args.session.display(), out.display());
+    outln!("processed {} → {}", args.session.display(), out.display())?;
     for (stage, s) in &processed.summary.stage_seconds {
-        println!("  {stage:<28} {s:>7.2} s");
+        outln!("  {stage:<28} {s:>7.2} s")?;
     }
     for o in &processed.summary.occurrences {
         let sky = o.sky.as_ref().map_or("no sky".to_owned(), |s| {
@@ -351,9 +351,9 @@ pub fn run(args: ProcessArgs) -> Result<()> {
         let sun = o.sun_irradiance.map_or("no sun".to_owned(), |e| {
             format!("sun {:.0}/{:.0}/{:.0} W·m⁻²", e[0], e[1], e[2])
         });
-        println!("  {:<28} {sun}; {sky}", o.occurrence);
+        outln!("  {:<28} {sun}; {sky}", o.occurrence)?;
         for n in &o.notes {
-            println!("    note: {n}");
+            outln!("    note: {n}")?;
         }
     }
     verdicts::finish(&quality, &out.join("quality.json"))
@@ -397,22 +397,22 @@ fn run_sky_series(args: &ProcessArgs, out: PathBuf, debevec: DebevecOptions, q: 
     std::fs::create_dir_all(&out).with_context(|| format!("{}: cannot create", out.display()))?;
     if let Some(occurrence) = &args.occurrence {
         let scan = sky_series::process_scan(&args.session, occurrence, &opts)?;
-        println!(
+        outln!(
             "processed {occurrence} → {}: flags [{}]",
             campanile_process::sky_series::scan_path(&out, occurrence).display(),
             scan.quality.names()
-        );
+        )?;
     }
     let (series, run) = match &args.merge_shards {
         _ if args.occurrence.is_some() => (sky_series::recompute_day(&out)?, None),
         Some(dirs) => {
             let (copied, series) = sky_series::merge_shards(&args.session, dirs, &opts)?;
-            println!(
+            outln!(
                 "merged {} shard directories ({copied} scan files copied): {} scans in {}",
                 dirs.len(),
                 series.scans.len(),
                 out.display()
-            );
+            )?;
             (series, None)
         }
         None => {
@@ -422,21 +422,21 @@ fn run_sky_series(args: &ProcessArgs, out: PathBuf, debevec: DebevecOptions, q: 
             } else {
                 0.0
             };
-            println!(
+            outln!(
                 "sky series {} → {}{}",
                 args.session.display(),
                 out.display(),
                 args.shard.map_or(String::new(), |s| format!(" (shard {s})"))
-            );
-            println!(
+            )?;
+            outln!(
                 "  processed {} scans in {:.2} s ({rate:.2} scans/s); {} already done, {} in other shards, {} still being captured",
                 run.processed.len(),
                 run.scan_seconds,
                 run.already_done,
                 run.other_shards,
                 run.incomplete.len()
-            );
-            println!("  response: {}", run.response);
+            )?;
+            outln!("  response: {}", run.response)?;
             (run.series.clone(), Some(run))
         }
     };
@@ -449,16 +449,16 @@ fn run_sky_series(args: &ProcessArgs, out: PathBuf, debevec: DebevecOptions, q: 
                     .map_or_else(|e| format!("none ({e})"), |e| format!("{:.4}", e.beta))
             })
             .collect();
-        println!(
+        outln!(
             "  {}: β r/g/b {} from {} scans ({} left out)",
             d.date,
             beta.join(" / "),
             d.points.len(),
             d.left_out
-        );
+        )?;
     }
     let flagged = series.scans.iter().filter(|s| !s.quality.names().is_empty()).count();
-    println!("  {} scans in the series, {flagged} flagged", series.scans.len());
+    outln!("  {} scans in the series, {flagged} flagged", series.scans.len())?;
     // With --occurrence, the verdicts (and the exit status) are that scan's;
     // otherwise the whole series'.
     let judged = series
@@ -749,9 +749,7 @@ pub fn outdoor_sections(
 
 /// Writes a report page (through a temporary file).
 pub fn write_report(report: &Report, path: &Path) -> Result<()> {
-    let tmp = path.with_extension("html.partial");
-    std::fs::write(&tmp, report.to_html()).with_context(|| format!("{}: cannot write", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot write", path.display()))
+    super::partial_file::write(path, report.to_html().as_bytes())
 }
 
 /// The sky fits of an occurrence as a sky file.
@@ -780,11 +778,7 @@ pub fn write_outputs(p: &Processed, out: &Path) -> Result<()> {
     mkdir(out)?;
     mkdir(&out.join("radiance"))?;
     mkdir(&out.join("light"))?;
-    let write = |path: PathBuf, bytes: &[u8]| -> Result<()> {
-        let tmp = path.with_extension("partial");
-        std::fs::write(&tmp, bytes).with_context(|| format!("{}: cannot write", tmp.display()))?;
-        std::fs::rename(&tmp, &path).with_context(|| format!("{}: cannot write", path.display()))
-    };
+    let write = |path: PathBuf, bytes: &[u8]| super::partial_file::write(&path, bytes);
     write(
         out.join("response.csv"),
         p.calibration.curve.to_csv(&p.calibration.method).as_bytes(),

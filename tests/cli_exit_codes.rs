@@ -1,0 +1,330 @@
+//! Exit statuses, pinned for every command: 2 for every bad input (an
+//! argument, a value, a configuration or input file), 1 for a failure
+//! while working, 0 for success. Also: numbers in errors are short, and a
+//! failed `--out` leaves no `.partial` file.
+
+mod common;
+
+use std::path::Path;
+
+use common::campanile;
+
+/// (arguments, expected exit status, a piece of the expected message on stderr).
+type Case = (Vec<String>, i32, &'static str);
+
+fn case(args: &[&str], code: i32, says: &'static str) -> Case {
+    (args.iter().map(|s| (*s).to_owned()).collect(), code, says)
+}
+
+fn files(dir: &Path) {
+    let write = |name: &str, text: &str| std::fs::write(dir.join(name), text).expect("write");
+    write("bad-sky.csv", "zenith_deg,azimuth_deg,r,g,b\n10,20,abc,1,1\n");
+    write("bad-env.csv", "region,r\nx,1\n");
+    write("bad.ron", "SkyFile(\n");
+    write(
+        "times.csv",
+        "time_utc,latitude_deg,longitude_deg\n2026-08-28T20:00:00Z,37.87,-122.26\n",
+    );
+    write(
+        "bad-times.csv",
+        "time_utc,latitude_deg,longitude_deg\n2026-08-28T20:00:00Z,37.87,-122.26\n2026-08-28T20:00:00Z,95,0\n",
+    );
+    std::fs::create_dir_all(dir.join("not-a-session")).expect("mkdir");
+    std::fs::create_dir_all(dir.join("unrelated")).expect("mkdir");
+    write("unrelated/notes.txt", "mine\n");
+}
+
+#[test]
+fn every_command_exits_2_on_bad_input_1_on_failure_and_0_on_success() {
+    let tmp = tempfile::tempdir().expect("temp");
+    let t = tmp.path();
+    files(t);
+    let p = |name: &str| t.join(name).display().to_string();
+    let (bad_sky, bad_env, bad_ron, times, bad_times) = (
+        p("bad-sky.csv"),
+        p("bad-env.csv"),
+        p("bad.ron"),
+        p("times.csv"),
+        p("bad-times.csv"),
+    );
+    let (missing, not_session, unrelated) = (p("no-such-file.ron"), p("not-a-session"), p("unrelated"));
+    let now = "2026-08-28T20:00:00Z";
+    let cases: Vec<Case> = vec![
+        // Bad input: 2.
+        case(&["frobnicate"], 2, "unrecognized subcommand"),
+        case(
+            &["config", "check", "config/tests/malformed/latitude-out-of-range.ron"],
+            2,
+            "found 95",
+        ),
+        case(
+            &["plan", "check", &missing, "--station", "examples/sim-station.ron"],
+            2,
+            "cannot read",
+        ),
+        case(
+            &["hdr", "calibrate", &missing, "--times", "1", "--out", &p("c.csv")],
+            2,
+            "No such file",
+        ),
+        case(
+            &[
+                "hdr",
+                "merge",
+                &missing,
+                "--times",
+                "1",
+                "--curve",
+                &missing,
+                "--out",
+                &p("m.exr"),
+            ],
+            2,
+            "No such file",
+        ),
+        case(
+            &["hdr", "lens", "--flat", &missing, "--out", &p("l.txt")],
+            2,
+            "No such file",
+        ),
+        case(
+            &["sun", "--lat", "95", "--lon", "0", "--time", now],
+            2,
+            "--lat: found 95; expected degrees from -90 to 90",
+        ),
+        case(
+            &["sun", "--lat", "1e308", "--lon", "0", "--time", now],
+            2,
+            "--lat: found 1e308;",
+        ),
+        case(
+            &[
+                "sun",
+                "--lat",
+                "30",
+                "--lon",
+                "0",
+                "--pressure-mbar",
+                "-5",
+                "--time",
+                now,
+            ],
+            2,
+            "--pressure-mbar: found -5; expected more than 0 and at most 2000 mbar",
+        ),
+        case(&["sun", "--csv", &bad_times], 2, "row 3"),
+        case(
+            &[
+                "sky",
+                "fit",
+                &bad_sky,
+                "--sun-zenith-deg",
+                "40",
+                "--sun-azimuth-deg",
+                "10",
+            ],
+            2,
+            "found \"abc\"",
+        ),
+        case(
+            &[
+                "sky",
+                "predict",
+                &missing,
+                "--sun-zenith-deg",
+                "40",
+                "--sun-azimuth-deg",
+                "10",
+            ],
+            2,
+            "cannot read",
+        ),
+        case(&["sky", "eval", &bad_ron, &times], 2, "bad.ron:"),
+        case(&["sky", "map", &missing, "--out", &p("m.exr")], 2, "cannot read"),
+        case(&["env", "fit", &bad_env], 2, "no `g` column"),
+        case(
+            &[
+                "env",
+                "predict",
+                &missing,
+                "--sky-irradiance",
+                "1,1,1",
+                "--sun-irradiance",
+                "1,1,1",
+                "--sun-zenith-deg",
+                "10",
+                "--sun-azimuth-deg",
+                "10",
+            ],
+            2,
+            "cannot read",
+        ),
+        case(&["igi", &missing, "--out", &p("igi")], 2, "no-such-file.ron"),
+        case(
+            &[
+                "capture",
+                &missing,
+                "--station",
+                "examples/sim-station.ron",
+                "--out",
+                &p("s"),
+            ],
+            2,
+            "cannot read",
+        ),
+        case(
+            &[
+                "station",
+                "run",
+                &missing,
+                "--station",
+                "examples/sky-sim-station.ron",
+                "--store",
+                &p("store"),
+            ],
+            2,
+            "cannot read",
+        ),
+        case(
+            &["station", "status", &unrelated, "--max-age", "-5"],
+            2,
+            "--max-age: found -5",
+        ),
+        case(&["process", &p("no-such-session")], 2, "no-such-session"),
+        case(&["process", &not_session], 2, "is not a session directory"),
+        case(&["devices", "test", "--station", &missing], 2, "cannot read"),
+        case(
+            &[
+                "devices",
+                "test",
+                "--station",
+                "examples/sim-station.ron",
+                "--move-limit-s",
+                "0",
+            ],
+            2,
+            "--move-limit-s",
+        ),
+        case(
+            &[
+                "render",
+                "--scene",
+                "examples/campanile-scene.ron",
+                "--station",
+                "examples/sim-station.ron",
+                "--materials",
+                &missing,
+                "--pose",
+                "view-se",
+                "--time",
+                now,
+                "--overcast",
+                "150",
+                "--out",
+                &p("r.png"),
+            ],
+            2,
+            "--overcast: found 150; expected a fraction from 0 to 1",
+        ),
+        case(
+            &[
+                "render",
+                "--scene",
+                "examples/campanile-scene.ron",
+                "--station",
+                "examples/sim-station.ron",
+                "--materials",
+                &missing,
+                "--pose",
+                "view-se",
+                "--time",
+                now,
+                "--width",
+                "0",
+                "--out",
+                &p("r.png"),
+            ],
+            2,
+            "--width 0",
+        ),
+        case(
+            &["demo", "--reuse-session", "--out", &unrelated],
+            2,
+            "campanile-session/journal.jsonl is missing",
+        ),
+        // A failure while working: 1 (/sys is read-only).
+        case(
+            &["sun", "--csv", &times, "--out", "/sys/campanile-positions.csv"],
+            1,
+            "/sys/campanile-positions.csv",
+        ),
+        case(
+            &[
+                "plan",
+                "check",
+                "examples/campanile-day.ron",
+                "--station",
+                "examples/sim-station.ron",
+                "--ron",
+                "/sys/timeline.ron",
+            ],
+            1,
+            "/sys/timeline.ron",
+        ),
+        case(&["station", "status", &unrelated], 1, "heartbeat.json"),
+        // Success: 0.
+        case(&["sun", "--lat", "37.87", "--lon", "-122.26", "--time", now], 0, ""),
+        case(&["sun", "--csv", &times, "--out", &p("positions.csv")], 0, ""),
+        case(&["config", "check", "examples/sim-station.ron"], 0, ""),
+    ];
+    let mut wrong = Vec::new();
+    for (args, code, says) in &cases {
+        let out = campanile(&args.iter().map(String::as_str).collect::<Vec<_>>());
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        if out.status.code() != Some(*code) || !stderr.contains(says) || stderr.contains("panicked") {
+            wrong.push(format!(
+                "campanile {}: exit {:?}, expected {code} with {says:?}\n{}",
+                args.join(" "),
+                out.status.code(),
+                stderr.chars().take(600).collect::<String>()
+            ));
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "{} of {} cases wrong:\n{}",
+        wrong.len(),
+        cases.len(),
+        wrong.join("\n")
+    );
+    // Nothing was written into the unrelated directory.
+    assert_eq!(std::fs::read_dir(&unrelated).expect("dir").count(), 1);
+}
+
+#[test]
+fn a_failed_out_leaves_no_partial_file() {
+    let tmp = tempfile::tempdir().expect("temp");
+    files(tmp.path());
+    let out_csv = tmp.path().join("positions.csv");
+    let out = campanile(&[
+        "sun",
+        "--csv",
+        tmp.path().join("bad-times.csv").to_str().expect("utf-8"),
+        "--out",
+        out_csv.to_str().expect("utf-8"),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    // The row's reason once, not twice (message and source).
+    assert_eq!(stderr.matches("invalid latitude 95").count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("row 3: site latitude_deg = 95: invalid latitude 95"),
+        "{stderr}"
+    );
+    let left: Vec<String> = std::fs::read_dir(tmp.path())
+        .expect("dir")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("positions"))
+        .collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+}
