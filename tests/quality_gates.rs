@@ -28,9 +28,16 @@ fn a_session_that_lost_half_its_calibration_bracket_exits_3_and_names_the_respon
         "--sim-camera-error-chance",
         "0.05",
     ]);
-    // The capture itself completes (missed shots are journaled, not fatal).
+    // The capture goes on past its faults: the shots it missed are
+    // journaled (171 of 243 with this seed), half the calibration bracket
+    // among them.
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.code().is_some(), "{text}");
+    let missed: usize = text
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("shots missed"))
+        .and_then(|n| n.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no 'shots missed' line: {text}"));
+    assert!(missed > 0, "{text}");
 
     let processed = tmp.path().join("processed");
     let out = campanile(&[

@@ -3,7 +3,7 @@
 use base64::Engine as _;
 use base64::engine::general_purpose::STANDARD;
 
-use crate::quality::{QualityReport, Verdict};
+use crate::quality::{ProductQuality, QualityReport, Verdict};
 
 /// A figure: an inline image with a caption.
 #[derive(Debug, Clone, PartialEq)]
@@ -98,17 +98,36 @@ fn banner(q: &QualityReport) -> String {
         "<div class=\"quality {}\" id=\"quality\"><strong>Quality: {}</strong> ({} ok, {} poor, {} failed; every figure and threshold in quality.json)",
         q.verdict, q.verdict, c.ok, c.poor, c.failed
     );
+    let item = |verdict: Verdict, p: &ProductQuality| {
+        format!(
+            "<li><b>{verdict}</b> {}: {}</li>",
+            escape(&p.product),
+            escape(&p.reasons())
+        )
+    };
     for verdict in [Verdict::Failed, Verdict::Poor] {
-        let items: Vec<String> = q
-            .with(verdict)
-            .map(|p| {
-                format!(
-                    "<li><b>{verdict}</b> {}: {}</li>",
-                    escape(&p.product),
-                    escape(&p.reasons())
-                )
-            })
-            .collect();
+        // Those that are so by their own figures, then one line for those
+        // that only inherited it (they can be many: every map of a curve).
+        let (own, inherited): (Vec<&ProductQuality>, Vec<&ProductQuality>) =
+            q.with(verdict).partition(|p| p.own_verdict == verdict);
+        let mut items: Vec<String> = own.iter().map(|p| item(verdict, p)).collect();
+        match inherited.as_slice() {
+            [] => {}
+            [p] => items.push(item(verdict, p)),
+            many => {
+                let mut from: Vec<&str> = many
+                    .iter()
+                    .flat_map(|p| p.inherited.iter().map(String::as_str))
+                    .collect();
+                from.sort_unstable();
+                from.dedup();
+                items.push(format!(
+                    "<li><b>{verdict}</b> {} more products, through what they inherited from {}</li>",
+                    many.len(),
+                    escape(&from.join(", "))
+                ));
+            }
+        }
         if !items.is_empty() {
             h.push_str(&format!("<ul>{}</ul>", items.join("")));
         }
@@ -238,15 +257,29 @@ mod tests {
             vec![Check::new("triplet spread", 0.05, Gate::new(0.03, 0.15), Better::Lower)],
         );
         let ok = ProductQuality::new("sky s@1", vec![]);
+        let heirs: Vec<ProductQuality> = (0..2)
+            .map(|k| {
+                let mut p = ProductQuality::new(format!("radiance m{k}"), vec![]);
+                p.inherit(&failed);
+                p
+            })
+            .collect();
+        let mut products = vec![failed, poor, ok];
+        products.extend(heirs);
         let r = Report {
             title: "t".into(),
-            quality: Some(QualityReport::new(vec![failed, poor, ok], &Quality::default())),
+            quality: Some(QualityReport::new(products, &Quality::default())),
             ..Report::default()
         };
         let html = r.to_html();
         let banner = &html[html.find("<div class=\"quality failed\"").expect("a failed banner")..];
         let banner = &banner[..banner.find("</div>").unwrap()];
-        assert!(banner.contains("1 ok, 1 poor, 1 failed"), "{banner}");
+        assert!(banner.contains("1 ok, 1 poor, 3 failed"), "{banner}");
+        assert!(
+            banner
+                .contains("<li><b>failed</b> 2 more products, through what they inherited from response: failed</li>"),
+            "{banner}"
+        );
         assert!(
             banner.contains("<li><b>failed</b> response: condition estimate 1.2e9 &gt; 1e8</li>"),
             "{banner}"
