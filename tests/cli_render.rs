@@ -195,8 +195,12 @@ fn a_sequence_runs_from_sunrise_to_sunset_and_bad_input_is_named() {
         "--out",
         out.to_str().unwrap(),
     ]);
-    assert!(!o.status.success());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("--overcast 1.5"));
+    assert_eq!(o.status.code(), Some(2), "bad input exits 2");
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("--overcast: found 1.5; expected a fraction from 0 to 1"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 }
 
 /// `render --zoom`: a zoom photo of the grey tower with a checkerboard of
