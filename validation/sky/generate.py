@@ -362,7 +362,7 @@ def make_gendaylit(env, spec, dirs_deg, outdir):
     pts = kept(dirs_deg, sun)
     row = {"id": sid, "source": "gendaylit", "bin": bin_of(eps["g"]), "cie_type": "",
            "sun_zenith_deg": fmt(round(90.0 - el_eff, 6)), "sun_azimuth_deg": fmt(az), "n_samples": len(pts)}
-    cols, warns, max_blend, nonpos = {}, [], 0.0, 0
+    cols, warns, max_blend, nonpos, refused = {}, [], 0.0, 0, []
     with tempfile.TemporaryDirectory() as tmp:
         for ch in CHANNELS:
             text, args, warn = gendaylit(env, el_eff, az_rad, eps[ch], dls[ch])
@@ -373,8 +373,11 @@ def make_gendaylit(env, spec, dirs_deg, outdir):
                 warns.append(f"{ch}: {warn}")
             if args[0] == 0 and all(v == 0 for v in args[1:7]):
                 # gendaylit's "error sky": all coefficients zero, a black sky.
-                return None, {"id": sid, "channel": ch, "eps": fmt(eps[ch]), "delta": fmt(dls[ch]),
-                              "sun_elevation_deg": fmt(el_eff), "sun_azimuth_deg": fmt(az), "reason": warn}
+                refused.append({"id": sid, "channel": ch, "eps": fmt(eps[ch]), "delta": fmt(dls[ch]),
+                                "sun_elevation_deg": fmt(el_eff), "sun_azimuth_deg": fmt(az), "reason": warn})
+                continue
+            if refused:
+                continue
             vals = rtrace(env, text, [p[2] for p in pts], tmp)
             cols[ch] = vals
             nonpos += sum(1 for v in vals if float(v) <= 0)
@@ -389,6 +392,8 @@ def make_gendaylit(env, spec, dirs_deg, outdir):
                         f"delta_eff_{ch}": fmt(effective_delta(eps[ch], dls[ch]))})
             for k, v in zip(["norm", "ground", "a", "b", "c", "d", "e"], args[:7]):
                 row[f"{k}_{ch}"] = fmt(v)
+    if refused:
+        return None, refused
     row["max_blend"] = f"{max_blend:.6e}"
     row["n_nonpositive"] = nonpos
     row["warnings"] = " | ".join(warns)
@@ -396,7 +401,7 @@ def make_gendaylit(env, spec, dirs_deg, outdir):
         f.write("zenith_deg,azimuth_deg,r,g,b\n")
         for i, (zen, az_, _) in enumerate(pts):
             f.write(f"{fmt(zen)},{fmt(az_)},{cols['r'][i]},{cols['g'][i]},{cols['b'][i]}\n")
-    return row, None
+    return row, []
 
 
 def make_cie(spec, dirs_deg, outdir):
@@ -434,7 +439,7 @@ def main():
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as ex:
         made = list(ex.map(lambda s: make_gendaylit(env, s, dirs_deg, out), gspecs))
     rows = [r for r, _ in made if r is not None]
-    refused = [x for _, x in made if x is not None]
+    refused = [x for _, xs in made for x in xs]
     with open(os.path.join(out, "refused.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=REFUSED, lineterminator="\n")
         w.writeheader()
@@ -445,9 +450,9 @@ def main():
         w.writeheader()
         for r in rows:
             w.writerow(r)
-    n_gdl = len(gspecs) - len(refused)
+    n_gdl = sum(1 for r, _ in made if r is not None)
     print(f"generate.py: {len(rows)} skies ({n_gdl} gendaylit, {len(rows) - n_gdl} CIE; "
-          f"{len(refused)} refused by gendaylit, listed in refused.csv), "
+          f"{len(gspecs) - n_gdl} refused by gendaylit in {len(refused)} channels, listed in refused.csv), "
           f"{len(dirs_deg)} grid directions, into {out}")
 
 
