@@ -44,8 +44,14 @@ def quantile(v, q):
 
 
 def read_csv(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(f))
+    except OSError as e:
+        fail(f"campanile_fit.py: {path}: cannot read ({e})")
+    if not rows:
+        fail(f"campanile_fit.py: {path}: no rows")
+    return rows
 
 
 def fit_sky(exe, d, sky, tmp):
@@ -68,6 +74,12 @@ def fit_sky(exe, d, sky, tmp):
     return (fitted, chosen, masked), wall, p.returncode, []
 
 
+def fail(msg):
+    """Bad input or usage: the message on standard error, exit status 2."""
+    print(msg, file=sys.stderr)
+    sys.exit(2)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("dir")
@@ -76,7 +88,7 @@ def main():
     ap.add_argument("--per-sky", action="store_true")
     args = ap.parse_args()
     if not os.access(args.campanile, os.X_OK):
-        sys.exit(f"campanile_fit.py: --campanile {args.campanile}: not an executable file")
+        fail(f"campanile_fit.py: --campanile {args.campanile}: not an executable file")
     skies = read_csv(os.path.join(args.dir, "manifest.csv"))
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -87,7 +99,10 @@ def main():
             for ch in chans:
                 row = {"id": sky["id"], "source": sky["source"], "bin": sky["bin"], "cie_type": sky["cie_type"],
                        "channel": ch, "n": len(samples), "exit": code, "time_ms": 1e3 * wall / len(chans)}
-                y = [float(s[ch]) for s in samples]
+                try:
+                    y = [float(s[ch]) for s in samples]
+                except (TypeError, ValueError) as e:
+                    fail(f"campanile_fit.py: {sky['id']}.csv column {ch}: expected numbers ({e})")
                 if res is None:
                     row.update(status="error", note=" ".join(msg))
                 elif min(y) <= 0:

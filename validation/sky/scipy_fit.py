@@ -133,21 +133,39 @@ def load_starts(path):
             try:
                 out[(r["id"], r["channel"])] = [float(r[k]) for k in NAMES]
             except (KeyError, ValueError) as e:
-                sys.exit(f"scipy_fit.py: {path} line {i}: needs numbers in columns {', '.join(NAMES)} ({e})")
+                fail(f"scipy_fit.py: {path} line {i}: needs numbers in columns {', '.join(NAMES)} ({e})")
     return out
 
 
 def read_samples(path):
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))
-    head = rows[0]
-    data = np.array(rows[1:], dtype=float)
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.reader(f))
+        head = rows[0]
+        data = np.array(rows[1:], dtype=float)
+    except (OSError, IndexError, ValueError) as e:
+        fail(f"scipy_fit.py: {path}: expected a CSV with zenith_deg,azimuth_deg and channel columns of numbers ({e})")
+    if "zenith_deg" not in head or "azimuth_deg" not in head or data.ndim != 2 or len(data) == 0:
+        fail(f"scipy_fit.py: {path}: header {','.join(head)}: expected zenith_deg, azimuth_deg and at least one sample")
     return {h: data[:, i] for i, h in enumerate(head)}
 
 
 def run(args):
-    with open(os.path.join(args.dir, "manifest.csv"), newline="") as f:
-        skies = list(csv.DictReader(f))
+    manifest = os.path.join(args.dir, "manifest.csv")
+    try:
+        with open(manifest, newline="") as f:
+            skies = list(csv.DictReader(f))
+    except OSError as e:
+        fail(f"scipy_fit.py: {manifest}: cannot read ({e})")
+    for i, sky in enumerate(skies, start=2):
+        for k in ("id", "source", "bin", "cie_type", "sun_zenith_deg", "sun_azimuth_deg"):
+            v = sky.get(k)
+            try:
+                if v is None or (k.startswith("sun_") and not math.isfinite(float(v))):
+                    raise ValueError
+            except ValueError:
+                fail(f"scipy_fit.py: {manifest} line {i}: {k} = {v!r}; expected "
+                     f"{'a finite number of degrees' if k.startswith('sun_') else 'the column of generate.py'}")
     starts = load_starts(args.start)
     noises = [0.0] + ([args.noise] if args.noise > 0 else [])
     out = []
@@ -240,6 +258,12 @@ def per_sky(rows):
     return "\n".join(lines)
 
 
+def fail(msg):
+    """Bad input or usage: the message on standard error, exit status 2."""
+    print(msg, file=sys.stderr)
+    sys.exit(2)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("dir")
@@ -255,15 +279,15 @@ def main():
     ap.add_argument("--per-sky", action="store_true", help="print one table row per sky and channel")
     args = ap.parse_args()
     if not 0 <= args.noise < 1:
-        sys.exit(f"scipy_fit.py: --noise {args.noise}: expected a fraction in [0, 1)")
+        fail(f"scipy_fit.py: --noise {args.noise}: expected a fraction in [0, 1)")
     if args.reps < 1:
-        sys.exit(f"scipy_fit.py: --reps {args.reps}: expected at least 1")
+        fail(f"scipy_fit.py: --reps {args.reps}: expected at least 1")
     try:
         args.cie_starts = [int(t) for t in args.cie_starts.split(",")]
     except ValueError:
         args.cie_starts = [0]
     if not args.cie_starts or any(t not in CIE_TYPES for t in args.cie_starts):
-        sys.exit(f"scipy_fit.py: --cie-starts: expected types among {sorted(CIE_TYPES)}, comma-separated")
+        fail(f"scipy_fit.py: --cie-starts: expected types among {sorted(CIE_TYPES)}, comma-separated")
     rows = run(args)
     out = args.out or os.path.join(os.environ.get("TMPDIR", "/tmp"), "campanile-validation", "scipy_fit.csv")
     os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
