@@ -137,8 +137,10 @@ pub fn sun(name: &str, spread: [f64; 3], measured: usize, refused: &[String], q:
 }
 
 /// A sky fit, per channel: the residual and the samples masked, with
-/// the model chosen and why as notes. `converged` per channel where the
-/// fitter reported it: a fit that did not converge is at best `poor`.
+/// the model chosen and why, what was masked and the optimizer's ending as
+/// notes. Convergence comes from each channel's record, else from
+/// `converged`: a fit that did not converge fails; one with a parameter at
+/// a bound of its range is at best `poor`.
 pub fn sky(name: &str, channels: &[ChannelSky], converged: Option<[bool; 3]>, q: &Quality) -> ProductQuality {
     let g = &q.sky;
     let mut checks = Vec::new();
@@ -157,12 +159,33 @@ pub fn sky(name: &str, channels: &[ChannelSky], converged: Option<[bool; 3]>, q:
             Better::Lower,
         ));
         notes.push(format!("{}: {}, {}", ch.channel, ch.chosen, ch.reason));
-        if converged.is_some_and(|v| !v.get(c).copied().unwrap_or(true)) {
+        if let Some(m) = &ch.masked {
+            notes.push(format!("{}: {m}", ch.channel));
+        }
+        // The optimizer's own criteria: not converged fails the sky; a
+        // parameter that ended at a bound of its range makes it poor (the
+        // sky lies outside what the model was given).
+        let (done, at_bound) = match &ch.convergence {
+            Some(cv) => {
+                notes.push(format!("{}: {}", ch.channel, cv.summary()));
+                (cv.converged, cv.at_bound.len())
+            }
+            None => (converged.is_none_or(|v| v.get(c).copied().unwrap_or(true)), 0),
+        };
+        if !done {
             checks.push(Check::new(
                 format!("{}: converged (1 yes, 0 no)", ch.channel),
                 0.0,
-                super::Gate::new(1.0, 0.0),
+                super::Gate::new(1.0, 0.5),
                 Better::Higher,
+            ));
+        }
+        if at_bound > 0 {
+            checks.push(Check::new(
+                format!("{}: parameters ended at a bound of their range", ch.channel),
+                at_bound as f64,
+                super::Gate::new(0.0, 7.0),
+                Better::Lower,
             ));
         }
     }
@@ -319,5 +342,49 @@ mod tests {
             "{}",
             half.reasons()
         );
+    }
+
+    #[test]
+    fn a_sky_parameter_at_a_bound_is_poor_and_no_convergence_fails() {
+        use crate::sky::{ChannelSky, Convergence, SkyModel, Termination};
+        let q = Quality::default();
+        let channel = |converged: bool, at_bound: Vec<String>| ChannelSky {
+            channel: "g".into(),
+            model: SkyModel {
+                lz: 1.0,
+                a: -1.0,
+                b: -0.3,
+                c: 10.0,
+                d: -3.0,
+                e: 0.45,
+                h: 1.0,
+            },
+            chosen: "Perez".into(),
+            reason: "test".into(),
+            rms_relative: 0.001,
+            samples: 500,
+            masked_fraction: 0.0,
+            masked: None,
+            convergence: Some(Convergence {
+                converged,
+                termination: if converged {
+                    Termination::Gradient
+                } else {
+                    Termination::Evaluations
+                },
+                iterations: 9,
+                evaluations: 12,
+                at_bound,
+            }),
+        };
+        assert_eq!(sky("s", &[channel(true, vec![])], None, &q).verdict, Verdict::Ok);
+        let bound = sky("s", &[channel(true, vec!["a = -3 (lower bound)".into()])], None, &q);
+        assert_eq!(bound.verdict, Verdict::Poor, "{bound:?}");
+        assert!(
+            bound.notes.iter().any(|n| n.contains("a = -3 (lower bound)")),
+            "{:?}",
+            bound.notes
+        );
+        assert_eq!(sky("s", &[channel(false, vec![])], None, &q).verdict, Verdict::Failed);
     }
 }

@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::csv_cell::{CellError, TableError, column, number};
 
-use super::fit::{SkyFit, SkyModelKind};
+use super::fit::{Convergence, RobustSkyFit, SkyFit};
 use super::seven_parameter::SkyModel;
 
 /// One channel's fitted sky.
@@ -23,7 +23,7 @@ pub struct ChannelSky {
     pub channel: String,
     /// Eq. (5.9) parameters.
     pub model: SkyModel,
-    /// The model chosen, e.g. "SevenParameter" or "Cie(12)".
+    /// The model chosen: "Perez", "SevenParameter", "SevenParameterFixedAureole" or "Cie(N)".
     pub chosen: String,
     /// Why.
     pub reason: String,
@@ -33,24 +33,38 @@ pub struct ChannelSky {
     pub samples: usize,
     /// Fraction of them left out as not sky (occluders, glare).
     pub masked_fraction: f64,
+    /// What was masked and why (absent in files written before it was
+    /// recorded).
+    #[serde(default)]
+    pub masked: Option<String>,
+    /// How the optimizer ended: criterion, iterations, parameters at a
+    /// bound (absent for predicted skies and older files).
+    #[serde(default)]
+    pub convergence: Option<Convergence>,
 }
 
 impl ChannelSky {
-    /// The record of a fit.
+    /// The record of a fit of `samples` samples of which `masked_fraction`
+    /// were left out.
     pub fn new(channel: &str, fit: &SkyFit, samples: usize, masked_fraction: f64) -> Self {
-        let chosen = match fit.kind {
-            SkyModelKind::Cie(t) => format!("Cie({})", t.number()),
-            SkyModelKind::SevenParameter => "SevenParameter".into(),
-            SkyModelKind::SevenParameterFixedAureole => "SevenParameterFixedAureole".into(),
-        };
         ChannelSky {
             channel: channel.to_owned(),
             model: fit.model,
-            chosen,
+            chosen: fit.kind.label(),
             reason: fit.reason.clone(),
             rms_relative: fit.rms_relative,
             samples,
             masked_fraction,
+            masked: None,
+            convergence: Some(fit.convergence.clone()),
+        }
+    }
+
+    /// The record of a fit with outliers masked.
+    pub fn of_robust(channel: &str, robust: &RobustSkyFit) -> Self {
+        ChannelSky {
+            masked: Some(robust.masked_summary()),
+            ..ChannelSky::new(channel, &robust.fit, robust.kept.len(), robust.masked_fraction)
         }
     }
 }

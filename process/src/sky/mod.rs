@@ -13,6 +13,7 @@ mod fit;
 mod frame_samples;
 mod geometry;
 mod latlong;
+mod perez;
 mod predict;
 mod seven_parameter;
 
@@ -20,11 +21,13 @@ pub use cie::{CieSky, CieSkyType};
 pub use daylight::{Atmosphere, Daylight, REDDENING_ONSET_AIR_MASS, SUN_ANGULAR_RADIUS_RAD};
 pub use file::{ChannelSky, SampleTable, SampleTableError, SkyFile, read_directions, read_samples};
 pub use fit::{
-    AUREOLE_SEEN_RAD, Candidate, OUTLIER_FLOOR, RobustSkyFit, SkyFit, SkyFitError, SkyModelKind, SkySample,
-    WEIGHT_FLOOR, fit_sky, fit_sky_robust,
+    Candidate, Convergence, MAX_MASKED_FRACTION, OUTLIER_FLOOR, PARAMETER_NAMES, PARAMETER_RANGES, RCOND_FLOOR,
+    RobustSkyFit, SkyFit, SkyFitError, SkyFitOptions, SkyModelKind, SkySample, Termination, WEIGHT_FLOOR, fit_sky,
+    fit_sky_robust, fit_sky_with,
 };
 pub use frame_samples::{FrameSampleError, MIN_ELEVATION_RAD, SkyFrame, sky_samples};
 pub use geometry::{angle_between, direction};
 pub use latlong::{latlong_direction, render_latlong};
+pub use perez::{BRIGHTNESS_RANGE, CLEARNESS_BIN_EDGES, PerezSky, table_extremes};
 pub use predict::{KnownSky, OvercastSky, PredictError, predict_sky, redden};
 pub use seven_parameter::{COS_XI_FLOOR, SkyModel};

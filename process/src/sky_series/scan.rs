@@ -109,7 +109,7 @@ pub fn scan_products(
     let sky: Option<Vec<ChannelSky>> = l.sky.as_ref().map(|fits| {
         fits.iter()
             .zip(["r", "g", "b"])
-            .map(|(f, name)| ChannelSky::new(name, &f.fit, f.kept.len(), f.masked_fraction))
+            .map(|(f, name)| ChannelSky::of_robust(name, f))
             .collect()
     });
     let models = sky

@@ -761,7 +761,7 @@ pub fn sky_file(l: &OccurrenceLight) -> Option<SkyFile> {
         channels: fits
             .iter()
             .zip(["r", "g", "b"])
-            .map(|(f, name)| ChannelSky::new(name, &f.fit, f.kept.len(), f.masked_fraction))
+            .map(|(f, name)| ChannelSky::of_robust(name, f))
             .collect(),
     })
 }
