@@ -270,3 +270,105 @@ fn map_writes_a_lat_long_exr_of_the_fitted_sky() {
     ]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// A CIE clear sky (type 12) for a sun at (`zs_deg`, `azs_deg`), sampled
+/// every 5° of zenith and 10° of azimuth with ±1% deterministic
+/// pseudo-noise: `(zenith_deg, azimuth_deg, noise factor, [r, g, b])` per row.
+fn clear_sky_rows(zs_deg: f64, azs_deg: f64) -> Vec<(u32, u32, f64, [f64; 3])> {
+    let (zs, azs) = (zs_deg.to_radians(), azs_deg.to_radians());
+    let sun = dir(zs, azs);
+    let mut rows = Vec::new();
+    let mut k = 0u64;
+    for zi in (0..86).step_by(5) {
+        for ai in (0..360).step_by(10) {
+            let (z, a) = (f64::from(zi).to_radians(), f64::from(ai).to_radians());
+            let v = dir(z, a);
+            let g = (v[0] * sun[0] + v[1] * sun[1] + v[2] * sun[2]).clamp(-1.0, 1.0).acos();
+            k = k.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let n = 1.0 + 0.01 * ((k >> 33) as f64 / f64::from(1u32 << 31) * 2.0 - 1.0);
+            rows.push((
+                zi,
+                ai,
+                n,
+                [
+                    cie12(z, g, zs, 0.05) * n,
+                    cie12(z, g, zs, 0.08) * n,
+                    cie12(z, g, zs, 0.13) * n,
+                ],
+            ));
+        }
+    }
+    rows
+}
+
+/// The sky file's fields `sun_zenith_deg`, `sun_azimuth_deg` and channel names.
+fn sky_summary(path: &std::path::Path) -> (f64, f64, Vec<String>) {
+    let sky: campanile_process::sky::SkyFile =
+        ron::from_str(&std::fs::read_to_string(path).expect("written")).expect("a sky file");
+    (
+        sky.sun_zenith_deg,
+        sky.sun_azimuth_deg,
+        sky.channels.iter().map(|c| c.channel.clone()).collect(),
+    )
+}
+
+#[test]
+fn extra_columns_are_ignored_and_r_g_b_are_the_channels() {
+    let tmp = tempfile::tempdir().expect("temp");
+    let samples = tmp.path().join("scan.csv");
+    let mut csv = String::from("id,zenith_deg,azimuth_deg,r,g,b,note\n");
+    for (i, (zi, ai, _, [r, g, b])) in clear_sky_rows(40.0, 190.0).into_iter().enumerate() {
+        let _ = writeln!(csv, "{i},{zi},{ai},{r},{g},{b},looks clear");
+    }
+    std::fs::write(&samples, csv).expect("write");
+    let sky = tmp.path().join("sky.ron");
+    let out = campanile(&[
+        "sky",
+        "fit",
+        samples.to_str().expect("utf-8"),
+        "--sun-zenith-deg",
+        "40",
+        "--sun-azimuth-deg",
+        "190",
+        "--out",
+        sky.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(sky_summary(&sky).2, ["r", "g", "b"]);
+
+    // --columns chooses the channels and their order.
+    let out = campanile(&[
+        "sky",
+        "fit",
+        samples.to_str().expect("utf-8"),
+        "--sun-zenith-deg",
+        "40",
+        "--sun-azimuth-deg",
+        "190",
+        "--columns",
+        "b,r",
+        "--out",
+        sky.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(sky_summary(&sky).2, ["b", "r"]);
+
+    // A name that is not in the header is refused, listing the header.
+    let out = campanile(&[
+        "sky",
+        "fit",
+        samples.to_str().expect("utf-8"),
+        "--sun-zenith-deg",
+        "40",
+        "--sun-azimuth-deg",
+        "190",
+        "--columns",
+        "r,q",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("`q`") && stderr.contains("id,zenith_deg,azimuth_deg,r,g,b,note"),
+        "{stderr}"
+    );
+}

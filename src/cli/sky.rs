@@ -9,8 +9,8 @@ use campanile_process::exr_io::write_radiance_exr;
 use campanile_process::hdr::merge::RadianceMap;
 use campanile_process::quality::{ProductQuality, QualityReport, gates};
 use campanile_process::sky::{
-    ChannelSky, KnownSky, SkyFile, angle_between, direction, fit_sky_robust, predict_sky, read_directions,
-    read_samples, render_latlong,
+    ChannelSelection, ChannelSky, KnownSky, SkyFile, angle_between, direction, fit_sky_robust, predict_sky,
+    read_directions, read_samples, render_latlong,
 };
 use campanile_process::sun::Ephemeris;
 use chrono::{DateTime, Utc};
@@ -21,7 +21,9 @@ pub enum SkyCommand {
     /// Fit the sky model (thesis eq. 5.9) to sky samples, one model per channel.
     ///
     /// SAMPLES is a CSV with zenith_deg, azimuth_deg (from north through
-    /// east) and one column per channel (e.g. r,g,b) of radiance. The sun's
+    /// east) and the channels' radiance: the columns --columns names, else
+    /// r,g,b (or red,green,blue), else one of y, luminance, radiance; other
+    /// columns are ignored. The sun's
     /// position comes from --sun-zenith-deg/--sun-azimuth-deg, or from --time
     /// and --station through the ephemeris. Samples within 0.5° of the sun
     /// (the disc) are left out.
@@ -41,6 +43,10 @@ pub enum SkyCommand {
     Fit {
         /// Sky samples (CSV).
         samples: PathBuf,
+        /// The channel columns, in order (e.g. r,g,b); by default r,g,b,
+        /// red,green,blue, or one of y, luminance, radiance.
+        #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
+        columns: Option<Vec<String>>,
         #[command(flatten)]
         sun: SunArgs,
         /// Where to write the fitted skies (RON); standard output when absent.
@@ -98,8 +104,8 @@ pub enum SkyCommand {
     },
     /// Evaluate fitted skies (RON from `sky fit`) at directions.
     ///
-    /// DIRECTIONS is a CSV with zenith_deg and azimuth_deg; the output adds
-    /// one radiance column per channel.
+    /// DIRECTIONS is a CSV with zenith_deg and azimuth_deg (any other
+    /// columns are ignored); the output adds one radiance column per channel.
     #[command(verbatim_doc_comment)]
     Eval {
         /// Fitted skies (RON).
@@ -169,6 +175,7 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
     match cmd {
         SkyCommand::Fit {
             samples,
+            columns,
             sun,
             out,
             residual_map,
@@ -177,7 +184,9 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
             let q = super::verdicts::thresholds(thresholds.as_deref(), None)?;
             let (zs, az) = sun.resolve()?;
             let file = File::open(&samples).with_context(|| format!("{}: cannot open", samples.display()))?;
-            let table = read_samples(BufReader::new(file)).with_context(|| format!("{}", samples.display()))?;
+            let selection = columns.map_or(ChannelSelection::Auto, ChannelSelection::Named);
+            let table =
+                read_samples(BufReader::new(file), &selection).with_context(|| format!("{}", samples.display()))?;
             let sun_dir = direction(zs, az);
             let mut channels = Vec::new();
             let mut converged = [true; 3];

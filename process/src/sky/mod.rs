@@ -18,7 +18,7 @@ mod seven_parameter;
 
 pub use cie::{CieSky, CieSkyType};
 pub use daylight::{Atmosphere, Daylight, REDDENING_ONSET_AIR_MASS, SUN_ANGULAR_RADIUS_RAD};
-pub use file::{ChannelSky, SampleTable, SampleTableError, SkyFile, read_directions, read_samples};
+pub use file::{ChannelSelection, ChannelSky, SampleTable, SampleTableError, SkyFile, read_directions, read_samples};
 pub use fit::{
     AUREOLE_SEEN_RAD, Candidate, OUTLIER_FLOOR, RobustSkyFit, SkyFit, SkyFitError, SkyModelKind, SkySample,
     WEIGHT_FLOOR, fit_sky, fit_sky_robust,
