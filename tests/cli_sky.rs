@@ -372,3 +372,65 @@ fn extra_columns_are_ignored_and_r_g_b_are_the_channels() {
         "{stderr}"
     );
 }
+
+#[test]
+fn the_sun_from_lat_lon_and_time_is_the_ephemeris_sun() {
+    use campanile_process::sun::{Ephemeris, Observer};
+    // Berkeley, 2026-08-28 20:30 UTC; refraction for 1013.25 mbar, 12 °C.
+    let (lat, lon, time) = (37.8719, -122.2585, "2026-08-28T20:30:00Z");
+    let t: chrono::DateTime<chrono::Utc> = time.parse().expect("time");
+    let p = Ephemeris::at(t, None)
+        .and_then(|e| e.position(&Observer::from_degrees(lat, lon, 0.0, 1013.25, 12.0)))
+        .expect("position");
+    let (zs, azs) = (p.zenith_rad.to_degrees(), p.azimuth_rad.to_degrees());
+    assert!((20.0..60.0).contains(&zs), "zenith {zs}");
+
+    let tmp = tempfile::tempdir().expect("temp");
+    let samples = tmp.path().join("scan.csv");
+    let mut csv = String::from("zenith_deg,azimuth_deg,y\n");
+    for (zi, ai, _, [_, y, _]) in clear_sky_rows(zs, azs) {
+        let _ = writeln!(csv, "{zi},{ai},{y}");
+    }
+    std::fs::write(&samples, csv).expect("write");
+    let fit = |name: &str, sun: &[&str]| {
+        let sky = tmp.path().join(name);
+        let mut args = vec![
+            "sky",
+            "fit",
+            samples.to_str().expect("utf-8"),
+            "--out",
+            sky.to_str().expect("utf-8"),
+        ];
+        args.extend_from_slice(sun);
+        let out = campanile(&args);
+        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        sky_summary(&sky)
+    };
+    let (z_text, a_text) = (format!("{zs:.17}"), format!("{azs:.17}"));
+    let given = fit(
+        "given.ron",
+        &["--sun-zenith-deg", &z_text, "--sun-azimuth-deg", &a_text],
+    );
+    let lon_text = lon.to_string();
+    let site = fit("site.ron", &["--lat", "37.8719", "--lon", &lon_text, "--time", time]);
+    // The same longitude written east of 180°.
+    let lon_east = (lon + 360.0).to_string();
+    let east = fit("east.ron", &["--lat", "37.8719", "--lon", &lon_east, "--time", time]);
+    for (name, s) in [("--lon -122.2585", &site), ("--lon 237.7415", &east)] {
+        assert!((s.0 - given.0).abs() < 1e-9, "{name}: zenith {} vs {}", s.0, given.0);
+        assert!((s.1 - given.1).abs() < 1e-9, "{name}: azimuth {} vs {}", s.1, given.1);
+        assert_eq!(s.2, ["y"]);
+    }
+    // `campanile sun` prints the same sun (to its 5 decimals).
+    let out = campanile(&["sun", "--lat", "37.8719", "--lon", &lon_text, "--time", time]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let field = |key: &str| -> f64 {
+        stdout
+            .lines()
+            .find_map(|l| l.strip_prefix(key))
+            .and_then(|v| v.trim().parse().ok())
+            .expect("a field")
+    };
+    assert!((field("zenith_deg") - site.0).abs() < 6e-6, "{stdout}");
+    assert!((field("azimuth_deg") - site.1).abs() < 6e-6, "{stdout}");
+}

@@ -14,7 +14,7 @@ use campanile_process::sky::{
 };
 use campanile_process::sun::Ephemeris;
 use chrono::{DateTime, Utc};
-use clap::{Args, Subcommand};
+use clap::{ArgGroup, Args, Subcommand};
 
 #[derive(Debug, Subcommand)]
 pub enum SkyCommand {
@@ -25,8 +25,8 @@ pub enum SkyCommand {
     /// r,g,b (or red,green,blue), else one of y, luminance, radiance; other
     /// columns are ignored. The sun's
     /// position comes from --sun-zenith-deg/--sun-azimuth-deg, or from --time
-    /// and --station through the ephemeris. Samples within 0.5° of the sun
-    /// (the disc) are left out.
+    /// with --station or with --lat/--lon through the ephemeris. Samples
+    /// within 0.5° of the sun (the disc) are left out.
     ///
     /// Samples that are not sky (buildings, trees, glare) are found and left
     /// out by robust fitting; the output gives the masked fraction.
@@ -115,40 +115,72 @@ pub enum SkyCommand {
     },
 }
 
+/// The sun: given, or from the ephemeris for a time and a site.
 #[derive(Debug, Args)]
+#[command(group(ArgGroup::new("site").args(["station", "lat"])))]
 pub struct SunArgs {
     /// The sun's zenith angle, degrees.
-    #[arg(long, requires = "sun_azimuth_deg", conflicts_with = "time")]
+    #[arg(
+        long,
+        requires = "sun_azimuth_deg",
+        conflicts_with_all = ["time", "station", "lat", "lon"],
+        allow_negative_numbers = true
+    )]
     sun_zenith_deg: Option<f64>,
     /// The sun's azimuth, degrees from north through east.
-    #[arg(long, requires = "sun_zenith_deg")]
+    #[arg(long, requires = "sun_zenith_deg", allow_negative_numbers = true)]
     sun_azimuth_deg: Option<f64>,
-    /// The instant the samples were taken (RFC 3339), with --station.
-    #[arg(long, requires = "station")]
+    /// The instant (RFC 3339, e.g. 2026-08-28T20:30:00Z), with --station or
+    /// with --lat and --lon.
+    #[arg(long, requires = "site", value_parser = rfc3339)]
     time: Option<DateTime<Utc>>,
     /// The station file whose site the ephemeris uses, with --time.
     #[arg(long, requires = "time")]
     station: Option<PathBuf>,
+    /// The site's latitude, degrees, north positive (-90 to 90), with --lon
+    /// and --time.
+    #[arg(long, requires_all = ["lon", "time"], allow_negative_numbers = true)]
+    lat: Option<f64>,
+    /// The site's longitude, degrees, east positive (-180 up to 360), with
+    /// --lat.
+    #[arg(long, requires = "lat", allow_negative_numbers = true)]
+    lon: Option<f64>,
+    /// The site's height above sea level, metres, with --lat [default: 0].
+    #[arg(long, requires = "lat", allow_negative_numbers = true)]
+    elevation_m: Option<f64>,
+}
+
+/// An instant as RFC 3339 gives it, for `--time`.
+fn rfc3339(text: &str) -> Result<DateTime<Utc>, String> {
+    DateTime::parse_from_rfc3339(text)
+        .map(|t| t.with_timezone(&Utc))
+        .map_err(|e| format!("expected an RFC 3339 instant such as 2026-08-28T20:30:00Z ({e})"))
 }
 
 impl SunArgs {
     /// (zenith, azimuth) in radians, for a sun that may be below the
     /// horizon (the environment is lit by the sky alone then).
     pub fn resolve_any(&self) -> Result<(f64, f64)> {
-        match (self.sun_zenith_deg, self.sun_azimuth_deg, self.time, &self.station) {
+        let site = (&self.station, self.lat, self.lon);
+        match (self.sun_zenith_deg, self.sun_azimuth_deg, self.time, site) {
             (Some(z), Some(a), _, _) if (0.0..=180.0).contains(&z) => Ok((z.to_radians(), a.to_radians())),
             (Some(z), Some(_), _, _) => Err(super::exit::bad_input(format!(
                 "--sun-zenith-deg: found {}; expected a zenith angle from 0 to 180 degrees",
                 super::exit::shown(z)
             ))),
-            (_, _, Some(t), Some(path)) => {
+            (_, _, Some(t), (Some(path), _, _)) => {
                 let s = super::site::station_site(path)?;
                 let obs = super::site::observer(&s);
                 let p = Ephemeris::at(t, s.delta_t_s)?.position(&obs)?;
                 Ok((p.zenith_rad, p.azimuth_rad))
             }
+            (_, _, Some(t), (None, Some(lat), Some(lon))) => {
+                let obs = super::site::observer_at(lat, lon, self.elevation_m.unwrap_or(0.0))?;
+                let p = Ephemeris::at(t, None)?.position(&obs)?;
+                Ok((p.zenith_rad, p.azimuth_rad))
+            }
             _ => Err(super::exit::bad_input(
-                "give the sun: --sun-zenith-deg and --sun-azimuth-deg, or --time and --station",
+                "give the sun: --sun-zenith-deg and --sun-azimuth-deg, or --time with --station or with --lat and --lon",
             )),
         }
     }
