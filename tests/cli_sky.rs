@@ -434,3 +434,98 @@ fn the_sun_from_lat_lon_and_time_is_the_ephemeris_sun() {
     assert!((field("zenith_deg") - site.0).abs() < 6e-6, "{stdout}");
     assert!((field("azimuth_deg") - site.1).abs() < 6e-6, "{stdout}");
 }
+
+#[test]
+fn eval_reads_a_sample_file_and_compare_gives_the_noise_back() {
+    let tmp = tempfile::tempdir().expect("temp");
+    let samples = tmp.path().join("scan.csv");
+    let rows = clear_sky_rows(40.0, 190.0);
+    let mut csv = String::from("id,zenith_deg,azimuth_deg,r,g,b,note\n");
+    for (i, (zi, ai, _, [r, g, b])) in rows.iter().enumerate() {
+        let _ = writeln!(csv, "{i},{zi},{ai},{r},{g},{b},looks clear");
+    }
+    std::fs::write(&samples, csv).expect("write");
+    let sky = tmp.path().join("sky.ron");
+    let out = campanile(&[
+        "sky",
+        "fit",
+        samples.to_str().expect("utf-8"),
+        "--sun-zenith-deg",
+        "40",
+        "--sun-azimuth-deg",
+        "190",
+        "--out",
+        sky.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+
+    // Plain eval of the sample file: directions and the sky's channels only.
+    let out = campanile(&[
+        "sky",
+        "eval",
+        sky.to_str().expect("utf-8"),
+        samples.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(stdout.lines().next(), Some("zenith_deg,azimuth_deg,r,g,b"));
+    assert_eq!(stdout.lines().count(), rows.len() + 1);
+    assert!(out.stderr.is_empty(), "{}", String::from_utf8_lossy(&out.stderr));
+
+    // --compare: measured / fitted − 1 is the noise put in (±1%, uniform),
+    // to within the fit's error in Lz.
+    let out = campanile(&[
+        "sky",
+        "eval",
+        sky.to_str().expect("utf-8"),
+        samples.to_str().expect("utf-8"),
+        "--compare",
+    ]);
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    let mut lines = stdout.lines();
+    assert_eq!(
+        lines.next(),
+        Some("zenith_deg,azimuth_deg,r,g,b,r_residual,g_residual,b_residual")
+    );
+    let mut worst = 0f64;
+    for (line, (_, _, n, _)) in lines.zip(&rows) {
+        let g: f64 = line.split(',').nth(6).and_then(|v| v.parse().ok()).expect("g_residual");
+        worst = worst.max((g - (n - 1.0)).abs());
+    }
+    assert!(worst < 2e-3, "g_residual off the noise by up to {worst}");
+    // The summary: the noise's own median and p95 of |n − 1|, nearest rank.
+    let mut noise: Vec<f64> = rows.iter().map(|(_, _, n, _)| (n - 1.0).abs()).collect();
+    noise.sort_by(f64::total_cmp);
+    let rank = |q: f64| noise[((noise.len() - 1) as f64 * q).round() as usize];
+    let summary = stderr
+        .lines()
+        .find(|l| l.starts_with("compared 648 samples, |measured / fitted − 1|: r median "))
+        .expect(&stderr);
+    let g_part = summary.split("; ").find(|p| p.starts_with("g median ")).expect(summary);
+    let figures: Vec<f64> = g_part.split([' ', ',']).filter_map(|w| w.parse().ok()).collect();
+    let [median, p95] = figures[..] else { panic!("{g_part}") };
+    assert!((median - rank(0.5)).abs() < 1e-3, "{summary}: median vs {}", rank(0.5));
+    assert!((p95 - rank(0.95)).abs() < 1e-3, "{summary}: p95 vs {}", rank(0.95));
+
+    // --compare on a file without the sky's channels is bad input.
+    let dirs = tmp.path().join("dirs.csv");
+    std::fs::write(&dirs, "zenith_deg,azimuth_deg,r\n10,20,1\n").expect("write");
+    let out = campanile(&[
+        "sky",
+        "eval",
+        sky.to_str().expect("utf-8"),
+        dirs.to_str().expect("utf-8"),
+        "--compare",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("--compare needs the sky's channels")
+            && stderr.contains("channel column `g` is not in the header (it has: zenith_deg,azimuth_deg,r)"),
+        "{stderr}"
+    );
+}

@@ -9,8 +9,8 @@ use campanile_process::exr_io::write_radiance_exr;
 use campanile_process::hdr::merge::RadianceMap;
 use campanile_process::quality::{ProductQuality, QualityReport, gates};
 use campanile_process::sky::{
-    ChannelSelection, ChannelSky, KnownSky, SkyFile, angle_between, direction, fit_sky_robust, predict_sky,
-    read_directions, read_samples, render_latlong,
+    ChannelSelection, ChannelSky, KnownSky, SkyFile, angle_between, compare_with_samples, direction, fit_sky_robust,
+    predict_sky, read_samples, render_latlong,
 };
 use campanile_process::sun::Ephemeris;
 use chrono::{DateTime, Utc};
@@ -106,12 +106,19 @@ pub enum SkyCommand {
     ///
     /// DIRECTIONS is a CSV with zenith_deg and azimuth_deg (any other
     /// columns are ignored); the output adds one radiance column per channel.
+    /// With --compare, DIRECTIONS also holds the sky's channels (measured):
+    /// the output adds CHANNEL_residual columns, measured / fitted − 1, and
+    /// standard error their median and 95th percentile.
     #[command(verbatim_doc_comment)]
     Eval {
         /// Fitted skies (RON).
         sky: PathBuf,
         /// Directions (CSV).
         directions: PathBuf,
+        /// Compare with DIRECTIONS' measured channels: add measured /
+        /// fitted − 1 columns and a summary on standard error.
+        #[arg(long)]
+        compare: bool,
     },
 }
 
@@ -347,25 +354,57 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
             write_radiance_exr(&map, &out).with_context(|| format!("{}: cannot write", out.display()))?;
             Ok(())
         }
-        SkyCommand::Eval { sky, directions } => {
+        SkyCommand::Eval {
+            sky,
+            directions,
+            compare,
+        } => {
             let sky_file = read_sky(&sky)?;
-            let file = File::open(&directions).with_context(|| format!("{}: cannot open", directions.display()))?;
-            let table = read_directions(BufReader::new(file)).with_context(|| format!("{}", directions.display()))?;
-            let sun_dir = direction(
-                sky_file.sun_zenith_deg.to_radians(),
-                sky_file.sun_azimuth_deg.to_radians(),
-            );
-            let mut out = std::io::stdout().lock();
             let names: Vec<&str> = sky_file.channels.iter().map(|c| c.channel.as_str()).collect();
-            writeln!(out, "zenith_deg,azimuth_deg,{}", names.join(","))?;
-            for &(z, a) in &table.directions {
-                let g = angle_between(direction(z, a), sun_dir);
-                let vals: Vec<String> = sky_file
-                    .channels
+            let selection = if compare {
+                ChannelSelection::Named(names.iter().map(|&n| n.to_owned()).collect())
+            } else {
+                ChannelSelection::Directions
+            };
+            let file = File::open(&directions).with_context(|| format!("{}: cannot open", directions.display()))?;
+            let table = read_samples(BufReader::new(file), &selection).with_context(|| {
+                if compare {
+                    format!("{}: --compare needs the sky's channels", directions.display())
+                } else {
+                    format!("{}", directions.display())
+                }
+            })?;
+            let compared = if compare {
+                compare_with_samples(&sky_file, &table)
+            } else {
+                Vec::new()
+            };
+            let mut out = std::io::stdout().lock();
+            let mut header = format!("zenith_deg,azimuth_deg,{}", names.join(","));
+            for c in &compared {
+                header += &format!(",{}_residual", c.channel);
+            }
+            writeln!(out, "{header}")?;
+            for (row, &(z, a)) in table.directions.iter().enumerate() {
+                let mut line = format!("{:.6},{:.6}", z.to_degrees(), a.to_degrees());
+                for v in sky_file.radiance(z, a) {
+                    line += &format!(",{v:.9e}");
+                }
+                for c in &compared {
+                    line += &format!(",{:.6e}", c.ratio_minus_1[row]);
+                }
+                writeln!(out, "{line}")?;
+            }
+            if !compared.is_empty() {
+                let parts: Vec<String> = compared
                     .iter()
-                    .map(|c| format!("{:.9e}", c.model.radiance(z, g)))
+                    .map(|c| format!("{} median {:.5}, p95 {:.5}", c.channel, c.median_abs, c.p95_abs))
                     .collect();
-                writeln!(out, "{:.6},{:.6},{}", z.to_degrees(), a.to_degrees(), vals.join(","))?;
+                eprintln!(
+                    "compared {} samples, |measured / fitted − 1|: {}",
+                    table.directions.len(),
+                    parts.join("; ")
+                );
             }
             Ok(())
         }
