@@ -529,3 +529,34 @@ fn eval_reads_a_sample_file_and_compare_gives_the_noise_back() {
         "{stderr}"
     );
 }
+
+#[test]
+fn the_help_documents_the_files_and_the_sun_options() {
+    let out = campanile(&["sky", "fit", "--help"]);
+    assert_eq!(out.status.code(), Some(0));
+    let help = String::from_utf8_lossy(&out.stdout);
+    for needed in [
+        "--columns <NAME,...>",
+        "--lat <LAT>",
+        "--lon <LON>",
+        "--elevation-m <ELEVATION_M>",
+        "zenith_deg    the element's zenith angle, degrees, in [0, 90]",
+        "azimuth_deg   its azimuth, degrees from north through east",
+        "id,zenith_deg,azimuth_deg,r,g,b,note",
+        "Other columns (ids, weights, times, notes) are ignored",
+        "masked_fraction",
+        "campanile sky fit scan.csv --lat 37.8719 --lon -122.2585",
+    ] {
+        assert!(help.contains(needed), "`sky fit --help` lacks {needed:?}:\n{help}");
+    }
+    let out = campanile(&["sky", "eval", "--help"]);
+    let help = String::from_utf8_lossy(&out.stdout);
+    for needed in ["--compare", "CHANNEL_residual", "Any other columns are ignored"] {
+        assert!(help.contains(needed), "`sky eval --help` lacks {needed:?}:\n{help}");
+    }
+    let out = campanile(&["sky", "predict", "--help"]);
+    let help = String::from_utf8_lossy(&out.stdout);
+    for needed in ["--lat <LAT>", "samples 0 and masked_fraction 0"] {
+        assert!(help.contains(needed), "`sky predict --help` lacks {needed:?}:\n{help}");
+    }
+}

@@ -20,12 +20,23 @@ use clap::{ArgGroup, Args, Subcommand};
 pub enum SkyCommand {
     /// Fit the sky model (thesis eq. 5.9) to sky samples, one model per channel.
     ///
-    /// SAMPLES is a CSV with zenith_deg, azimuth_deg (from north through
-    /// east) and the channels' radiance: the columns --columns names, else
-    /// r,g,b (or red,green,blue), else one of y, luminance, radiance; other
-    /// columns are ignored. The sun's
-    /// position comes from --sun-zenith-deg/--sun-azimuth-deg, or from --time
-    /// with --station or with --lat/--lon through the ephemeris. Samples
+    /// SAMPLES is a CSV with a header row and one row per sky element:
+    ///   zenith_deg    the element's zenith angle, degrees, in [0, 90]
+    ///   azimuth_deg   its azimuth, degrees from north through east
+    ///                 (-360 to 360)
+    ///   channels      its radiance, in any one unit, one column per channel:
+    ///                 those --columns names, else r,g,b (or red,green,blue;
+    ///                 any case) when all three are there, else the one
+    ///                 column named y, luminance or radiance
+    /// Other columns (ids, weights, times, notes) are ignored: their cells
+    /// are not read. For example:
+    ///   id,zenith_deg,azimuth_deg,r,g,b,note
+    ///   17,35,190,0.0521,0.0803,0.1302,clear
+    ///
+    /// The sun: --sun-zenith-deg and --sun-azimuth-deg; or --time with
+    /// --station (its site), or --time with --lat and --lon (and
+    /// --elevation-m), through the ephemeris (NREL SPA; refraction for
+    /// 1013.25 mbar and 12 °C with --lat/--lon, as `campanile sun`). Samples
     /// within 0.5° of the sun (the disc) are left out.
     ///
     /// Samples that are not sky (buildings, trees, glare) are found and left
@@ -37,8 +48,22 @@ pub enum SkyCommand {
     /// why. Weights are relative errors, so the result does not depend on
     /// the radiance unit.
     ///
-    /// Example: campanile sky fit scan.csv --time 2026-08-28T20:30:00Z \
-    ///            --station examples/sim-station.ron --out sky.ron
+    /// OUTPUT (RON, to --out or standard output): sun_zenith_deg and
+    /// sun_azimuth_deg (degrees), and per channel, in column order:
+    ///   channel          its column's name
+    ///   model            eq. (5.9)'s (lz, a, b, c, d, e, h); lz in the
+    ///                    samples' unit
+    ///   chosen, reason   the model chosen ("Cie(12)", "SevenParameter",
+    ///                    "SevenParameterFixedAureole") and why
+    ///   rms_relative     RMS of measured / fitted − 1 over the sky samples
+    ///   samples          samples used (outside the disc)
+    ///   masked_fraction  the fraction of them left out as not sky
+    ///
+    /// Examples:
+    ///   campanile sky fit scan.csv --lat 37.8719 --lon -122.2585 \
+    ///       --time 2026-08-28T20:30:00Z --out sky.ron
+    ///   campanile sky fit scan.csv --time 2026-08-28T20:30:00Z \
+    ///       --station examples/sim-station.ron --columns r_mean,g_mean,b_mean --out sky.ron
     #[command(verbatim_doc_comment)]
     Fit {
         /// Sky samples (CSV).
@@ -71,10 +96,19 @@ pub enum SkyCommand {
     /// background and the aureole of the known skies are averaged separately
     /// with weights inversely proportional to the angle between their suns
     /// and the new sun, then a new model is fitted. Give at least one fitted
-    /// sky (RON from `sky fit`), with the same channels, and the new sun.
+    /// sky (RON from `sky fit`), with the same channels, and the new sun:
+    /// --sun-zenith-deg and --sun-azimuth-deg, or --time with --station or
+    /// with --lat and --lon (as for `sky fit`).
     ///
-    /// Example: campanile sky predict morning.ron noon.ron evening.ron \
-    ///            --time 2026-08-28T22:00:00Z --station examples/sim-station.ron --out sky.ron
+    /// OUTPUT (RON, to --out or standard output): a sky file as `sky fit`
+    /// writes (sun_zenith_deg, sun_azimuth_deg, and per channel: channel,
+    /// model (lz, a, b, c, d, e, h), chosen, reason, rms_relative), with
+    /// samples 0 and masked_fraction 0: nothing was measured. It inherits
+    /// the verdicts of the skies it came from (their .quality.json).
+    ///
+    /// Example:
+    ///   campanile sky predict morning.ron noon.ron evening.ron \
+    ///       --time 2026-08-28T22:00:00Z --lat 37.8719 --lon -122.2585 --out sky.ron
     #[command(verbatim_doc_comment)]
     Predict {
         /// Fitted skies (RON), one per time.
@@ -102,13 +136,24 @@ pub enum SkyCommand {
         #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(4..=16384))]
         width: u32,
     },
-    /// Evaluate fitted skies (RON from `sky fit`) at directions.
+    /// Evaluate fitted skies (RON from `sky fit` or `sky predict`) at directions.
     ///
-    /// DIRECTIONS is a CSV with zenith_deg and azimuth_deg (any other
-    /// columns are ignored); the output adds one radiance column per channel.
-    /// With --compare, DIRECTIONS also holds the sky's channels (measured):
-    /// the output adds CHANNEL_residual columns, measured / fitted − 1, and
-    /// standard error their median and 95th percentile.
+    /// DIRECTIONS is a CSV with a header row and one row per direction:
+    ///   zenith_deg    degrees, in [0, 90]
+    ///   azimuth_deg   degrees from north through east (-360 to 360)
+    /// Any other columns are ignored, so a sample file for `sky fit` will do.
+    ///
+    /// Prints a CSV: zenith_deg, azimuth_deg, then each sky channel's
+    /// radiance, named as in the sky file.
+    ///
+    /// With --compare, DIRECTIONS must also hold the sky's channel columns
+    /// (measured radiance, same names): each adds a column CHANNEL_residual,
+    /// measured / fitted − 1, and one line on standard error gives per
+    /// channel the median and 95th percentile of |measured / fitted − 1|.
+    ///
+    /// Examples:
+    ///   campanile sky eval sky.ron directions.csv
+    ///   campanile sky eval sky.ron scan.csv --compare > residuals.csv
     #[command(verbatim_doc_comment)]
     Eval {
         /// Fitted skies (RON).
