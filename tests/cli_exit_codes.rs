@@ -20,6 +20,15 @@ fn files(dir: &Path) {
     let write = |name: &str, text: &str| std::fs::write(dir.join(name), text).expect("write");
     write("bad-sky.csv", "zenith_deg,azimuth_deg,r,g,b\n10,20,abc,1,1\n");
     write("bad-env.csv", "region,r\nx,1\n");
+    write("no-channels.csv", "id,zenith_deg,azimuth_deg,weight\n1,10,20,0.5\n");
+    write("two-channels.csv", "zenith_deg,azimuth_deg,y,radiance\n10,20,1,1\n");
+    write("only-r.csv", "id,zenith_deg,azimuth_deg,r,note\n1,10,20,0.5,clear\n");
+    write(
+        "sky.ron",
+        "(sun_zenith_deg: 40.0, sun_azimuth_deg: 180.0, channels: [(channel: \"g\", \
+         model: (lz: 0.07, a: -1.0, b: -0.4, c: 12.0, d: -3.2, e: 0.5, h: 0.9), chosen: \"SevenParameter\", \
+         reason: \"test\", rms_relative: 0.0, samples: 100, masked_fraction: 0.0)])",
+    );
     write("bad.ron", "SkyFile(\n");
     write(
         "times.csv",
@@ -47,6 +56,19 @@ fn every_command_exits_2_on_bad_input_1_on_failure_and_0_on_success() {
         p("times.csv"),
         p("bad-times.csv"),
     );
+    let (no_channels, two_channels, only_r, sky) = (
+        p("no-channels.csv"),
+        p("two-channels.csv"),
+        p("only-r.csv"),
+        p("sky.ron"),
+    );
+    let sun = ["--sun-zenith-deg", "40", "--sun-azimuth-deg", "10"];
+    let fit = |samples: &str, more: &[&str]| {
+        let mut args = vec!["sky", "fit"];
+        args.push(samples);
+        args.extend_from_slice(more);
+        args.iter().map(|s| (*s).to_owned()).collect::<Vec<String>>()
+    };
     let (missing, not_session, unrelated) = (p("no-such-file.ron"), p("not-a-session"), p("unrelated"));
     let now = "2026-08-28T20:00:00Z";
     let cases: Vec<Case> = vec![
@@ -125,6 +147,162 @@ fn every_command_exits_2_on_bad_input_1_on_failure_and_0_on_success() {
             ],
             2,
             "found \"abc\"",
+        ),
+        // The sun from a site: values out of their domains, a time that is
+        // not RFC 3339, two sites, a time without a site.
+        case(
+            &["sky", "fit", &missing, "--lat", "95", "--lon", "0", "--time", now],
+            2,
+            "--lat: found 95; expected degrees from -90 to 90, north positive",
+        ),
+        case(
+            &["sky", "fit", &missing, "--lat", "-1e308", "--lon", "0", "--time", now],
+            2,
+            "--lat: found -1e308;",
+        ),
+        case(
+            &["sky", "fit", &missing, "--lat", "30", "--lon", "360", "--time", now],
+            2,
+            "--lon: found 360; expected degrees from -180 up to (not including) 360, east positive",
+        ),
+        case(
+            &["sky", "fit", &missing, "--lat", "30", "--lon", "-180.5", "--time", now],
+            2,
+            "--lon: found -180.5;",
+        ),
+        case(
+            &[
+                "sky",
+                "fit",
+                &missing,
+                "--lat",
+                "30",
+                "--lon",
+                "10",
+                "--elevation-m",
+                "2e7",
+                "--time",
+                now,
+            ],
+            2,
+            "--elevation-m: found 20000000; expected metres above sea level",
+        ),
+        case(
+            &[
+                "sky",
+                "fit",
+                &missing,
+                "--lat",
+                "30",
+                "--lon",
+                "10",
+                "--time",
+                "yesterday",
+            ],
+            2,
+            "invalid value 'yesterday' for '--time <TIME>': expected an RFC 3339 instant such as 2026-08-28T20:30:00Z",
+        ),
+        case(
+            &[
+                "sky",
+                "fit",
+                &missing,
+                "--lat",
+                "30",
+                "--lon",
+                "10",
+                "--time",
+                "2026-08-28 20:00",
+            ],
+            2,
+            "expected an RFC 3339 instant",
+        ),
+        case(
+            &[
+                "sky",
+                "fit",
+                &missing,
+                "--lat",
+                "30",
+                "--lon",
+                "10",
+                "--station",
+                "examples/sim-station.ron",
+                "--time",
+                now,
+            ],
+            2,
+            "cannot be used with",
+        ),
+        case(
+            &["sky", "fit", &missing, "--time", now],
+            2,
+            "<--station <STATION>|--lat <LAT>>",
+        ),
+        case(
+            &["sky", "predict", &missing, "--lat", "95", "--lon", "0", "--time", now],
+            2,
+            "--lat: found 95;",
+        ),
+        case(
+            &[
+                "env",
+                "predict",
+                &missing,
+                "--sky-irradiance",
+                "1,1,1",
+                "--sun-irradiance",
+                "1,1,1",
+                "--lat",
+                "30",
+                "--lon",
+                "-200",
+                "--time",
+                now,
+            ],
+            2,
+            "--lon: found -200;",
+        ),
+        // The channel columns.
+        (
+            fit(&only_r, &[&sun[..], &["--columns", "r,q"]].concat()),
+            2,
+            "channel column `q` is not in the header (it has: id,zenith_deg,azimuth_deg,r,note)",
+        ),
+        (
+            fit(&only_r, &[&sun[..], &["--columns", "r,zenith_deg"]].concat()),
+            2,
+            "channel column `zenith_deg` cannot be a channel: it is a direction column",
+        ),
+        (
+            fit(&only_r, &[&sun[..], &["--columns", "r,r"]].concat()),
+            2,
+            "channel column `r` cannot be a channel: it is named twice",
+        ),
+        (
+            fit(&only_r, &[&sun[..], &["--columns", "note"]].concat()),
+            2,
+            "column `note`: found \"clear\"; expected a radiance",
+        ),
+        (
+            fit(&only_r, &sun),
+            2,
+            "no channel columns: the header has id,zenith_deg,azimuth_deg,r,note",
+        ),
+        (
+            fit(&no_channels, &sun),
+            2,
+            "no channel columns: the header has id,zenith_deg,azimuth_deg,weight",
+        ),
+        (
+            fit(&two_channels, &sun),
+            2,
+            "the channel column is ambiguous: the header has y, radiance",
+        ),
+        case(
+            &["sky", "eval", &sky, &only_r, "--compare"],
+            2,
+            "--compare needs the sky's channels: channel column `g` is not in the header",
         ),
         case(
             &[
@@ -276,6 +454,7 @@ fn every_command_exits_2_on_bad_input_1_on_failure_and_0_on_success() {
         case(&["sun", "--lat", "37.87", "--lon", "-122.26", "--time", now], 0, ""),
         case(&["sun", "--csv", &times, "--out", &p("positions.csv")], 0, ""),
         case(&["config", "check", "examples/sim-station.ron"], 0, ""),
+        case(&["sky", "eval", &sky, &only_r], 0, ""),
     ];
     let mut wrong = Vec::new();
     for (args, code, says) in &cases {

@@ -270,3 +270,293 @@ fn map_writes_a_lat_long_exr_of_the_fitted_sky() {
     ]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// A CIE clear sky (type 12) for a sun at (`zs_deg`, `azs_deg`), sampled
+/// every 5° of zenith and 10° of azimuth with ±1% deterministic
+/// pseudo-noise: `(zenith_deg, azimuth_deg, noise factor, [r, g, b])` per row.
+fn clear_sky_rows(zs_deg: f64, azs_deg: f64) -> Vec<(u32, u32, f64, [f64; 3])> {
+    let (zs, azs) = (zs_deg.to_radians(), azs_deg.to_radians());
+    let sun = dir(zs, azs);
+    let mut rows = Vec::new();
+    let mut k = 0u64;
+    for zi in (0..86).step_by(5) {
+        for ai in (0..360).step_by(10) {
+            let (z, a) = (f64::from(zi).to_radians(), f64::from(ai).to_radians());
+            let v = dir(z, a);
+            let g = (v[0] * sun[0] + v[1] * sun[1] + v[2] * sun[2]).clamp(-1.0, 1.0).acos();
+            k = k.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let n = 1.0 + 0.01 * ((k >> 33) as f64 / f64::from(1u32 << 31) * 2.0 - 1.0);
+            rows.push((
+                zi,
+                ai,
+                n,
+                [
+                    cie12(z, g, zs, 0.05) * n,
+                    cie12(z, g, zs, 0.08) * n,
+                    cie12(z, g, zs, 0.13) * n,
+                ],
+            ));
+        }
+    }
+    rows
+}
+
+/// The sky file's fields `sun_zenith_deg`, `sun_azimuth_deg` and channel names.
+fn sky_summary(path: &std::path::Path) -> (f64, f64, Vec<String>) {
+    let sky: campanile_process::sky::SkyFile =
+        ron::from_str(&std::fs::read_to_string(path).expect("written")).expect("a sky file");
+    (
+        sky.sun_zenith_deg,
+        sky.sun_azimuth_deg,
+        sky.channels.iter().map(|c| c.channel.clone()).collect(),
+    )
+}
+
+#[test]
+fn extra_columns_are_ignored_and_r_g_b_are_the_channels() {
+    let tmp = tempfile::tempdir().expect("temp");
+    let samples = tmp.path().join("scan.csv");
+    let mut csv = String::from("id,zenith_deg,azimuth_deg,r,g,b,note\n");
+    for (i, (zi, ai, _, [r, g, b])) in clear_sky_rows(40.0, 190.0).into_iter().enumerate() {
+        let _ = writeln!(csv, "{i},{zi},{ai},{r},{g},{b},looks clear");
+    }
+    std::fs::write(&samples, csv).expect("write");
+    let sky = tmp.path().join("sky.ron");
+    let out = campanile(&[
+        "sky",
+        "fit",
+        samples.to_str().expect("utf-8"),
+        "--sun-zenith-deg",
+        "40",
+        "--sun-azimuth-deg",
+        "190",
+        "--out",
+        sky.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(sky_summary(&sky).2, ["r", "g", "b"]);
+
+    // --columns chooses the channels and their order.
+    let out = campanile(&[
+        "sky",
+        "fit",
+        samples.to_str().expect("utf-8"),
+        "--sun-zenith-deg",
+        "40",
+        "--sun-azimuth-deg",
+        "190",
+        "--columns",
+        "b,r",
+        "--out",
+        sky.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(sky_summary(&sky).2, ["b", "r"]);
+
+    // A name that is not in the header is refused, listing the header.
+    let out = campanile(&[
+        "sky",
+        "fit",
+        samples.to_str().expect("utf-8"),
+        "--sun-zenith-deg",
+        "40",
+        "--sun-azimuth-deg",
+        "190",
+        "--columns",
+        "r,q",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("`q`") && stderr.contains("id,zenith_deg,azimuth_deg,r,g,b,note"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn the_sun_from_lat_lon_and_time_is_the_ephemeris_sun() {
+    use campanile_process::sun::{Ephemeris, Observer};
+    // Berkeley, 2026-08-28 20:30 UTC; refraction for 1013.25 mbar, 12 °C.
+    let (lat, lon, time) = (37.8719, -122.2585, "2026-08-28T20:30:00Z");
+    let t: chrono::DateTime<chrono::Utc> = time.parse().expect("time");
+    let p = Ephemeris::at(t, None)
+        .and_then(|e| e.position(&Observer::from_degrees(lat, lon, 0.0, 1013.25, 12.0)))
+        .expect("position");
+    let (zs, azs) = (p.zenith_rad.to_degrees(), p.azimuth_rad.to_degrees());
+    assert!((20.0..60.0).contains(&zs), "zenith {zs}");
+
+    let tmp = tempfile::tempdir().expect("temp");
+    let samples = tmp.path().join("scan.csv");
+    let mut csv = String::from("zenith_deg,azimuth_deg,y\n");
+    for (zi, ai, _, [_, y, _]) in clear_sky_rows(zs, azs) {
+        let _ = writeln!(csv, "{zi},{ai},{y}");
+    }
+    std::fs::write(&samples, csv).expect("write");
+    let fit = |name: &str, sun: &[&str]| {
+        let sky = tmp.path().join(name);
+        let mut args = vec![
+            "sky",
+            "fit",
+            samples.to_str().expect("utf-8"),
+            "--out",
+            sky.to_str().expect("utf-8"),
+        ];
+        args.extend_from_slice(sun);
+        let out = campanile(&args);
+        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        sky_summary(&sky)
+    };
+    let (z_text, a_text) = (format!("{zs:.17}"), format!("{azs:.17}"));
+    let given = fit(
+        "given.ron",
+        &["--sun-zenith-deg", &z_text, "--sun-azimuth-deg", &a_text],
+    );
+    let lon_text = lon.to_string();
+    let site = fit("site.ron", &["--lat", "37.8719", "--lon", &lon_text, "--time", time]);
+    // The same longitude written east of 180°.
+    let lon_east = (lon + 360.0).to_string();
+    let east = fit("east.ron", &["--lat", "37.8719", "--lon", &lon_east, "--time", time]);
+    for (name, s) in [("--lon -122.2585", &site), ("--lon 237.7415", &east)] {
+        assert!((s.0 - given.0).abs() < 1e-9, "{name}: zenith {} vs {}", s.0, given.0);
+        assert!((s.1 - given.1).abs() < 1e-9, "{name}: azimuth {} vs {}", s.1, given.1);
+        assert_eq!(s.2, ["y"]);
+    }
+    // `campanile sun` prints the same sun (to its 5 decimals).
+    let out = campanile(&["sun", "--lat", "37.8719", "--lon", &lon_text, "--time", time]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let field = |key: &str| -> f64 {
+        stdout
+            .lines()
+            .find_map(|l| l.strip_prefix(key))
+            .and_then(|v| v.trim().parse().ok())
+            .expect("a field")
+    };
+    assert!((field("zenith_deg") - site.0).abs() < 6e-6, "{stdout}");
+    assert!((field("azimuth_deg") - site.1).abs() < 6e-6, "{stdout}");
+}
+
+#[test]
+fn eval_reads_a_sample_file_and_compare_gives_the_noise_back() {
+    let tmp = tempfile::tempdir().expect("temp");
+    let samples = tmp.path().join("scan.csv");
+    let rows = clear_sky_rows(40.0, 190.0);
+    let mut csv = String::from("id,zenith_deg,azimuth_deg,r,g,b,note\n");
+    for (i, (zi, ai, _, [r, g, b])) in rows.iter().enumerate() {
+        let _ = writeln!(csv, "{i},{zi},{ai},{r},{g},{b},looks clear");
+    }
+    std::fs::write(&samples, csv).expect("write");
+    let sky = tmp.path().join("sky.ron");
+    let out = campanile(&[
+        "sky",
+        "fit",
+        samples.to_str().expect("utf-8"),
+        "--sun-zenith-deg",
+        "40",
+        "--sun-azimuth-deg",
+        "190",
+        "--out",
+        sky.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+
+    // Plain eval of the sample file: directions and the sky's channels only.
+    let out = campanile(&[
+        "sky",
+        "eval",
+        sky.to_str().expect("utf-8"),
+        samples.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(stdout.lines().next(), Some("zenith_deg,azimuth_deg,r,g,b"));
+    assert_eq!(stdout.lines().count(), rows.len() + 1);
+    assert!(out.stderr.is_empty(), "{}", String::from_utf8_lossy(&out.stderr));
+
+    // --compare: measured / fitted − 1 is the noise put in (±1%, uniform),
+    // to within the fit's error in Lz.
+    let out = campanile(&[
+        "sky",
+        "eval",
+        sky.to_str().expect("utf-8"),
+        samples.to_str().expect("utf-8"),
+        "--compare",
+    ]);
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    let mut lines = stdout.lines();
+    assert_eq!(
+        lines.next(),
+        Some("zenith_deg,azimuth_deg,r,g,b,r_residual,g_residual,b_residual")
+    );
+    let mut worst = 0f64;
+    for (line, (_, _, n, _)) in lines.zip(&rows) {
+        let g: f64 = line.split(',').nth(6).and_then(|v| v.parse().ok()).expect("g_residual");
+        worst = worst.max((g - (n - 1.0)).abs());
+    }
+    assert!(worst < 2e-3, "g_residual off the noise by up to {worst}");
+    // The summary: the noise's own median and p95 of |n − 1|, nearest rank.
+    let mut noise: Vec<f64> = rows.iter().map(|(_, _, n, _)| (n - 1.0).abs()).collect();
+    noise.sort_by(f64::total_cmp);
+    let rank = |q: f64| noise[((noise.len() - 1) as f64 * q).round() as usize];
+    let summary = stderr
+        .lines()
+        .find(|l| l.starts_with("compared 648 samples, |measured / fitted − 1|: r median "))
+        .expect(&stderr);
+    let g_part = summary.split("; ").find(|p| p.starts_with("g median ")).expect(summary);
+    let figures: Vec<f64> = g_part.split([' ', ',']).filter_map(|w| w.parse().ok()).collect();
+    let [median, p95] = figures[..] else { panic!("{g_part}") };
+    assert!((median - rank(0.5)).abs() < 1e-3, "{summary}: median vs {}", rank(0.5));
+    assert!((p95 - rank(0.95)).abs() < 1e-3, "{summary}: p95 vs {}", rank(0.95));
+
+    // --compare on a file without the sky's channels is bad input.
+    let dirs = tmp.path().join("dirs.csv");
+    std::fs::write(&dirs, "zenith_deg,azimuth_deg,r\n10,20,1\n").expect("write");
+    let out = campanile(&[
+        "sky",
+        "eval",
+        sky.to_str().expect("utf-8"),
+        dirs.to_str().expect("utf-8"),
+        "--compare",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("--compare needs the sky's channels")
+            && stderr.contains("channel column `g` is not in the header (it has: zenith_deg,azimuth_deg,r)"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn the_help_documents_the_files_and_the_sun_options() {
+    let out = campanile(&["sky", "fit", "--help"]);
+    assert_eq!(out.status.code(), Some(0));
+    let help = String::from_utf8_lossy(&out.stdout);
+    for needed in [
+        "--columns <NAME,...>",
+        "--lat <LAT>",
+        "--lon <LON>",
+        "--elevation-m <ELEVATION_M>",
+        "zenith_deg    the element's zenith angle, degrees, in [0, 90]",
+        "azimuth_deg   its azimuth, degrees from north through east",
+        "id,zenith_deg,azimuth_deg,r,g,b,note",
+        "Other columns (ids, weights, times, notes) are ignored",
+        "masked_fraction",
+        "campanile sky fit scan.csv --lat 37.8719 --lon -122.2585",
+    ] {
+        assert!(help.contains(needed), "`sky fit --help` lacks {needed:?}:\n{help}");
+    }
+    let out = campanile(&["sky", "eval", "--help"]);
+    let help = String::from_utf8_lossy(&out.stdout);
+    for needed in ["--compare", "CHANNEL_residual", "Any other columns are ignored"] {
+        assert!(help.contains(needed), "`sky eval --help` lacks {needed:?}:\n{help}");
+    }
+    let out = campanile(&["sky", "predict", "--help"]);
+    let help = String::from_utf8_lossy(&out.stdout);
+    for needed in ["--lat <LAT>", "samples 0 and masked_fraction 0"] {
+        assert!(help.contains(needed), "`sky predict --help` lacks {needed:?}:\n{help}");
+    }
+}

@@ -24,3 +24,40 @@ pub fn observer(site: &Site) -> Observer {
         site.temperature_c,
     )
 }
+
+/// The observer at `--lat`, `--lon` (north and east positive; a longitude
+/// from 180 up to 360 is taken as east of Greenwich the long way round)
+/// and `--elevation-m`, with refraction for 1013.25 mbar and 12 °C (as
+/// `campanile sun` assumes). Values outside their domains are bad input.
+pub fn observer_at(lat: f64, lon: f64, elevation_m: f64) -> Result<Observer> {
+    let checks = [
+        (
+            "--lat",
+            lat,
+            (-90.0..=90.0).contains(&lat),
+            "degrees from -90 to 90, north positive",
+        ),
+        (
+            "--lon",
+            lon,
+            (-180.0..360.0).contains(&lon),
+            "degrees from -180 up to (not including) 360, east positive",
+        ),
+        (
+            "--elevation-m",
+            elevation_m,
+            (-6_500_000.0..=1e7).contains(&elevation_m),
+            "metres above sea level, -6500000 to 10000000",
+        ),
+    ];
+    for (flag, value, ok, expected) in checks {
+        if !ok {
+            return Err(super::exit::bad_input(format!(
+                "{flag}: found {}; expected {expected}",
+                super::exit::shown(value)
+            )));
+        }
+    }
+    let lon = if lon >= 180.0 { lon - 360.0 } else { lon };
+    Ok(Observer::from_degrees(lat, lon, elevation_m, 1013.25, 12.0))
+}

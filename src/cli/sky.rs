@@ -9,22 +9,35 @@ use campanile_process::exr_io::write_radiance_exr;
 use campanile_process::hdr::merge::RadianceMap;
 use campanile_process::quality::{ProductQuality, QualityReport, gates};
 use campanile_process::sky::{
-    ChannelSky, KnownSky, SkyFile, angle_between, direction, fit_sky_robust, predict_sky, read_directions,
-    read_samples, render_latlong,
+    ChannelSelection, ChannelSky, KnownSky, SkyFile, angle_between, compare_with_samples, direction, fit_sky_robust,
+    predict_sky, read_samples, render_latlong,
 };
 use campanile_process::sun::Ephemeris;
 use chrono::{DateTime, Utc};
-use clap::{Args, Subcommand};
+use clap::{ArgGroup, Args, Subcommand};
 
 #[derive(Debug, Subcommand)]
 pub enum SkyCommand {
     /// Fit the sky model (thesis eq. 5.9) to sky samples, one model per channel.
     ///
-    /// SAMPLES is a CSV with zenith_deg, azimuth_deg (from north through
-    /// east) and one column per channel (e.g. r,g,b) of radiance. The sun's
-    /// position comes from --sun-zenith-deg/--sun-azimuth-deg, or from --time
-    /// and --station through the ephemeris. Samples within 0.5° of the sun
-    /// (the disc) are left out.
+    /// SAMPLES is a CSV with a header row and one row per sky element:
+    ///   zenith_deg    the element's zenith angle, degrees, in [0, 90]
+    ///   azimuth_deg   its azimuth, degrees from north through east
+    ///                 (-360 to 360)
+    ///   channels      its radiance, in any one unit, one column per channel:
+    ///                 those --columns names, else r,g,b (or red,green,blue;
+    ///                 any case) when all three are there, else the one
+    ///                 column named y, luminance or radiance
+    /// Other columns (ids, weights, times, notes) are ignored: their cells
+    /// are not read. For example:
+    ///   id,zenith_deg,azimuth_deg,r,g,b,note
+    ///   17,35,190,0.0521,0.0803,0.1302,clear
+    ///
+    /// The sun: --sun-zenith-deg and --sun-azimuth-deg; or --time with
+    /// --station (its site), or --time with --lat and --lon (and
+    /// --elevation-m), through the ephemeris (NREL SPA; refraction for
+    /// 1013.25 mbar and 12 °C with --lat/--lon, as `campanile sun`). Samples
+    /// within 0.5° of the sun (the disc) are left out.
     ///
     /// Samples that are not sky (buildings, trees, glare) are found and left
     /// out by robust fitting; the output gives the masked fraction.
@@ -35,12 +48,30 @@ pub enum SkyCommand {
     /// why. Weights are relative errors, so the result does not depend on
     /// the radiance unit.
     ///
-    /// Example: campanile sky fit scan.csv --time 2026-08-28T20:30:00Z \
-    ///            --station examples/sim-station.ron --out sky.ron
+    /// OUTPUT (RON, to --out or standard output): sun_zenith_deg and
+    /// sun_azimuth_deg (degrees), and per channel, in column order:
+    ///   channel          its column's name
+    ///   model            eq. (5.9)'s (lz, a, b, c, d, e, h); lz in the
+    ///                    samples' unit
+    ///   chosen, reason   the model chosen ("Cie(12)", "SevenParameter",
+    ///                    "SevenParameterFixedAureole") and why
+    ///   rms_relative     RMS of measured / fitted − 1 over the sky samples
+    ///   samples          samples used (outside the disc)
+    ///   masked_fraction  the fraction of them left out as not sky
+    ///
+    /// Examples:
+    ///   campanile sky fit scan.csv --lat 37.8719 --lon -122.2585 \
+    ///       --time 2026-08-28T20:30:00Z --out sky.ron
+    ///   campanile sky fit scan.csv --time 2026-08-28T20:30:00Z \
+    ///       --station examples/sim-station.ron --columns r_mean,g_mean,b_mean --out sky.ron
     #[command(verbatim_doc_comment)]
     Fit {
         /// Sky samples (CSV).
         samples: PathBuf,
+        /// The channel columns, in order (e.g. r,g,b); by default r,g,b,
+        /// red,green,blue, or one of y, luminance, radiance.
+        #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
+        columns: Option<Vec<String>>,
         #[command(flatten)]
         sun: SunArgs,
         /// Where to write the fitted skies (RON); standard output when absent.
@@ -65,10 +96,19 @@ pub enum SkyCommand {
     /// background and the aureole of the known skies are averaged separately
     /// with weights inversely proportional to the angle between their suns
     /// and the new sun, then a new model is fitted. Give at least one fitted
-    /// sky (RON from `sky fit`), with the same channels, and the new sun.
+    /// sky (RON from `sky fit`), with the same channels, and the new sun:
+    /// --sun-zenith-deg and --sun-azimuth-deg, or --time with --station or
+    /// with --lat and --lon (as for `sky fit`).
     ///
-    /// Example: campanile sky predict morning.ron noon.ron evening.ron \
-    ///            --time 2026-08-28T22:00:00Z --station examples/sim-station.ron --out sky.ron
+    /// OUTPUT (RON, to --out or standard output): a sky file as `sky fit`
+    /// writes (sun_zenith_deg, sun_azimuth_deg, and per channel: channel,
+    /// model (lz, a, b, c, d, e, h), chosen, reason, rms_relative), with
+    /// samples 0 and masked_fraction 0: nothing was measured. It inherits
+    /// the verdicts of the skies it came from (their .quality.json).
+    ///
+    /// Example:
+    ///   campanile sky predict morning.ron noon.ron evening.ron \
+    ///       --time 2026-08-28T22:00:00Z --lat 37.8719 --lon -122.2585 --out sky.ron
     #[command(verbatim_doc_comment)]
     Predict {
         /// Fitted skies (RON), one per time.
@@ -96,53 +136,103 @@ pub enum SkyCommand {
         #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(4..=16384))]
         width: u32,
     },
-    /// Evaluate fitted skies (RON from `sky fit`) at directions.
+    /// Evaluate fitted skies (RON from `sky fit` or `sky predict`) at directions.
     ///
-    /// DIRECTIONS is a CSV with zenith_deg and azimuth_deg; the output adds
-    /// one radiance column per channel.
+    /// DIRECTIONS is a CSV with a header row and one row per direction:
+    ///   zenith_deg    degrees, in [0, 90]
+    ///   azimuth_deg   degrees from north through east (-360 to 360)
+    /// Any other columns are ignored, so a sample file for `sky fit` will do.
+    ///
+    /// Prints a CSV: zenith_deg, azimuth_deg, then each sky channel's
+    /// radiance, named as in the sky file.
+    ///
+    /// With --compare, DIRECTIONS must also hold the sky's channel columns
+    /// (measured radiance, same names): each adds a column CHANNEL_residual,
+    /// measured / fitted − 1, and one line on standard error gives per
+    /// channel the median and 95th percentile of |measured / fitted − 1|.
+    ///
+    /// Examples:
+    ///   campanile sky eval sky.ron directions.csv
+    ///   campanile sky eval sky.ron scan.csv --compare > residuals.csv
     #[command(verbatim_doc_comment)]
     Eval {
         /// Fitted skies (RON).
         sky: PathBuf,
         /// Directions (CSV).
         directions: PathBuf,
+        /// Compare with DIRECTIONS' measured channels: add measured /
+        /// fitted − 1 columns and a summary on standard error.
+        #[arg(long)]
+        compare: bool,
     },
 }
 
+/// The sun: given, or from the ephemeris for a time and a site.
 #[derive(Debug, Args)]
+#[command(group(ArgGroup::new("site").args(["station", "lat"])))]
 pub struct SunArgs {
     /// The sun's zenith angle, degrees.
-    #[arg(long, requires = "sun_azimuth_deg", conflicts_with = "time")]
+    #[arg(
+        long,
+        requires = "sun_azimuth_deg",
+        conflicts_with_all = ["time", "station", "lat", "lon"],
+        allow_negative_numbers = true
+    )]
     sun_zenith_deg: Option<f64>,
     /// The sun's azimuth, degrees from north through east.
-    #[arg(long, requires = "sun_zenith_deg")]
+    #[arg(long, requires = "sun_zenith_deg", allow_negative_numbers = true)]
     sun_azimuth_deg: Option<f64>,
-    /// The instant the samples were taken (RFC 3339), with --station.
-    #[arg(long, requires = "station")]
+    /// The instant (RFC 3339, e.g. 2026-08-28T20:30:00Z), with --station or
+    /// with --lat and --lon.
+    #[arg(long, requires = "site", value_parser = rfc3339)]
     time: Option<DateTime<Utc>>,
     /// The station file whose site the ephemeris uses, with --time.
     #[arg(long, requires = "time")]
     station: Option<PathBuf>,
+    /// The site's latitude, degrees, north positive (-90 to 90), with --lon
+    /// and --time.
+    #[arg(long, requires_all = ["lon", "time"], allow_negative_numbers = true)]
+    lat: Option<f64>,
+    /// The site's longitude, degrees, east positive (-180 up to 360), with
+    /// --lat.
+    #[arg(long, requires = "lat", allow_negative_numbers = true)]
+    lon: Option<f64>,
+    /// The site's height above sea level, metres, with --lat [default: 0].
+    #[arg(long, requires = "lat", allow_negative_numbers = true)]
+    elevation_m: Option<f64>,
+}
+
+/// An instant as RFC 3339 gives it, for `--time`.
+fn rfc3339(text: &str) -> Result<DateTime<Utc>, String> {
+    DateTime::parse_from_rfc3339(text)
+        .map(|t| t.with_timezone(&Utc))
+        .map_err(|e| format!("expected an RFC 3339 instant such as 2026-08-28T20:30:00Z ({e})"))
 }
 
 impl SunArgs {
     /// (zenith, azimuth) in radians, for a sun that may be below the
     /// horizon (the environment is lit by the sky alone then).
     pub fn resolve_any(&self) -> Result<(f64, f64)> {
-        match (self.sun_zenith_deg, self.sun_azimuth_deg, self.time, &self.station) {
+        let site = (&self.station, self.lat, self.lon);
+        match (self.sun_zenith_deg, self.sun_azimuth_deg, self.time, site) {
             (Some(z), Some(a), _, _) if (0.0..=180.0).contains(&z) => Ok((z.to_radians(), a.to_radians())),
             (Some(z), Some(_), _, _) => Err(super::exit::bad_input(format!(
                 "--sun-zenith-deg: found {}; expected a zenith angle from 0 to 180 degrees",
                 super::exit::shown(z)
             ))),
-            (_, _, Some(t), Some(path)) => {
+            (_, _, Some(t), (Some(path), _, _)) => {
                 let s = super::site::station_site(path)?;
                 let obs = super::site::observer(&s);
                 let p = Ephemeris::at(t, s.delta_t_s)?.position(&obs)?;
                 Ok((p.zenith_rad, p.azimuth_rad))
             }
+            (_, _, Some(t), (None, Some(lat), Some(lon))) => {
+                let obs = super::site::observer_at(lat, lon, self.elevation_m.unwrap_or(0.0))?;
+                let p = Ephemeris::at(t, None)?.position(&obs)?;
+                Ok((p.zenith_rad, p.azimuth_rad))
+            }
             _ => Err(super::exit::bad_input(
-                "give the sun: --sun-zenith-deg and --sun-azimuth-deg, or --time and --station",
+                "give the sun: --sun-zenith-deg and --sun-azimuth-deg, or --time with --station or with --lat and --lon",
             )),
         }
     }
@@ -169,6 +259,7 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
     match cmd {
         SkyCommand::Fit {
             samples,
+            columns,
             sun,
             out,
             residual_map,
@@ -177,7 +268,9 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
             let q = super::verdicts::thresholds(thresholds.as_deref(), None)?;
             let (zs, az) = sun.resolve()?;
             let file = File::open(&samples).with_context(|| format!("{}: cannot open", samples.display()))?;
-            let table = read_samples(BufReader::new(file)).with_context(|| format!("{}", samples.display()))?;
+            let selection = columns.map_or(ChannelSelection::Auto, ChannelSelection::Named);
+            let table =
+                read_samples(BufReader::new(file), &selection).with_context(|| format!("{}", samples.display()))?;
             let sun_dir = direction(zs, az);
             let mut channels = Vec::new();
             let mut converged = [true; 3];
@@ -306,25 +399,57 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
             write_radiance_exr(&map, &out).with_context(|| format!("{}: cannot write", out.display()))?;
             Ok(())
         }
-        SkyCommand::Eval { sky, directions } => {
+        SkyCommand::Eval {
+            sky,
+            directions,
+            compare,
+        } => {
             let sky_file = read_sky(&sky)?;
-            let file = File::open(&directions).with_context(|| format!("{}: cannot open", directions.display()))?;
-            let table = read_directions(BufReader::new(file)).with_context(|| format!("{}", directions.display()))?;
-            let sun_dir = direction(
-                sky_file.sun_zenith_deg.to_radians(),
-                sky_file.sun_azimuth_deg.to_radians(),
-            );
-            let mut out = std::io::stdout().lock();
             let names: Vec<&str> = sky_file.channels.iter().map(|c| c.channel.as_str()).collect();
-            writeln!(out, "zenith_deg,azimuth_deg,{}", names.join(","))?;
-            for &(z, a) in &table.directions {
-                let g = angle_between(direction(z, a), sun_dir);
-                let vals: Vec<String> = sky_file
-                    .channels
+            let selection = if compare {
+                ChannelSelection::Named(names.iter().map(|&n| n.to_owned()).collect())
+            } else {
+                ChannelSelection::Directions
+            };
+            let file = File::open(&directions).with_context(|| format!("{}: cannot open", directions.display()))?;
+            let table = read_samples(BufReader::new(file), &selection).with_context(|| {
+                if compare {
+                    format!("{}: --compare needs the sky's channels", directions.display())
+                } else {
+                    format!("{}", directions.display())
+                }
+            })?;
+            let compared = if compare {
+                compare_with_samples(&sky_file, &table)
+            } else {
+                Vec::new()
+            };
+            let mut out = std::io::stdout().lock();
+            let mut header = format!("zenith_deg,azimuth_deg,{}", names.join(","));
+            for c in &compared {
+                header += &format!(",{}_residual", c.channel);
+            }
+            writeln!(out, "{header}")?;
+            for (row, &(z, a)) in table.directions.iter().enumerate() {
+                let mut line = format!("{:.6},{:.6}", z.to_degrees(), a.to_degrees());
+                for v in sky_file.radiance(z, a) {
+                    line += &format!(",{v:.9e}");
+                }
+                for c in &compared {
+                    line += &format!(",{:.6e}", c.ratio_minus_1[row]);
+                }
+                writeln!(out, "{line}")?;
+            }
+            if !compared.is_empty() {
+                let parts: Vec<String> = compared
                     .iter()
-                    .map(|c| format!("{:.9e}", c.model.radiance(z, g)))
+                    .map(|c| format!("{} median {:.5}, p95 {:.5}", c.channel, c.median_abs, c.p95_abs))
                     .collect();
-                writeln!(out, "{:.6},{:.6},{}", z.to_degrees(), a.to_degrees(), vals.join(","))?;
+                eprintln!(
+                    "compared {} samples, |measured / fitted − 1|: {}",
+                    table.directions.len(),
+                    parts.join("; ")
+                );
             }
             Ok(())
         }

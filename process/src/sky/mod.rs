@@ -7,6 +7,7 @@
 //! the sun, both in radians.
 
 mod cie;
+mod compare;
 mod daylight;
 mod file;
 mod fit;
@@ -18,8 +19,9 @@ mod predict;
 mod seven_parameter;
 
 pub use cie::{CieSky, CieSkyType};
+pub use compare::{ChannelComparison, compare_with_samples};
 pub use daylight::{Atmosphere, Daylight, REDDENING_ONSET_AIR_MASS, SUN_ANGULAR_RADIUS_RAD};
-pub use file::{ChannelSky, SampleTable, SampleTableError, SkyFile, read_directions, read_samples};
+pub use file::{ChannelSelection, ChannelSky, SampleTable, SampleTableError, SkyFile, read_directions, read_samples};
 pub use fit::{
     Candidate, Convergence, MAX_MASKED_FRACTION, OUTLIER_FLOOR, PARAMETER_NAMES, PARAMETER_RANGES, RCOND_FLOOR,
     RobustSkyFit, SkyFit, SkyFitError, SkyFitOptions, SkyModelKind, SkySample, Termination, WEIGHT_FLOOR, fit_sky,
