@@ -9,8 +9,8 @@ use campanile_process::exr_io::write_radiance_exr;
 use campanile_process::hdr::merge::RadianceMap;
 use campanile_process::quality::{ProductQuality, QualityReport, gates};
 use campanile_process::sky::{
-    ChannelSelection, ChannelSky, KnownSky, SkyFile, angle_between, compare_with_samples, direction, fit_sky_robust,
-    predict_sky, read_samples, render_latlong,
+    ChannelSelection, ChannelSky, KnownSky, SkyFile, SkyFitOptions, angle_between, compare_with_samples, direction,
+    fit_sky_with, predict_sky, read_samples, render_latlong,
 };
 use campanile_process::sun::Ephemeris;
 use chrono::{DateTime, Utc};
@@ -39,25 +39,39 @@ pub enum SkyCommand {
     /// 1013.25 mbar and 12 °C with --lat/--lon, as `campanile sun`). Samples
     /// within 0.5° of the sun (the disc) are left out.
     ///
-    /// Samples that are not sky (buildings, trees, glare) are found and left
-    /// out by robust fitting; the output gives the masked fraction.
+    /// Samples that are not sky (buildings, the mount, trees, glare) are
+    /// found and left out: a graduated robust fit of the sky, then every
+    /// sample more than max(3 robust deviations, 5%) off that fit in
+    /// |ln(measured/model)| is masked, at most --max-masked of them (the
+    /// worst first). --no-reject fits every sample.
     ///
-    /// Each channel gets the smallest model the data supports: one of the 15
-    /// CIE standard skies, or the seven-parameter sky (with the aureole fixed
-    /// when no sample is within 10° of the sun); the output says which and
-    /// why. Weights are relative errors, so the result does not depend on
-    /// the radiance unit.
+    /// Each channel gets the smallest model the data supports, by the
+    /// Bayesian information criterion: the best of the 15 CIE standard
+    /// skies (scale only), eq. 5.9 with the aureole fixed (4 parameters),
+    /// the Perez all-weather form (h = 1, 6) or the seven-parameter sky (7);
+    /// the output says which and why. Bounded Levenberg–Marquardt, started
+    /// from the best of the CIE and Perez-table skies; weights are relative
+    /// errors, so the result does not depend on the radiance unit.
     ///
     /// OUTPUT (RON, to --out or standard output): sun_zenith_deg and
     /// sun_azimuth_deg (degrees), and per channel, in column order:
     ///   channel          its column's name
     ///   model            eq. (5.9)'s (lz, a, b, c, d, e, h); lz in the
     ///                    samples' unit
-    ///   chosen, reason   the model chosen ("Cie(12)", "SevenParameter",
-    ///                    "SevenParameterFixedAureole") and why
+    ///   chosen, reason   the model chosen ("Cie(12)", "Perez",
+    ///                    "SevenParameter", "SevenParameterFixedAureole")
+    ///                    and why
     ///   rms_relative     RMS of measured / fitted − 1 over the sky samples
     ///   samples          samples used (outside the disc)
     ///   masked_fraction  the fraction of them left out as not sky
+    ///   masked           how many, darker or brighter, and the threshold
+    ///   convergence      the optimizer's ending: converged, termination
+    ///                    (Gradient, Reduction, Step, Exact, ClosedForm, or
+    ///                    Evaluations: not converged), iterations,
+    ///                    evaluations, and any parameter that ended at a
+    ///                    bound of its range (the sky's verdict is then poor)
+    /// The log (standard error) gives one line per channel: the model, the
+    /// residual, the masking and the convergence.
     ///
     /// Examples:
     ///   campanile sky fit scan.csv --lat 37.8719 --lon -122.2585 \
@@ -89,6 +103,14 @@ pub enum SkyCommand {
         /// standard error); a failed fit exits 3.
         #[arg(long, value_name = "FILE.ron")]
         thresholds: Option<PathBuf>,
+        /// Fit every sample: no outlier rejection.
+        #[arg(long)]
+        no_reject: bool,
+        /// The largest fraction of samples that may be masked as not sky
+        /// (0 to 1); more outliers than that are kept, and said so.
+        #[arg(long, default_value_t = campanile_process::sky::MAX_MASKED_FRACTION, value_name = "FRACTION",
+              value_parser = fraction)]
+        max_masked: f64,
     },
     /// Predict the sky at another sun position from skies fitted at others.
     ///
@@ -264,7 +286,13 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
             out,
             residual_map,
             thresholds,
+            no_reject,
+            max_masked,
         } => {
+            let options = SkyFitOptions {
+                reject_outliers: !no_reject,
+                max_masked_fraction: max_masked,
+            };
             let q = super::verdicts::thresholds(thresholds.as_deref(), None)?;
             let (zs, az) = sun.resolve()?;
             let file = File::open(&samples).with_context(|| format!("{}: cannot open", samples.display()))?;
@@ -276,18 +304,18 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
             let mut converged = [true; 3];
             for (c, name) in table.channels.iter().enumerate() {
                 let pts = table.sky_samples(c, sun_dir);
-                let robust =
-                    fit_sky_robust(&pts, zs).with_context(|| format!("{}: channel {name}", samples.display()))?;
+                let robust = fit_sky_with(&pts, zs, &options)
+                    .with_context(|| format!("{}: channel {name}", samples.display()))?;
                 let fit = &robust.fit;
+                tracing::debug!(channel = %name, "{}", fit.reason);
                 tracing::info!(
-                    channel = %name,
-                    model = ?fit.kind,
-                    rms = fit.rms_relative,
-                    masked = robust.masked_fraction,
-                    "{}",
-                    fit.reason
+                    "{name}: {}, RMS residual {:.3}%, {}; {}",
+                    fit.kind.label(),
+                    100.0 * fit.rms_relative,
+                    robust.masked_summary(),
+                    fit.convergence.summary()
                 );
-                channels.push(ChannelSky::new(name, fit, pts.len(), robust.masked_fraction));
+                channels.push(ChannelSky::of_robust(name, &robust));
                 if let Some(slot) = converged.get_mut(c) {
                     *slot = fit.converged;
                 }
@@ -453,5 +481,13 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
             }
             Ok(())
         }
+    }
+}
+
+/// A fraction in [0, 1], for --max-masked.
+fn fraction(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(x) if (0.0..=1.0).contains(&x) => Ok(x),
+        _ => Err(format!("found {text:?}; expected a fraction from 0 to 1")),
     }
 }
