@@ -81,6 +81,8 @@ mod tests {
                 rms_relative: 0.0,
                 samples: 0,
                 masked_fraction: 0.0,
+                masked: None,
+                convergence: None,
             }],
         };
         let dirs: Vec<(f64, f64)> = (0..20)
