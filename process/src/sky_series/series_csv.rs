@@ -36,7 +36,7 @@ pub const SERIES_COLUMNS: &[(&str, &str)] = &[
     ),
     (
         "sky_model_{c}",
-        "text: eq. (5.9) model chosen for channel {c} (SevenParameter, SevenParameterFixedAureole or Cie(N))",
+        "text: eq. (5.9) model chosen for channel {c} (Perez, SevenParameter, SevenParameterFixedAureole or Cie(N))",
     ),
     ("sky_lz_{c}_w_m2_sr", "W·m⁻²·sr⁻¹: eq. (5.9) scale Lz, channel {c}"),
     ("sky_a_{c}", "unitless: gradation coefficient a, channel {c}"),
