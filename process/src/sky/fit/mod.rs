@@ -308,6 +308,11 @@ fn rescaled(prep: &Prepared, m: &SkyModel) -> (SkyModel, f64) {
 /// wrong minimum, 1.8% p95, where the second start reaches 0.1%).
 const SECOND_START_RMS: f64 = 0.003;
 
+/// The relative standard error under which the Perez fit's c and d count
+/// as pinned by the samples (1%), so that the fixed-aureole candidate is not
+/// fitted.
+const AUREOLE_PINNED: f64 = 0.01;
+
 /// The free θ entries of the Perez form (h held at 1).
 const PEREZ_FREE: [usize; 6] = [0, 1, 2, 3, 4, 5];
 /// All seven.
@@ -394,17 +399,33 @@ fn fit_prepared(prep: &Prepared, starts: &[Start], first: Option<SkyModel>) -> S
             fits.push((SkyModelKind::SevenParameter, 7, Some(out.clone()), m7, 2.0 * out.cost));
         }
     }
-    if let Some(out) = run(&starts[0].model, &FIXED_AUREOLE_FREE, &mut evaluations) {
-        let m = model_of(&out.theta);
-        fits.push((
-            SkyModelKind::SevenParameterFixedAureole,
-            4,
-            Some(out.clone()),
-            m,
-            2.0 * out.cost,
-        ));
+    // The aureole fixed, unless the Perez fit already pins it: c and d
+    // each known to within AUREOLE_PINNED of themselves (their standard
+    // errors from its JᵀJ), when holding them at a start's values can only
+    // fit worse for fewer parameters than BIC would forgive.
+    let pinned = perez.as_ref().and_then(|p| {
+        let (c, d) = (p.theta[3], p.theta[4]);
+        let (sc, sd) = (p.standard_errors[3], p.standard_errors[4]);
+        (sc <= AUREOLE_PINNED * c.abs() && sd <= AUREOLE_PINNED * d.abs())
+            .then(|| format!("the samples pin the aureole (c = {c:.3} ± {sc:.1e}, d = {d:.3} ± {sd:.1e})"))
+    });
+    let mut skipped: Vec<(SkyModelKind, usize, String)> = Vec::new();
+    match pinned {
+        Some(why) => skipped.push((SkyModelKind::SevenParameterFixedAureole, 4, why)),
+        None => {
+            if let Some(out) = run(&starts[0].model, &FIXED_AUREOLE_FREE, &mut evaluations) {
+                let m = model_of(&out.theta);
+                fits.push((
+                    SkyModelKind::SevenParameterFixedAureole,
+                    4,
+                    Some(out.clone()),
+                    m,
+                    2.0 * out.cost,
+                ));
+            }
+        }
     }
-    let candidates: Vec<Candidate> = fits
+    let mut candidates: Vec<Candidate> = fits
         .iter()
         .map(|(kind, k, out, _, rss)| {
             let excluded = if !rss.is_finite() {
@@ -430,6 +451,13 @@ fn fit_prepared(prep: &Prepared, starts: &[Start], first: Option<SkyModel>) -> S
             }
         })
         .collect();
+    candidates.extend(skipped.into_iter().map(|(kind, parameters, why)| Candidate {
+        kind,
+        parameters,
+        rss: f64::INFINITY,
+        bic: f64::INFINITY,
+        excluded: Some(format!("not fitted: {why}")),
+    }));
     // Smallest BIC among the eligible; on a tie, fewer parameters.
     let winner = (0..candidates.len())
         .filter(|&i| candidates[i].excluded.is_none())

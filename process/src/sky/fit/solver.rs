@@ -391,6 +391,10 @@ pub struct Outcome {
     /// factor's diagonal): near 0, some combination of the free parameters
     /// is not determined by the samples.
     pub rcond: f64,
+    /// The standard error of each free parameter (in `free`'s order), from
+    /// (JᵀJ)⁻¹ scaled by the residual variance 2·cost / (n − k); NaN when
+    /// JᵀJ is singular.
+    pub standard_errors: [f64; 7],
 }
 
 /// Solves `m x = rhs` for a symmetric positive definite k × k `m` by
@@ -434,6 +438,20 @@ fn cholesky_solve(m: &[[f64; 7]; 7], rhs: &[f64; 7], k: usize) -> Option<([f64; 
         (lo.min(l[i][i]), hi.max(l[i][i]))
     });
     Some((x, lo, hi))
+}
+
+/// √diag((JᵀJ)⁻¹ · 2 cost / (n − k)).
+fn standard_errors(ev: &Evaluation, k: usize, n: usize) -> [f64; 7] {
+    let mut out = [f64::NAN; 7];
+    let variance = 2.0 * ev.cost / (n.saturating_sub(k).max(1)) as f64;
+    for j in 0..k {
+        let mut e = [0.0; 7];
+        e[j] = 1.0;
+        if let Some((col, _, _)) = cholesky_solve(&ev.jtj, &e, k) {
+            out[j] = (col[j] * variance).max(0.0).sqrt();
+        }
+    }
+    out
 }
 
 /// The reciprocal condition estimate of JᵀJ with its columns scaled to unit
@@ -601,6 +619,7 @@ pub fn minimize(
         evaluations,
         at_bound,
         rcond: rcond(&ev.jtj, k),
+        standard_errors: standard_errors(&ev, k, prep.len()),
     })
 }
 
