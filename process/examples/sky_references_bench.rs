@@ -16,6 +16,7 @@ use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
+use campanile_process::error_figures::quantile;
 use campanile_process::sky::{SkyModel, SkySample, angle_between, direction, fit_sky, fit_sky_robust};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -41,9 +42,7 @@ fn errors(m: &SkyModel, samples: &[SkySample], truth: &[f64]) -> (f64, f64, f64)
         .zip(truth)
         .map(|(s, &y)| (m.radiance(s.xi, s.gamma) / y - 1.0).abs())
         .collect();
-    e.sort_by(f64::total_cmp);
-    let q = |p: f64| e[((e.len() as f64 * p).ceil() as usize).clamp(1, e.len()) - 1];
-    (q(0.5), q(0.95), e[e.len() - 1])
+    (quantile(&mut e, 0.5), quantile(&mut e, 0.95), quantile(&mut e, 1.0))
 }
 
 fn main() -> Result<(), Error> {

@@ -9,6 +9,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+use campanile_process::error_figures::quantile;
 use campanile_process::sky::{
     PARAMETER_RANGES, PerezSky, SkyModel, SkySample, angle_between, direction, fit_sky, fit_sky_robust, table_extremes,
 };
@@ -97,9 +98,7 @@ fn errors(m: &SkyModel, samples: &[SkySample], truth: &[f64]) -> (f64, f64, f64)
         .zip(truth)
         .map(|(s, &y)| (m.radiance(s.xi, s.gamma) / y - 1.0).abs())
         .collect();
-    e.sort_by(f64::total_cmp);
-    let q = |p: f64| e[((e.len() as f64 * p).ceil() as usize).clamp(1, e.len()) - 1];
-    (q(0.5), q(0.95), e[e.len() - 1])
+    (quantile(&mut e, 0.5), quantile(&mut e, 0.95), quantile(&mut e, 1.0))
 }
 
 fn gaussian(rng: &mut ChaCha8Rng) -> f64 {

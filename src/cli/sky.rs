@@ -301,7 +301,6 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
                 read_samples(BufReader::new(file), &selection).with_context(|| format!("{}", samples.display()))?;
             let sun_dir = direction(zs, az);
             let mut channels = Vec::new();
-            let mut converged = [true; 3];
             for (c, name) in table.channels.iter().enumerate() {
                 let pts = table.sky_samples(c, sun_dir);
                 let robust = fit_sky_with(&pts, zs, &options)
@@ -316,9 +315,6 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
                     fit.convergence.summary()
                 );
                 channels.push(ChannelSky::of_robust(name, &robust));
-                if let Some(slot) = converged.get_mut(c) {
-                    *slot = fit.converged;
-                }
             }
             let sky = SkyFile {
                 sun_zenith_deg: zs.to_degrees(),
@@ -346,7 +342,7 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
             let name = samples
                 .file_name()
                 .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-            let quality = QualityReport::new(vec![gates::sky(&name, &sky.channels, Some(converged), &q)], &q);
+            let quality = QualityReport::new(vec![gates::sky(&name, &sky.channels, &q)], &q);
             match &out {
                 Some(path) => super::verdicts::finish(&quality, &super::verdicts::beside(path)),
                 None => super::verdicts::finish_on_stderr(&quality),

@@ -138,14 +138,14 @@ pub fn sun(name: &str, spread: [f64; 3], measured: usize, refused: &[String], q:
 
 /// A sky fit, per channel: the residual and the samples masked, with
 /// the model chosen and why, what was masked and the optimizer's ending as
-/// notes. Convergence comes from each channel's record, else from
-/// `converged`: a fit that did not converge fails; one with a parameter at
-/// a bound of its range is at best `poor`.
-pub fn sky(name: &str, channels: &[ChannelSky], converged: Option<[bool; 3]>, q: &Quality) -> ProductQuality {
+/// notes. Convergence comes from each channel's record (absent in files
+/// written before it was kept): a fit that did not converge fails; one with
+/// a parameter at a bound of its range is at best `poor`.
+pub fn sky(name: &str, channels: &[ChannelSky], q: &Quality) -> ProductQuality {
     let g = &q.sky;
     let mut checks = Vec::new();
     let mut notes = Vec::new();
-    for (c, ch) in channels.iter().enumerate() {
+    for ch in channels {
         checks.push(Check::new(
             format!("{}: RMS relative residual ({} samples)", ch.channel, ch.samples),
             ch.rms_relative,
@@ -170,7 +170,7 @@ pub fn sky(name: &str, channels: &[ChannelSky], converged: Option<[bool; 3]>, q:
                 notes.push(format!("{}: {}", ch.channel, cv.summary()));
                 (cv.converged, cv.at_bound.len())
             }
-            None => (converged.is_none_or(|v| v.get(c).copied().unwrap_or(true)), 0),
+            None => (true, 0),
         };
         if !done {
             checks.push(Check::new(
@@ -244,7 +244,7 @@ pub fn scan(scan: &ScanProducts, q: &Quality) -> Vec<ProductQuality> {
         None => not_made("sun", "no sun shot"),
     };
     let sky = match &scan.sky {
-        Some(channels) => Some(sky(occ, channels, None, q)),
+        Some(channels) => Some(sky(occ, channels, q)),
         None => not_made("sky", "no sky scan"),
     };
     [sun, sky].into_iter().flatten().collect()
@@ -377,14 +377,14 @@ mod tests {
                 at_bound,
             }),
         };
-        assert_eq!(sky("s", &[channel(true, vec![])], None, &q).verdict, Verdict::Ok);
-        let bound = sky("s", &[channel(true, vec!["a = -3 (lower bound)".into()])], None, &q);
+        assert_eq!(sky("s", &[channel(true, vec![])], &q).verdict, Verdict::Ok);
+        let bound = sky("s", &[channel(true, vec!["a = -3 (lower bound)".into()])], &q);
         assert_eq!(bound.verdict, Verdict::Poor, "{bound:?}");
         assert!(
             bound.notes.iter().any(|n| n.contains("a = -3 (lower bound)")),
             "{:?}",
             bound.notes
         );
-        assert_eq!(sky("s", &[channel(false, vec![])], None, &q).verdict, Verdict::Failed);
+        assert_eq!(sky("s", &[channel(false, vec![])], &q).verdict, Verdict::Failed);
     }
 }

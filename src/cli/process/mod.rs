@@ -606,10 +606,7 @@ fn light_quality(l: &OccurrenceLight, response: &ProductQuality, q: &Quality) ->
         None => not_made("sun", "no sun shot"),
     };
     let sky = match (&l.sky, sky_file(l)) {
-        (Some(fits), Some(file)) => {
-            let converged = [0, 1, 2].map(|c| fits.get(c).is_none_or(|f| f.fit.converged));
-            Some(gates::sky(occ, &file.channels, Some(converged), q))
-        }
+        (Some(_), Some(file)) => Some(gates::sky(occ, &file.channels, q)),
         _ => not_made("sky", "no sky scan"),
     };
     let env = l.environment.as_ref().map(|m| gates::environment(occ, m, q));

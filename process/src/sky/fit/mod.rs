@@ -195,9 +195,6 @@ pub struct SkyFit {
     pub candidates: Vec<Candidate>,
     /// Residual evaluations Levenberg–Marquardt used, over all candidates.
     pub evaluations: usize,
-    /// Whether the winning model's optimizer converged
-    /// (`convergence.converged`).
-    pub converged: bool,
     /// How the winning model's optimizer ended.
     pub convergence: Convergence,
     /// The start the optimizer began from, in words.
@@ -284,16 +281,7 @@ fn model_of(theta: &[f64; 7]) -> SkyModel {
 
 /// The weighted RSS of a model with its scale refitted in closed form.
 fn rescaled(prep: &Prepared, m: &SkyModel) -> (SkyModel, f64) {
-    let t = [1.0, m.a, m.b, m.c, m.d, m.e, m.h];
-    let (mut sy, mut ss, mut yy) = (0.0, 0.0, 0.0);
-    for i in 0..prep.len() {
-        let w = prep.inv_sigma(i);
-        let s = prep.model_at(&t, i) * w;
-        let y = prep.y(i) * w;
-        sy += s * y;
-        ss += s * s;
-        yy += y * y;
-    }
+    let (sy, ss, yy) = prep.scale_sums(&[1.0, m.a, m.b, m.c, m.d, m.e, m.h], 1);
     let lz = if ss > 0.0 {
         (sy / ss).max(f64::MIN_POSITIVE)
     } else {
@@ -497,7 +485,6 @@ fn fit_prepared(prep: &Prepared, starts: &[Start], first: Option<SkyModel>) -> S
         rms_relative: (rss / n as f64).sqrt(),
         candidates,
         evaluations,
-        converged: convergence.converged,
         convergence,
         start,
         start_model,

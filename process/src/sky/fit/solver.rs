@@ -198,6 +198,23 @@ impl Prepared {
         self.inv_sigma[i]
     }
 
+    /// Over every `step`-th sample, the weighted sums (Σ S y, Σ S², Σ y²)
+    /// of the shape S = the model of `t` and the samples y, each divided by
+    /// σ: the scale that fits S to y in closed form is Σ S y / Σ S², its
+    /// residual sum of squares Σ y² − (Σ S y)² / Σ S².
+    pub fn scale_sums(&self, t: &[f64; 7], step: usize) -> (f64, f64, f64) {
+        let (mut sy, mut ss, mut yy) = (0.0, 0.0, 0.0);
+        for i in (0..self.len()).step_by(step.max(1)) {
+            let w = self.inv_sigma[i];
+            let s = self.model_at(t, i) * w;
+            let y = self.y[i] * w;
+            sy += s * y;
+            ss += s * s;
+            yy += y * y;
+        }
+        (sy, ss, yy)
+    }
+
     /// The model's value at sample i, for θ's natural parameters
     /// `[Lz, a, b, c, d, e, h]`.
     pub fn model_at(&self, t: &[f64; 7], i: usize) -> f64 {

@@ -103,16 +103,7 @@ pub fn scored_least_squares(prep: &Prepared, sun_zenith: f64) -> Vec<Start> {
     let mut out: Vec<Start> = shapes(sun_zenith)
         .into_iter()
         .filter_map(|(shape, origin)| {
-            let t = params(&shape);
-            let (mut sy, mut ss, mut yy) = (0.0, 0.0, 0.0);
-            for i in (0..prep.len()).step_by(step) {
-                let w = prep.inv_sigma(i);
-                let s = prep.model_at(&t, i) * w;
-                let y = prep.y(i) * w;
-                sy += s * y;
-                ss += s * s;
-                yy += y * y;
-            }
+            let (sy, ss, yy) = prep.scale_sums(&params(&shape), step);
             if !(ss > 0.0 && sy > 0.0 && ss.is_finite() && sy.is_finite()) {
                 return None;
             }
