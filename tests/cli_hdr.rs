@@ -4,11 +4,16 @@
 
 mod common;
 
+use std::path::Path;
+
+use campanile_process::camera::image::{CodeImage, RadianceImage};
 use campanile_process::camera::sensor::CameraModel;
 use campanile_process::camera::test_chart::hdr_chart;
-use campanile_process::exr_io::read_radiance_exr;
+use campanile_process::exr_io::{read_radiance_exr, read_rgb_exr};
 use campanile_process::hdr::image_file::write_png;
 use common::campanile;
+use exif::experimental::Writer;
+use exif::{Field, In, Rational, Tag, Value};
 
 #[test]
 fn calibrate_then_merge_recovers_the_chart_radiance() {
@@ -43,6 +48,7 @@ fn calibrate_then_merge_recovers_the_chart_radiance() {
     let mut args = vec![
         "hdr",
         "merge",
+        "--with-variance",
         "--times",
         &times_arg,
         "--curve",
@@ -205,4 +211,313 @@ fn duplicate_exposure_times_are_a_usage_error() {
     let out = campanile(&args);
     assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(!curve.exists(), "no partial output");
+}
+
+/// EXIF settings of a test JPEG: exposure time, f-number, ISO, orientation.
+struct Settings {
+    time: (u32, u32),
+    f_number: (u32, u32),
+    iso: u16,
+    orientation: u16,
+}
+
+/// Writes `img` as a quality-95 JPEG with an EXIF block (APP1) carrying `s`.
+fn write_jpeg_with_exif(img: &CodeImage, path: &Path, s: &Settings) {
+    let rgb: Vec<u8> = img.data.iter().map(|&z| z as u8).collect();
+    let mut jpeg = Vec::new();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, 95)
+        .encode(
+            &rgb,
+            img.width as u32,
+            img.height as u32,
+            image::ExtendedColorType::Rgb8,
+        )
+        .expect("jpeg");
+    let rational = |(num, denom): (u32, u32)| Value::Rational(vec![Rational { num, denom }]);
+    let fields = [
+        Field {
+            tag: Tag::ExposureTime,
+            ifd_num: In::PRIMARY,
+            value: rational(s.time),
+        },
+        Field {
+            tag: Tag::FNumber,
+            ifd_num: In::PRIMARY,
+            value: rational(s.f_number),
+        },
+        Field {
+            tag: Tag::PhotographicSensitivity,
+            ifd_num: In::PRIMARY,
+            value: Value::Short(vec![s.iso]),
+        },
+        Field {
+            tag: Tag::Orientation,
+            ifd_num: In::PRIMARY,
+            value: Value::Short(vec![s.orientation]),
+        },
+    ];
+    let mut writer = Writer::new();
+    for f in &fields {
+        writer.push_field(f);
+    }
+    let mut tiff = std::io::Cursor::new(Vec::new());
+    writer.write(&mut tiff, false).expect("exif");
+    let tiff = tiff.into_inner();
+    let mut out = jpeg[..2].to_vec();
+    out.extend_from_slice(&[0xFF, 0xE1]);
+    out.extend_from_slice(&((2 + 6 + tiff.len()) as u16).to_be_bytes());
+    out.extend_from_slice(b"Exif\0\0");
+    out.extend_from_slice(&tiff);
+    out.extend_from_slice(&jpeg[2..]);
+    std::fs::write(path, out).expect("write jpeg");
+}
+
+/// `img` as stored by a camera held on its side: the upright image turned
+/// 90° counter-clockwise, to be turned back by EXIF orientation 6.
+fn stored_on_its_side(img: &CodeImage) -> CodeImage {
+    let (w, h) = (img.width, img.height);
+    let mut data = Vec::with_capacity(img.data.len());
+    for ys in 0..w {
+        for xs in 0..h {
+            let (x, y) = (w - 1 - ys, xs);
+            data.extend_from_slice(&img.data[(y * w + x) * 3..(y * w + x) * 3 + 3]);
+        }
+    }
+    CodeImage {
+        width: h,
+        height: w,
+        data,
+        ..img.clone()
+    }
+}
+
+/// Median relative error of `map` against `truth` after the best scale per
+/// channel (the curve's gauge is free), on pixels whose three channels lie
+/// within the chart's well-exposed range.
+fn median_error_after_scale(map: &RadianceImage, truth: &RadianceImage) -> [f64; 3] {
+    std::array::from_fn(|c| {
+        let mut ratios: Vec<f64> = (0..truth.width * truth.height)
+            .map(|p| f64::from(map.data[3 * p + c]) / f64::from(truth.data[3 * p + c]))
+            .filter(|r| r.is_finite() && *r > 0.0)
+            .collect();
+        ratios.sort_by(f64::total_cmp);
+        let scale = ratios[ratios.len() / 2];
+        let mut rel: Vec<f64> = ratios.iter().map(|r| (r / scale - 1.0).abs()).collect();
+        rel.sort_by(f64::total_cmp);
+        rel[rel.len() / 2]
+    })
+}
+
+/// Issue 23: camera JPEGs with EXIF calibrate and merge with no --times and
+/// no override; the orientation tag is applied; a bracket that varies
+/// aperture and ISO instead of time merges to the same radiance.
+#[test]
+fn exif_jpegs_calibrate_and_merge_without_times() {
+    let dir = tempfile::tempdir().expect("temp");
+    let (w, h) = (128, 96);
+    let chart = hdr_chart(w, h);
+    let camera = CameraModel::typical(8);
+    // A time bracket, 2 stops apart, stored on its side (orientation 6).
+    let mut side = Vec::new();
+    for k in 0..7u32 {
+        let t = (1u32 << (2 * k), 64u32);
+        let p = dir.path().join(format!("IMG_{k}.JPG"));
+        let shot = camera.photograph(&chart, f64::from(t.0) / f64::from(t.1), 11 + u64::from(k));
+        let settings = Settings {
+            time: t,
+            f_number: (8, 1),
+            iso: 100,
+            orientation: 6,
+        };
+        write_jpeg_with_exif(&stored_on_its_side(&shot), &p, &settings);
+        side.push(p.to_str().expect("utf-8").to_owned());
+    }
+    let curve = dir.path().join("curve.csv");
+    let mut args = vec!["hdr", "calibrate", "-o", curve.to_str().expect("utf-8")];
+    args.extend(side.iter().map(String::as_str));
+    let out = campanile(&args);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("IMG_0.JPG: EXIF 1/64 s, f/8, ISO 100 → exposure 0.015625 s"),
+        "{stdout}"
+    );
+
+    let exr = dir.path().join("side.exr");
+    let mut args = vec![
+        "hdr",
+        "merge",
+        "--curve",
+        curve.to_str().expect("utf-8"),
+        "-o",
+        exr.to_str().expect("utf-8"),
+    ];
+    args.extend(side.iter().map(String::as_str));
+    let out = campanile(&args);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let map = read_rgb_exr(&exr).expect("plain RGB EXR");
+    assert_eq!((map.width, map.height), (w, h), "turned upright");
+    let err = median_error_after_scale(&map, &chart);
+    assert!(
+        err.iter().all(|&e| e < 0.03),
+        "orientation-6 bracket: median errors {err:?}"
+    );
+
+    // Same relative exposures from aperture and ISO: t·ISO/N² = 1, 4, 16, 64, 256 × (1/64 s at f/8, ISO 100).
+    let plan = [
+        ((1, 64), (8, 1), 100),
+        ((1, 64), (4, 1), 100),
+        ((1, 64), (4, 1), 400),
+        ((1, 16), (4, 1), 400),
+        ((1, 4), (4, 1), 400),
+    ];
+    let mut mixed = Vec::new();
+    for (k, &(time, f_number, iso)) in plan.iter().enumerate() {
+        let t_eff = 4f64.powi(k as i32) / 64.0;
+        let p = dir.path().join(format!("mixed_{k}.jpg"));
+        let settings = Settings {
+            time,
+            f_number,
+            iso,
+            orientation: 1,
+        };
+        write_jpeg_with_exif(&camera.photograph(&chart, t_eff, 40 + k as u64), &p, &settings);
+        mixed.push(p.to_str().expect("utf-8").to_owned());
+    }
+    let exr2 = dir.path().join("mixed.exr");
+    let mut args = vec![
+        "hdr",
+        "merge",
+        "--curve",
+        curve.to_str().expect("utf-8"),
+        "-o",
+        exr2.to_str().expect("utf-8"),
+    ];
+    args.extend(mixed.iter().map(String::as_str));
+    let out = campanile(&args);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let map2 = read_rgb_exr(&exr2).expect("plain RGB EXR");
+    // Against the time bracket's map: same scale (same curve, same gauge).
+    for c in 0..3 {
+        let mut rel: Vec<f64> = (0..w * h)
+            .map(|p| (f64::from(map2.data[3 * p + c]) / f64::from(map.data[3 * p + c]) - 1.0).abs())
+            .filter(|r| r.is_finite())
+            .collect();
+        rel.sort_by(f64::total_cmp);
+        let median = rel[rel.len() / 2];
+        assert!(
+            median < 0.03,
+            "channel {c}: aperture/ISO bracket vs time bracket median {median}"
+        );
+    }
+
+    // A PNG without EXIF and no --times: a usage error naming the file and the way out.
+    let png = dir.path().join("plain.png");
+    write_png(&camera.photograph(&chart, 0.1, 1), &png).expect("png");
+    let out = campanile(&["hdr", "calibrate", "-o", curve.to_str().unwrap(), png.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("plain.png") && stderr.contains("ExposureTime") && stderr.contains("--times"),
+        "{stderr}"
+    );
+}
+
+/// Issue 23: a green channel that a camera clips at 254 in every exposure
+/// (the phone's moon) is marked clipped, not merged into a magenta pixel;
+/// the radiance map is also written as Radiance RGBE.
+#[test]
+fn channel_clipped_below_the_largest_code_is_masked() {
+    let dir = tempfile::tempdir().expect("temp");
+    let (w, h) = (96, 64);
+    let chart = hdr_chart(w, h);
+    let camera = CameraModel::typical(8);
+    let times = [1.0 / 16.0, 0.25, 1.0, 4.0, 16.0];
+    let times_arg = "1/16,1/4,1,4,16";
+    // The moon: a 12×12 square, red and blue well exposed in the short
+    // frames, green written as 254 in every frame.
+    let in_moon = |p: usize| (40..52).contains(&(p % w)) && (20..32).contains(&(p / w));
+    let mut paths = Vec::new();
+    for (k, &t) in times.iter().enumerate() {
+        let mut shot = camera.photograph(&chart, t, 3 + k as u64);
+        for p in (0..w * h).filter(|&p| in_moon(p)) {
+            let rb = ((40.0 * t * 16.0) as u16).min(255);
+            shot.data[3 * p..3 * p + 3].copy_from_slice(&[rb, 254, rb]);
+        }
+        let path = dir.path().join(format!("m{k}.png"));
+        write_png(&shot, &path).expect("png");
+        paths.push(path.to_str().expect("utf-8").to_owned());
+    }
+    let curve = dir.path().join("c.csv");
+    let mut args = vec!["hdr", "calibrate", "--times", times_arg, "-o", curve.to_str().unwrap()];
+    args.extend(paths.iter().map(String::as_str));
+    let out = campanile(&args);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("m0.png: green piles up at code 254 (below the largest, 255): codes ≥ 253 treated as clipped"),
+        "{stdout}"
+    );
+    let exr = dir.path().join("moon.exr");
+    let mut args = vec![
+        "hdr",
+        "merge",
+        "--with-variance",
+        "--times",
+        times_arg,
+        "--curve",
+        curve.to_str().unwrap(),
+        "-o",
+        exr.to_str().unwrap(),
+    ];
+    args.extend(paths.iter().map(String::as_str));
+    let out = campanile(&args);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let map = read_radiance_exr(&exr).expect("EXR with mask");
+    let moon: Vec<usize> = (0..w * h).filter(|&p| in_moon(p)).collect();
+    let flagged = moon.iter().filter(|&&p| map.mask[p] & 0b010 != 0).count();
+    assert_eq!(flagged, moon.len(), "every moon pixel's green flagged saturated");
+    assert!(moon.iter().all(|&p| !map.is_valid(p)), "no moon pixel valid");
+    // The green bound (the darkest exposure's clipped value) is not below red: not magenta.
+    let p = moon[moon.len() / 2];
+    assert!(
+        map.rgb[3 * p + 1] >= 0.5 * map.rgb[3 * p],
+        "green {} red {}",
+        map.rgb[3 * p + 1],
+        map.rgb[3 * p]
+    );
+
+    // Radiance RGBE by extension; the OpenEXR-only options are refused for it.
+    let hdr = dir.path().join("moon.hdr");
+    let mut args = vec![
+        "hdr",
+        "merge",
+        "--times",
+        times_arg,
+        "--curve",
+        curve.to_str().unwrap(),
+        "-o",
+        hdr.to_str().unwrap(),
+    ];
+    args.extend(paths.iter().map(String::as_str));
+    let out = campanile(&args);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let rgbe = image::open(&hdr).expect("readable .hdr").into_rgb32f();
+    assert_eq!((rgbe.width() as usize, rgbe.height() as usize), (w, h));
+    let q = 5 * w + 5;
+    let (got, want) = (rgbe.as_raw()[3 * q], map.rgb[3 * q]);
+    assert!((got / want - 1.0).abs() < 0.01, "RGBE {got} vs EXR {want}");
+    args.push("--with-variance");
+    let out = campanile(&args);
+    assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
 }

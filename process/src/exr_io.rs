@@ -6,6 +6,10 @@
 //! bit field as a small integer: saturated `1 << c`, underexposed `8 << c`).
 //! OpenImageIO and Blender read `R`, `G`, `B` as the colour and the rest as
 //! extra channels.
+//!
+//! [`write_rgb_exr`] writes the plain colour image alone (`R`, `G`, `B`, half
+//! or float, no layer name): what every viewer opens, and what `hdr merge`
+//! writes unless asked for the variance.
 
 use std::path::Path;
 
@@ -38,6 +42,47 @@ pub fn write_radiance_exr(map: &RadianceMap, path: &Path) -> std::result::Result
     let layer = Layer::new(
         (map.width, map.height),
         LayerAttributes::named("radiance"),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(SmallVec::from_vec(channels)),
+    );
+    Image::from_layer(layer)
+        .write()
+        .to_file(path)
+        .map_err(|cause| HdrError::Exr {
+            path: path.to_path_buf(),
+            cause,
+        })
+}
+
+/// Sample precision of a plain RGB OpenEXR file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ExrPrecision {
+    /// 32-bit float.
+    #[default]
+    Float,
+    /// 16-bit half float (max 65504; larger values become +∞).
+    Half,
+}
+
+/// Writes the radiance of `map` alone as a plain RGB OpenEXR (ZIP-compressed
+/// scan lines, channels `R`, `G`, `B`).
+pub fn write_rgb_exr(map: &RadianceMap, path: &Path, precision: ExrPrecision) -> std::result::Result<(), HdrError> {
+    let n = map.width * map.height;
+    let plane = |c: usize| -> FlatSamples {
+        let v = (0..n).map(|p| map.rgb[p * 3 + c]);
+        match precision {
+            ExrPrecision::Float => FlatSamples::F32(v.collect()),
+            ExrPrecision::Half => FlatSamples::F16(v.map(f16::from_f32).collect()),
+        }
+    };
+    let channels: Vec<AnyChannel<FlatSamples>> = ["R", "G", "B"]
+        .iter()
+        .enumerate()
+        .map(|(c, name)| AnyChannel::new(*name, plane(c)))
+        .collect();
+    let layer = Layer::new(
+        (map.width, map.height),
+        LayerAttributes::default(),
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(SmallVec::from_vec(channels)),
     );
@@ -129,6 +174,37 @@ pub fn read_rgb_exr(path: &Path) -> std::result::Result<RadianceImage, HdrError>
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn plain_rgb_exr_has_only_r_g_b_in_float_or_half() {
+        let (w, h) = (4, 2);
+        let map = RadianceMap {
+            width: w,
+            height: h,
+            rgb: (0..w * h * 3).map(|i| 0.5 + i as f32).collect(),
+            variance: vec![1.0; w * h * 3],
+            mask: vec![0; w * h],
+        };
+        let dir = tempfile::tempdir().unwrap();
+        for (precision, kind) in [(ExrPrecision::Float, "F32"), (ExrPrecision::Half, "F16")] {
+            let path = dir.path().join(format!("{kind}.exr"));
+            write_rgb_exr(&map, &path, precision).unwrap();
+            let image = read_all_flat_layers_from_file(&path).unwrap();
+            let layer = &image.layer_data[0];
+            let names: Vec<String> = layer.channel_data.list.iter().map(|c| c.name.to_string()).collect();
+            assert_eq!(names, ["B", "G", "R"]);
+            assert!(layer.attributes.layer_name.is_none());
+            let r = &layer.channel_data.list[2].sample_data;
+            let is_kind = match r {
+                FlatSamples::F32(_) => kind == "F32",
+                FlatSamples::F16(_) => kind == "F16",
+                FlatSamples::U32(_) => false,
+            };
+            assert!(is_kind, "{kind}");
+            let back = read_rgb_exr(&path).unwrap();
+            assert_eq!(back.data, map.rgb, "{kind}: values 0.5..23.5 are exact in half too");
+        }
+    }
 
     #[test]
     fn exr_round_trip_checks_channels_and_values_with_the_exr_crate() {

@@ -6,6 +6,7 @@
 //! - [`hdr`]: camera response recovery (Debevec–Malik, Robertson), HDR
 //!   assembly, lens falloff, and the checks on the input images.
 //! - [`exr_io`]: OpenEXR output and input of radiance maps.
+//! - [`rgbe_file`]: Radiance RGBE (`.hdr`) output of radiance maps.
 
 pub mod brdf;
 pub mod camera;
@@ -24,6 +25,7 @@ pub mod pose;
 pub mod quality;
 pub mod render;
 pub mod report;
+pub mod rgbe_file;
 pub mod scene_geometry;
 pub mod sky;
 pub mod sky_series;

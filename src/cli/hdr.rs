@@ -6,17 +6,21 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow};
-use campanile_process::exr_io::{read_rgb_exr, write_radiance_exr};
+use campanile_process::exr_io::{ExrPrecision, read_rgb_exr, write_radiance_exr, write_rgb_exr};
 use campanile_process::hdr::HdrError;
 use campanile_process::hdr::bracket::Bracket;
-use campanile_process::hdr::bracket_list::{load_bracket, parse_time_s, read_bracket_list};
+use campanile_process::hdr::bracket_list::{
+    FrameRecord, TimeSource, load_bracket_files, parse_time_s, read_bracket_list,
+};
 use campanile_process::hdr::curve::ResponseCurve;
 use campanile_process::hdr::curve_plot::curve_plot_svg;
 use campanile_process::hdr::debevec::{DEFAULT_LAMBDA, DebevecOptions, Smoothness, calibrate_debevec};
 use campanile_process::hdr::lens::{LensModel, fit_distortion, fit_falloff, undistort_map};
 use campanile_process::hdr::merge::{MergeOptions, NoiseModel, merge};
+use campanile_process::hdr::resampled::assess_resampling;
 use campanile_process::hdr::robertson::{RobertsonOptions, calibrate_robertson};
 use campanile_process::hdr::sampling::SampleOptions;
+use campanile_process::rgbe_file::write_rgbe;
 use clap::{Args, Subcommand, ValueEnum};
 
 use super::verdicts;
@@ -27,16 +31,37 @@ use campanile_process::quality::{QualityReport, gates};
 pub enum HdrCommand {
     /// Recover the camera response curve from an exposure bracket.
     ///
+    /// Input: PNG, TIFF or JPEG files, 8 or 16 bits per sample, grey or RGB
+    /// (alpha ignored), turned upright by their EXIF orientation. Exposure
+    /// times come from --times, from --list, or else from each file's EXIF
+    /// (ExposureTime, with FNumber and ISO when every frame has them: the
+    /// relative exposure is t·ISO/N², so brackets that vary aperture or ISO
+    /// work). Codes where a frame's histogram piles up below the largest
+    /// code (a JPEG clipping at 254) are treated as clipped.
+    ///
     /// Writes the curve as CSV (g(z) = ln relative exposure per code and
     /// channel, with its 1σ uncertainty and support) and an SVG plot with the
-    /// ±2σ band. 8-bit images that were resampled after capture are refused.
+    /// ±2σ band.
+    ///
+    /// Example:
+    ///   campanile hdr calibrate IMG_*.JPG -o curve.csv
+    ///   campanile hdr calibrate a.png b.png c.png --times 1/250,1/60,1/15 -o curve.csv
     #[command(verbatim_doc_comment)]
     Calibrate(CalibrateArgs),
-    /// Merge an exposure bracket into an OpenEXR radiance map.
+    /// Merge an exposure bracket into a radiance map (OpenEXR or Radiance RGBE).
     ///
-    /// Channels: R, G, B (radiance), variance.R/G/B, valid (1/0) and mask
-    /// (bits: saturated 1<<c, underexposed 8<<c). Pixels clipped in every
-    /// exposure keep the darkest exposure's bound.
+    /// Input as for `calibrate`. Output by OUT's extension or --format:
+    /// - .exr (default): plain RGB (float, or half with --half), which every
+    ///   viewer opens; with --with-variance also variance.R/G/B, valid (1/0)
+    ///   and mask (bits: saturated 1<<c, underexposed 8<<c);
+    /// - .hdr: Radiance RGBE (hdrgen's and RADIANCE's format; no variance).
+    ///
+    /// Pixels clipped in every exposure keep the darkest exposure's bound and
+    /// are counted in the verdict (OUT's stem + .quality.json).
+    ///
+    /// Example:
+    ///   campanile hdr merge IMG_*.JPG --curve curve.csv -o scene.exr
+    ///   campanile hdr merge IMG_*.JPG --curve curve.csv -o scene.hdr
     #[command(verbatim_doc_comment)]
     Merge(MergeArgs),
     /// Fit the lens model 1 + a r² + b r⁴ (falloff and distortion).
@@ -50,13 +75,16 @@ pub enum HdrCommand {
 
 #[derive(Debug, Args)]
 pub struct BracketArgs {
-    /// Images of the bracket (PNG or TIFF, 8 or 16 bits).
+    /// Images of the bracket (PNG, TIFF or JPEG; 8 or 16 bits).
     #[arg(value_name = "IMAGE")]
     images: Vec<PathBuf>,
-    /// Exposure times in seconds, one per image, comma separated ("1/30" allowed).
+    /// Exposure times in seconds, one per image, comma separated ("1/30"
+    /// allowed); default: each file's EXIF.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     times: Vec<String>,
-    /// A bracket list file, one "IMAGE TIME_S" per line, instead of IMAGE… --times.
+    /// A bracket list instead of IMAGE…: plain text, one "IMAGE TIME_S" per
+    /// line, or CSV with a header naming "file" and "time" columns (and
+    /// optionally "iso" and "f_number").
     #[arg(long, conflicts_with_all = ["images", "times"])]
     list: Option<PathBuf>,
 }
@@ -94,7 +122,8 @@ pub struct CalibrateArgs {
     /// Also fit the true exposure times (labelled times are often off by a few %).
     #[arg(long)]
     fit_times: bool,
-    /// Accept 8-bit images that look resampled (for cameras that filter their own output).
+    /// Do not flag 8-bit images that look resampled (for cameras that filter
+    /// their own output); without it such a curve's verdict is poor.
     #[arg(long)]
     allow_resampled: bool,
     /// Quality thresholds (a `Quality(...)` RON file, any subset of the
@@ -111,9 +140,18 @@ pub struct MergeArgs {
     /// Response curve (CSV from `hdr calibrate`).
     #[arg(long)]
     curve: PathBuf,
-    /// Output radiance map (OpenEXR).
+    /// Output radiance map: .exr (OpenEXR) or .hdr (Radiance RGBE).
     #[arg(long, short)]
     out: PathBuf,
+    /// Output format; default: from OUT's extension (.hdr → hdr, else exr).
+    #[arg(long, value_enum)]
+    format: Option<OutputFormat>,
+    /// OpenEXR: also write the variance and mask channels (variance.R/G/B, valid, mask).
+    #[arg(long)]
+    with_variance: bool,
+    /// OpenEXR: half-float colour (16 bits; values above 65504 become +∞).
+    #[arg(long, conflicts_with = "with_variance")]
+    half: bool,
     /// ND filter transmittance: one value, or R,G,B.
     #[arg(long, value_delimiter = ',', default_value = "1")]
     nd: Vec<f64>,
@@ -135,6 +173,15 @@ pub struct MergeArgs {
     /// all-black or all-white bracket) exits 3.
     #[arg(long, value_name = "FILE.ron")]
     thresholds: Option<PathBuf>,
+}
+
+/// A radiance map's file format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum OutputFormat {
+    /// OpenEXR.
+    Exr,
+    /// Radiance RGBE (.hdr).
+    Hdr,
 }
 
 #[derive(Debug, Args)]
@@ -189,10 +236,15 @@ fn is_output_error(e: &anyhow::Error) -> bool {
 
 fn load(args: &BracketArgs) -> Result<Bracket> {
     let (paths, times) = match &args.list {
-        Some(list) => read_bracket_list(list).with_context(|| format!("reading bracket list {}", list.display()))?,
+        Some(list) => {
+            let (p, t) = read_bracket_list(list).with_context(|| format!("reading bracket list {}", list.display()))?;
+            (p, Some(t))
+        }
         None => {
             if args.images.is_empty() {
-                return Err(anyhow!("no images: give IMAGE… --times T,… or --list FILE"));
+                return Err(anyhow!(
+                    "no images: give IMAGE… (times from EXIF or --times T,…) or --list FILE"
+                ));
             }
             let times = args
                 .times
@@ -202,10 +254,59 @@ fn load(args: &BracketArgs) -> Result<Bracket> {
                         .ok_or_else(|| anyhow!("--times: '{t}' is not a time in seconds > 0 (e.g. 0.033 or 1/30)"))
                 })
                 .collect::<Result<Vec<_>>>()?;
-            (args.images.clone(), times)
+            (args.images.clone(), (!times.is_empty()).then_some(times))
         }
     };
-    load_bracket(&paths, &times).context("reading the bracket")
+    let (bracket, frames) = load_bracket_files(&paths, times.as_deref()).context("reading the bracket")?;
+    report_frames(&frames, &bracket)?;
+    Ok(bracket)
+}
+
+/// One line per frame: its time and where it came from; then each white
+/// point found below the largest code.
+fn report_frames(frames: &[FrameRecord], bracket: &Bracket) -> Result<()> {
+    for f in frames.iter().filter(|f| f.source == TimeSource::Exif) {
+        let m = &f.metadata;
+        let mut what = vec![format!("{} s", m.exposure_time_s.map_or_else(String::new, shutter))];
+        if let Some(n) = m.f_number {
+            what.push(format!("f/{n}"));
+        }
+        if let Some(iso) = m.iso {
+            what.push(format!("ISO {iso}"));
+        }
+        outln!(
+            "{}: EXIF {}{} → exposure {:.6} s",
+            f.path.display(),
+            what.join(", "),
+            m.camera.as_deref().map_or_else(String::new, |c| format!(" ({c})")),
+            f.time_s
+        )?;
+    }
+    for (img, wp) in bracket.images().iter().zip(bracket.white_points()) {
+        for (c, p) in wp.iter().enumerate() {
+            if let Some(p) = p {
+                outln!(
+                    "{}: {} piles up at code {} (below the largest, {}): codes ≥ {} treated as clipped ({} pixels)",
+                    img.label,
+                    ["red", "green", "blue"][c],
+                    p.code,
+                    img.max_code(),
+                    p.clipped_from,
+                    p.pixels
+                )?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A time as photographers write it: "1/250" below a second, else decimal.
+fn shutter(t: f64) -> String {
+    if t < 1.0 && (1.0 / t - (1.0 / t).round()).abs() < 1e-3 * (1.0 / t) {
+        format!("1/{}", (1.0 / t).round())
+    } else {
+        format!("{t}")
+    }
 }
 
 fn write(path: &Path, text: &str) -> Result<()> {
@@ -258,12 +359,12 @@ fn calibrate(a: &CalibrateArgs) -> Result<()> {
         Method::Robertson => {
             let opts = RobertsonOptions {
                 sampling,
-                allow_resampled: a.allow_resampled,
                 ..Default::default()
             };
             let (curve, iters) = calibrate_robertson(&bracket, &opts).context("recovering the response (Robertson)")?;
             outln!("Robertson: {iters:?} iterations (R, G, B)")?;
-            let quality = gates::response_curve(&curve, bracket.len(), bracket.len(), &q);
+            let resampling = (!a.allow_resampled).then(|| assess_resampling(&bracket)).flatten();
+            let quality = gates::response_curve(&curve, bracket.len(), bracket.len(), resampling.as_ref(), &q);
             (
                 curve,
                 format!("robertson samples={} seed={}", a.samples, a.seed),
@@ -317,7 +418,29 @@ fn merge_cmd(a: &MergeArgs) -> Result<()> {
     {
         map = undistort_map(&map, &l.distortion);
     }
-    write_radiance_exr(&map, &a.out).context("writing the radiance map")?;
+    let format = a.format.unwrap_or_else(|| {
+        let hdr = a.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("hdr"));
+        if hdr { OutputFormat::Hdr } else { OutputFormat::Exr }
+    });
+    match format {
+        OutputFormat::Hdr if a.with_variance || a.half => {
+            return Err(super::exit::bad_input(
+                "--with-variance and --half are OpenEXR options: Radiance RGBE (.hdr) holds colour only",
+            ));
+        }
+        OutputFormat::Hdr => write_rgbe(&map, &a.out),
+        OutputFormat::Exr if a.with_variance => write_radiance_exr(&map, &a.out),
+        OutputFormat::Exr => write_rgb_exr(
+            &map,
+            &a.out,
+            if a.half {
+                ExrPrecision::Half
+            } else {
+                ExrPrecision::Float
+            },
+        ),
+    }
+    .context("writing the radiance map")?;
     let invalid = map.mask.iter().filter(|&&m| m != 0).count();
     outln!(
         "wrote {} ({}×{}, {} exposures; {invalid} pixels clipped in some channel in every exposure)",

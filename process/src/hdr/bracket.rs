@@ -2,15 +2,19 @@
 //! times, validated and sorted from the shortest to the longest exposure.
 
 use super::HdrError;
+use super::white_point::{WhitePoint, apply_white_points, detect_white_points};
 use crate::camera::image::CodeImage;
 
 /// A validated bracket: at least one image, all the same size and bit depth,
 /// codes within range, distinct finite positive times, sorted by time, and
-/// brightness that rises with time.
+/// brightness that rises with time. Codes at or above a frame's effective
+/// white point ([`super::white_point`]) are mapped to the largest code, so
+/// that every consumer treats them as clipped.
 #[derive(Debug, Clone)]
 pub struct Bracket {
     images: Vec<CodeImage>,
     times_s: Vec<f64>,
+    white_points: Vec<[Option<WhitePoint>; 3]>,
 }
 
 impl Bracket {
@@ -120,12 +124,24 @@ impl Bracket {
             }
         }
         let mut slots: Vec<Option<CodeImage>> = images.into_iter().map(Some).collect();
-        let images = order
+        let mut images: Vec<CodeImage> = order
             .iter()
             .map(|&i| slots[i].take().expect("each index once"))
             .collect();
         let times_s = order.iter().map(|&i| times_s[i]).collect();
-        Ok(Self { images, times_s })
+        let white_points = detect_white_points(&images);
+        apply_white_points(&mut images, &white_points);
+        Ok(Self {
+            images,
+            times_s,
+            white_points,
+        })
+    }
+
+    /// Per image (shortest exposure first) and channel, the white point found
+    /// below the largest code, if any; its codes were mapped to the largest.
+    pub fn white_points(&self) -> &[[Option<WhitePoint>; 3]] {
+        &self.white_points
     }
 
     /// The images, shortest exposure first.

@@ -45,7 +45,7 @@ use super::HdrError;
 use super::bracket::Bracket;
 use super::curve::{ChannelCurve, ResponseCurve, make_monotone, node_code, node_count, node_position};
 use super::noise_bias::{NoiseBiasReport, Observation, correct_noise_bias};
-use super::resampled::check_not_resampled;
+use super::resampled::{ResamplingEvidence, assess_resampling};
 use super::sampling::{SampleOptions, select_samples};
 
 /// Default smoothness `λ` (per observation per node; see the module doc).
@@ -79,7 +79,7 @@ pub struct DebevecOptions {
     pub fit_exposure_times: bool,
     /// Prior standard deviation of the log time corrections.
     pub time_prior_sigma: f64,
-    /// Skip the resampled-input check (for cameras that filter their own output).
+    /// Skip the resampling assessment (for cameras that filter their own output).
     pub allow_resampled: bool,
 }
 
@@ -126,6 +126,8 @@ pub struct Calibration {
     pub times_s: Vec<f64>,
     /// Method and parameters, for the CSV header.
     pub method: String,
+    /// The resampling statistic of 8-bit input (held to a gate, not refused).
+    pub resampling: Option<ResamplingEvidence>,
 }
 
 /// `w(z)`: Debevec's hat weight, normalized to 1 at mid-scale and 0 at both ends.
@@ -152,9 +154,11 @@ pub fn calibrate_debevec(bracket: &Bracket, opts: &DebevecOptions) -> Result<Cal
             expected: "a finite σ > 0",
         });
     }
-    if !opts.allow_resampled {
-        check_not_resampled(bracket)?;
-    }
+    let resampling = if opts.allow_resampled {
+        None
+    } else {
+        assess_resampling(bracket)
+    };
     let needed = (node_count(bracket.bits()) / (bracket.len() - 1)).max(16);
     let samples: Vec<Vec<usize>> = (0..3)
         .into_par_iter()
@@ -225,6 +229,7 @@ pub fn calibrate_debevec(bracket: &Bracket, opts: &DebevecOptions) -> Result<Cal
             "debevec-malik lambda={} samples={} seed={} fit_times={}",
             opts.lambda, opts.sampling.samples, opts.sampling.seed, opts.fit_exposure_times
         ),
+        resampling,
     })
 }
 

@@ -121,18 +121,6 @@ pub enum HdrError {
         /// Maximum.
         max: u16,
     },
-    /// The image was resampled after capture (see [`super::resampled`]).
-    #[error(
-        "image '{image}' looks resampled (downscaled or filtered) after capture: {evidence}. \
-         A resampled 8-bit image gives a wrong response curve; calibrate on the camera's own \
-         full-size images (or pass the override if the camera itself filters)"
-    )]
-    Resampled {
-        /// The image.
-        image: String,
-        /// The statistic that gave it away.
-        evidence: String,
-    },
     /// Not enough usable samples.
     #[error(
         "channel {channel}: only {found} usable samples (unclipped, edge- and motion-free): expected at least {needed}"
@@ -179,6 +167,14 @@ pub enum HdrError {
         /// 1-based line.
         line: usize,
         /// What was expected.
+        what: String,
+    },
+    /// A file's EXIF block: unreadable, or a field missing or impossible.
+    #[error("{path}: EXIF: {what}")]
+    Exif {
+        /// File.
+        path: PathBuf,
+        /// What is wrong, and what was expected.
         what: String,
     },
     /// File I/O.

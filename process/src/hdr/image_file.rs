@@ -1,15 +1,54 @@
-//! Reading exposure brackets from image files (PNG, TIFF, JPEG; 8 or 16 bits).
+//! Reading exposure brackets from image files (PNG, TIFF, JPEG; 8 or 16
+//! bits), turned upright by their EXIF orientation.
 
 use std::path::Path;
 
 use image::DynamicImage;
 
 use super::HdrError;
+use super::exposure_metadata::{ExposureMetadata, Orientation, read_exposure_metadata};
 use crate::camera::image::CodeImage;
 
-/// Reads an image file as RGB codes. 8-bit files give 8-bit codes, 16-bit
-/// files 16-bit codes; grey images are expanded to RGB. Float images are refused.
+/// Reads an image file as upright RGB codes with its EXIF exposure metadata
+/// (see [`read_code_image`] and [`read_exposure_metadata`]).
+pub fn read_frame(path: &Path) -> Result<(CodeImage, ExposureMetadata), HdrError> {
+    let meta = read_exposure_metadata(path)?;
+    let img = read_stored_codes(path)?;
+    Ok((turn_upright(img, meta.orientation), meta))
+}
+
+/// Reads an image file as RGB codes, turned upright by its EXIF
+/// orientation. 8-bit files give 8-bit codes, 16-bit files 16-bit codes;
+/// grey images are expanded to RGB. Float images are refused.
 pub fn read_code_image(path: &Path) -> Result<CodeImage, HdrError> {
+    read_frame(path).map(|(img, _)| img)
+}
+
+/// Turns `img` upright: the pixel stored at `o.source_of(x, y)` goes to `(x, y)`.
+pub fn turn_upright(img: CodeImage, o: Orientation) -> CodeImage {
+    if o == Orientation::Upright {
+        return img;
+    }
+    let (w, h) = (img.width, img.height);
+    let (wo, ho) = if o.swaps_axes() { (h, w) } else { (w, h) };
+    let mut data = Vec::with_capacity(img.data.len());
+    for yo in 0..ho {
+        for xo in 0..wo {
+            let (x, y) = o.source_of(xo, yo, w, h);
+            let i = (y * w + x) * 3;
+            data.extend_from_slice(&img.data[i..i + 3]);
+        }
+    }
+    CodeImage {
+        width: wo,
+        height: ho,
+        data,
+        ..img
+    }
+}
+
+/// The codes as stored in the file, before any EXIF orientation.
+fn read_stored_codes(path: &Path) -> Result<CodeImage, HdrError> {
     let img = image::open(path).map_err(|cause| HdrError::Image {
         path: path.to_path_buf(),
         cause,

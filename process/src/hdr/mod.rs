@@ -11,7 +11,9 @@
 //! - [`merge`]: the single-pass, LUT-driven, noise-optimal radiance merge.
 //! - [`lens`]: the radial falloff and distortion model `1 + a r² + b r⁴` and its fit.
 //! - [`resampled`]: detection of resampled (downscaled) 8-bit input.
-//! - [`image_file`]: reading brackets from PNG/TIFF files.
+//! - [`image_file`]: reading brackets from PNG/TIFF/JPEG files, turned upright.
+//! - [`exposure_metadata`]: EXIF exposure time, f-number, ISO, orientation; effective times.
+//! - [`white_point`]: each frame's effective white point per channel (clipping below the largest code).
 //! - [`error`]: the typed errors of all of the above.
 
 pub mod bracket;
@@ -20,6 +22,7 @@ pub mod curve;
 pub mod curve_plot;
 pub mod debevec;
 pub mod error;
+pub mod exposure_metadata;
 pub mod image_file;
 pub mod lens;
 pub mod merge;
@@ -27,5 +30,6 @@ pub mod noise_bias;
 pub mod resampled;
 pub mod robertson;
 pub mod sampling;
+pub mod white_point;
 
 pub use error::HdrError;

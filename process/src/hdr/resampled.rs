@@ -12,18 +12,21 @@
 //! (|d| above 6× the median |d|; clipped codes are excluded too). Every
 //! resampling filter that mixes neighbouring pixels with overlapping kernels
 //! (bilinear, bicubic, Lanczos, area at non-integer factors) correlates the
-//! noise and raises this autocorrelation toward 0 or above. The check
-//! measures it along rows and columns of the middle exposure's green channel
-//! and refuses the bracket when the mean exceeds [`RESAMPLED_THRESHOLD`]
-//! (−0.5, halfway between white noise and a typical 2:1 triangle filter).
+//! noise and raises this autocorrelation toward 0 or above. The assessment
+//! measures it along rows and columns of the middle exposure's green channel;
+//! the response curve's quality gate holds the mean to a bound (default
+//! −0.5, halfway between white noise and a typical 2:1 triangle filter,
+//! `Quality.response.resampling`), past which the curve is `poor`: a
+//! warning, never a refusal.
 //!
 //! **Limits.** An exact integer box downscale (block averaging) keeps the
 //! noise white and is not detected; nor are images too flat or too clean to
-//! carry noise (then the check passes for lack of evidence). Cameras that
-//! demosaic or sharpen their own output also correlate their noise: for them,
-//! the calibration options carry an override (`allow_resampled`).
+//! carry noise (then there is no evidence either way). Cameras that demosaic,
+//! denoise, sharpen or compress their own output also correlate their noise,
+//! so a camera's own JPEGs can score like a resampled image: the figure is
+//! evidence to look at, and the calibration option `allow_resampled`
+//! (`--allow-resampled`) leaves it out.
 
-use super::HdrError;
 use super::bracket::Bracket;
 use crate::camera::image::CodeImage;
 
@@ -90,11 +93,35 @@ pub fn second_difference_autocorrelation(img: &CodeImage, c: usize) -> Option<(f
     Some((out[0].0 / out[0].1, out[1].0 / out[1].1, n))
 }
 
-/// Refuses an 8-bit bracket whose middle exposure looks resampled. Deeper
-/// brackets pass (the concern is re-quantized 8-bit output).
-pub fn check_not_resampled(bracket: &Bracket) -> Result<(), HdrError> {
+/// The resampling statistic of a bracket's middle exposure.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResamplingEvidence {
+    /// The image examined.
+    pub image: String,
+    /// Lag-1 autocorrelation of second differences along rows.
+    pub rows: f64,
+    /// The same along columns.
+    pub columns: f64,
+    /// Their mean: −2/3 for white sensor noise, toward 0 or above when resampled.
+    pub mean: f64,
+    /// Pairs of second differences used (the fewer of rows and columns).
+    pub pairs: usize,
+}
+
+impl ResamplingEvidence {
+    /// Whether the mean exceeds [`RESAMPLED_THRESHOLD`].
+    pub fn looks_resampled(&self) -> bool {
+        self.mean > RESAMPLED_THRESHOLD
+    }
+}
+
+/// The statistic of an 8-bit bracket's middle exposure (central crop of at
+/// most 512² pixels, green channel); `None` for deeper brackets (the concern
+/// is re-quantized 8-bit output) and for images without enough noise to
+/// judge.
+pub fn assess_resampling(bracket: &Bracket) -> Option<ResamplingEvidence> {
     if bracket.bits() != 8 {
-        return Ok(());
+        return None;
     }
     let img = &bracket.images()[bracket.len() / 2];
     // A central crop of at most CHECK_SIZE² pixels is plenty of evidence.
@@ -111,19 +138,14 @@ pub fn check_not_resampled(bracket: &Bracket) -> Result<(), HdrError> {
         data,
         label: img.label.clone(),
     };
-    if let Some((rh, rv, n)) = second_difference_autocorrelation(&crop, 1) {
-        let mean = 0.5 * (rh + rv);
-        if mean > RESAMPLED_THRESHOLD {
-            return Err(HdrError::Resampled {
-                image: img.label.clone(),
-                evidence: format!(
-                    "noise second-difference autocorrelation {mean:.3} (rows {rh:.3}, columns {rv:.3}, {n} pairs); \
-                     native sensor noise gives −0.667, the limit is {RESAMPLED_THRESHOLD}"
-                ),
-            });
-        }
-    }
-    Ok(())
+    let (rows, columns, pairs) = second_difference_autocorrelation(&crop, 1)?;
+    Some(ResamplingEvidence {
+        image: img.label.clone(),
+        rows,
+        columns,
+        mean: 0.5 * (rows + columns),
+        pairs,
+    })
 }
 
 #[cfg(test)]
@@ -147,7 +169,7 @@ mod tests {
     }
 
     #[test]
-    fn native_noise_is_white_and_resampled_is_refused() {
+    fn native_noise_is_white_and_resampled_is_flagged() {
         let cam = CameraModel::typical(8);
         let scene = hdr_chart(192, 128);
         let native: Vec<CodeImage> = SEVEN_STOP_TIMES_S
@@ -161,7 +183,8 @@ mod tests {
             "native: {rh} {rv}"
         );
         let b = Bracket::new(native.clone(), SEVEN_STOP_TIMES_S.to_vec()).unwrap();
-        check_not_resampled(&b).unwrap();
+        let e = assess_resampling(&b).unwrap();
+        assert!(!e.looks_resampled(), "native: {e:?}");
         for (w, h, f) in [
             (96, 64, FilterType::Triangle),
             (128, 85, FilterType::CatmullRom),
@@ -169,8 +192,8 @@ mod tests {
         ] {
             let small: Vec<CodeImage> = native.iter().map(|im| downscale(im, w, h, f)).collect();
             let b = Bracket::new(small, SEVEN_STOP_TIMES_S.to_vec()).unwrap();
-            let e = check_not_resampled(&b).unwrap_err();
-            assert!(e.to_string().contains("looks resampled"), "{w}x{h} {f:?}: {e}");
+            let e = assess_resampling(&b).unwrap();
+            assert!(e.looks_resampled(), "{w}x{h} {f:?}: {e:?}");
         }
     }
 }

@@ -26,7 +26,6 @@ use super::HdrError;
 use super::bracket::Bracket;
 use super::curve::{ChannelCurve, ResponseCurve, make_monotone, node_count, node_position};
 use super::debevec::{hat_weight, to_array3};
-use super::resampled::check_not_resampled;
 use super::sampling::{SampleOptions, select_samples};
 
 /// Options of [`calibrate_robertson`].
@@ -36,8 +35,6 @@ pub struct RobertsonOptions {
     pub sampling: SampleOptions,
     /// Iteration cap.
     pub max_iterations: usize,
-    /// Skip the resampled-input check.
-    pub allow_resampled: bool,
 }
 
 impl Default for RobertsonOptions {
@@ -45,7 +42,6 @@ impl Default for RobertsonOptions {
         Self {
             sampling: SampleOptions::default(),
             max_iterations: 2000,
-            allow_resampled: false,
         }
     }
 }
@@ -57,9 +53,6 @@ pub fn calibrate_robertson(
 ) -> Result<(ResponseCurve, [usize; 3]), HdrError> {
     if bracket.len() < 2 {
         return Err(HdrError::SingleExposure(bracket.len()));
-    }
-    if !opts.allow_resampled {
-        check_not_resampled(bracket)?;
     }
     let bits = bracket.bits();
     let n = node_count(bits);
