@@ -109,13 +109,6 @@ pub struct ResponseGates {
     /// Fraction of curve nodes that had to be made monotone, worst channel
     /// (lower is better). Default poor 0.02, failed 0.1.
     pub non_monotone: Gate,
-    /// The lag-1 autocorrelation of noise second differences in an 8-bit
-    /// bracket's middle exposure (lower is better): −0.667 for white sensor
-    /// noise, toward 0 when the images were resampled after capture, which
-    /// bends the recovered curve. Default poor −0.5, failed 1 (never: a
-    /// camera's own JPEG processing also correlates its noise, so this is a
-    /// warning to look at, not a refusal).
-    pub resampling: Gate,
 }
 
 impl Default for ResponseGates {
@@ -125,7 +118,6 @@ impl Default for ResponseGates {
             exposures_used: Gate::new(1.0, 0.75),
             code_coverage: Gate::new(0.8, 0.5),
             non_monotone: Gate::new(0.02, 0.1),
-            resampling: Gate::new(-0.5, 1.0),
         }
     }
 }
@@ -252,12 +244,11 @@ impl Default for IgiGates {
 impl Validate for Quality {
     fn validate(&self, v: &mut Validator) {
         use Better::{Higher, Lower};
-        let gates: [(&str, &str, &Gate, Better); 16] = [
+        let gates: [(&str, &str, &Gate, Better); 15] = [
             ("response", "condition", &self.response.condition, Lower),
             ("response", "exposures_used", &self.response.exposures_used, Higher),
             ("response", "code_coverage", &self.response.code_coverage, Higher),
             ("response", "non_monotone", &self.response.non_monotone, Lower),
-            ("response", "resampling", &self.response.resampling, Lower),
             ("merge", "valid", &self.merge.valid, Higher),
             ("merge", "clipped", &self.merge.clipped, Lower),
             ("merge", "dark", &self.merge.dark, Lower),

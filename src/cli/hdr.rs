@@ -17,7 +17,6 @@ use campanile_process::hdr::curve_plot::curve_plot_svg;
 use campanile_process::hdr::debevec::{DEFAULT_LAMBDA, DebevecOptions, Smoothness, calibrate_debevec};
 use campanile_process::hdr::lens::{LensModel, fit_distortion, fit_falloff, undistort_map};
 use campanile_process::hdr::merge::{MergeOptions, NoiseModel, merge};
-use campanile_process::hdr::resampled::assess_resampling;
 use campanile_process::hdr::robertson::{RobertsonOptions, calibrate_robertson};
 use campanile_process::hdr::sampling::SampleOptions;
 use campanile_process::rgbe_file::write_rgbe;
@@ -122,10 +121,10 @@ pub struct CalibrateArgs {
     /// Also fit the true exposure times (labelled times are often off by a few %).
     #[arg(long)]
     fit_times: bool,
-    /// Do not flag 8-bit images that look resampled (for cameras that filter
-    /// their own output); without it such a curve's verdict is poor.
-    #[arg(long)]
-    allow_resampled: bool,
+    /// Accepted and ignored: resampled-looking input is no longer refused
+    /// (camera JPEGs look resampled too; see validation/hdr/README.md).
+    #[arg(long = "allow-resampled", hide = true)]
+    _allow_resampled: bool,
     /// Quality thresholds (a `Quality(...)` RON file, any subset of the
     /// gates). The curve's verdict goes to OUT's stem + .quality.json; a
     /// failed curve exits 3.
@@ -328,7 +327,6 @@ fn calibrate(a: &CalibrateArgs) -> Result<()> {
                 smoothness: Smoothness::Code,
                 sampling,
                 fit_exposure_times: a.fit_times,
-                allow_resampled: a.allow_resampled,
                 ..Default::default()
             };
             let cal = calibrate_debevec(&bracket, &opts).context("recovering the response (Debevec–Malik)")?;
@@ -363,8 +361,7 @@ fn calibrate(a: &CalibrateArgs) -> Result<()> {
             };
             let (curve, iters) = calibrate_robertson(&bracket, &opts).context("recovering the response (Robertson)")?;
             outln!("Robertson: {iters:?} iterations (R, G, B)")?;
-            let resampling = (!a.allow_resampled).then(|| assess_resampling(&bracket)).flatten();
-            let quality = gates::response_curve(&curve, bracket.len(), bracket.len(), resampling.as_ref(), &q);
+            let quality = gates::response_curve(&curve, bracket.len(), bracket.len(), &q);
             (
                 curve,
                 format!("robertson samples={} seed={}", a.samples, a.seed),

@@ -45,7 +45,6 @@ use super::HdrError;
 use super::bracket::Bracket;
 use super::curve::{ChannelCurve, ResponseCurve, make_monotone, node_code, node_count, node_position};
 use super::noise_bias::{NoiseBiasReport, Observation, correct_noise_bias};
-use super::resampled::{ResamplingEvidence, assess_resampling};
 use super::sampling::{SampleOptions, select_samples};
 
 /// Default smoothness `λ` (per observation per node; see the module doc).
@@ -79,8 +78,6 @@ pub struct DebevecOptions {
     pub fit_exposure_times: bool,
     /// Prior standard deviation of the log time corrections.
     pub time_prior_sigma: f64,
-    /// Skip the resampling assessment (for cameras that filter their own output).
-    pub allow_resampled: bool,
 }
 
 impl Default for DebevecOptions {
@@ -92,7 +89,6 @@ impl Default for DebevecOptions {
             sampling: SampleOptions::default(),
             fit_exposure_times: false,
             time_prior_sigma: 1.0,
-            allow_resampled: false,
         }
     }
 }
@@ -126,8 +122,6 @@ pub struct Calibration {
     pub times_s: Vec<f64>,
     /// Method and parameters, for the CSV header.
     pub method: String,
-    /// The resampling statistic of 8-bit input (held to a gate, not refused).
-    pub resampling: Option<ResamplingEvidence>,
 }
 
 /// `w(z)`: Debevec's hat weight, normalized to 1 at mid-scale and 0 at both ends.
@@ -154,11 +148,6 @@ pub fn calibrate_debevec(bracket: &Bracket, opts: &DebevecOptions) -> Result<Cal
             expected: "a finite σ > 0",
         });
     }
-    let resampling = if opts.allow_resampled {
-        None
-    } else {
-        assess_resampling(bracket)
-    };
     let needed = (node_count(bracket.bits()) / (bracket.len() - 1)).max(16);
     let samples: Vec<Vec<usize>> = (0..3)
         .into_par_iter()
@@ -229,7 +218,6 @@ pub fn calibrate_debevec(bracket: &Bracket, opts: &DebevecOptions) -> Result<Cal
             "debevec-malik lambda={} samples={} seed={} fit_times={}",
             opts.lambda, opts.sampling.samples, opts.sampling.seed, opts.fit_exposure_times
         ),
-        resampling,
     })
 }
 
@@ -577,14 +565,7 @@ mod tests {
             label: format!("t{t}"),
         };
         let b = Bracket::new(vec![img(1.0), img(2.0), img(4.0)], vec![1.0, 2.0, 4.0]).unwrap();
-        let e = calibrate_debevec(
-            &b,
-            &DebevecOptions {
-                allow_resampled: true,
-                ..Default::default()
-            },
-        )
-        .unwrap_err();
+        let e = calibrate_debevec(&b, &DebevecOptions::default()).unwrap_err();
         assert!(matches!(e, HdrError::TooFewSamples { found: 0, .. }), "{e}");
     }
 }

@@ -9,7 +9,6 @@ use crate::environment::{EnvironmentMap, RegionFit};
 use crate::hdr::curve::ResponseCurve;
 use crate::hdr::debevec::Calibration;
 use crate::hdr::merge::{MASK_SATURATED, MASK_UNDEREXPOSED, RadianceMap};
-use crate::hdr::resampled::ResamplingEvidence;
 use crate::igi::SurfaceResult;
 use crate::sky::ChannelSky;
 use crate::sky_series::ScanProducts;
@@ -45,21 +44,14 @@ pub fn response(calibration: &Calibration, used: usize, planned: usize, q: &Qual
         Check::new("condition estimate", condition, g.condition, Better::Lower),
         Check::new("nodes made monotone", monotone, g.non_monotone, Better::Lower),
     ];
-    checks.extend(response_curve(&calibration.curve, used, planned, calibration.resampling.as_ref(), q).checks);
+    checks.extend(response_curve(&calibration.curve, used, planned, q).checks);
     ProductQuality::new("response", checks)
 }
 
 /// A response curve from any method, by what the curve itself shows:
 /// exposures used over planned, and the span of codes observed over the
-/// code range (worst channel); and, for 8-bit input, the resampling
-/// statistic of [`crate::hdr::resampled`] (a warning: `poor` at worst).
-pub fn response_curve(
-    curve: &ResponseCurve,
-    used: usize,
-    planned: usize,
-    resampling: Option<&ResamplingEvidence>,
-    q: &Quality,
-) -> ProductQuality {
+/// code range (worst channel).
+pub fn response_curve(curve: &ResponseCurve, used: usize, planned: usize, q: &Quality) -> ProductQuality {
     let g = &q.response;
     let codes = curve.channels[0].support.len().max(2);
     let coverage = |c: usize| {
@@ -71,7 +63,7 @@ pub fn response_curve(
             _ => 0.0,
         }
     };
-    let mut checks = vec![
+    let checks = vec![
         Check::new(
             format!("exposures used ({used} of {planned} planned)"),
             used as f64 / planned.max(1) as f64,
@@ -85,18 +77,6 @@ pub fn response_curve(
             Better::Higher,
         ),
     ];
-    if let Some(e) = resampling {
-        checks.push(Check::new(
-            format!(
-                "noise second-difference autocorrelation of {} (−0.667 for sensor noise; resampling raises it; \
-                 --allow-resampled leaves it out)",
-                e.image
-            ),
-            e.mean,
-            g.resampling,
-            Better::Lower,
-        ));
-    }
     ProductQuality::new("response", checks)
 }
 
