@@ -861,61 +861,14 @@ pub(crate) mod tests {
     use super::*;
     use crate::camera::image::RadianceImage;
     use crate::camera::sensor::CameraModel;
+    use crate::camera::textured_scene::textured_scene;
     use crate::hdr::curve::ResponseCurve;
     use crate::hdr::curve::{ChannelCurve, node_code, node_count};
     use crate::hdr::merge::{MergeOptions, merge};
 
-    /// Deterministic lattice hash in [0, 1).
-    fn hash(i: i64, j: i64, seed: u64) -> f64 {
-        let mut z = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
-            ^ (j as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F)
-            ^ seed.wrapping_mul(0x1656_67B1_9E37_79F9);
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Smooth (C¹) value noise in [0, 1) at feature size `scale` px.
-    fn value_noise(x: f64, y: f64, scale: f64, seed: u64) -> f64 {
-        let (u, v) = (x / scale, y / scale);
-        let (i, j) = (u.floor(), v.floor());
-        let (fx, fy) = (u - i, v - j);
-        let s = |t: f64| t * t * (3.0 - 2.0 * t);
-        let (sx, sy) = (s(fx), s(fy));
-        let (i, j) = (i as i64, j as i64);
-        let a = hash(i, j, seed) * (1.0 - sx) + hash(i + 1, j, seed) * sx;
-        let b = hash(i, j + 1, seed) * (1.0 - sx) + hash(i + 1, j + 1, seed) * sx;
-        a * (1.0 - sy) + b * sy
-    }
-
-    /// A textured continuous scene: log radiance from three octaves of value
-    /// noise, about 0.0007–4 W·m⁻²·sr⁻¹, slightly tinted.
-    pub(crate) fn textured_radiance(x: f64, y: f64) -> [f64; 3] {
-        let n = 2.0 * (value_noise(x, y, 29.0, 1) - 0.5) * 2.6
-            + 2.0 * (value_noise(x, y, 11.0, 2) - 0.5) * 1.2
-            + 2.0 * (value_noise(x, y, 4.5, 3) - 0.5) * 0.5;
-        let l = 0.05 * n.exp();
-        [l, 0.9 * l, 0.8 * l]
-    }
-
     /// The scene as image `j` sees it: pixel `s` shows the scene at `T⁻¹(s)`.
     pub(crate) fn render(w: usize, h: usize, t: Transform) -> RadianceImage {
-        let (cx, cy) = ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0);
-        let (s, c) = t.angle_rad.sin_cos();
-        let mut data = Vec::with_capacity(w * h * 3);
-        for y in 0..h {
-            for x in 0..w {
-                let (u, v) = (x as f64 - cx - t.dx, y as f64 - cy - t.dy);
-                let (px, py) = (c * u + s * v + cx, -s * u + c * v + cy);
-                data.extend(textured_radiance(px, py).map(|v| v as f32));
-            }
-        }
-        RadianceImage {
-            width: w,
-            height: h,
-            data,
-        }
+        textured_scene(w, h, t.dx, t.dy, t.angle_rad)
     }
 
     pub(crate) const TIMES: [f64; 5] = [1.0 / 16.0, 0.25, 1.0, 4.0, 16.0];
