@@ -2,6 +2,8 @@
 //! through the camera model, write the bracket as PNGs, run the commands,
 //! and compare the merged EXR with the chart's true radiance.
 
+#[path = "cli_hdr/align.rs"]
+mod align;
 mod common;
 
 use std::path::Path;

@@ -15,12 +15,15 @@ use campanile_process::hdr::bracket_list::{
 use campanile_process::hdr::curve::ResponseCurve;
 use campanile_process::hdr::curve_plot::curve_plot_svg;
 use campanile_process::hdr::debevec::{DEFAULT_LAMBDA, DebevecOptions, Smoothness, calibrate_debevec};
+use campanile_process::hdr::deghost::{DeghostOptions, merge_deghosted};
 use campanile_process::hdr::lens::{LensModel, fit_distortion, fit_falloff, undistort_map};
 use campanile_process::hdr::merge::{MergeOptions, NoiseModel, merge};
 use campanile_process::hdr::robertson::{RobertsonOptions, calibrate_robertson};
 use campanile_process::hdr::sampling::SampleOptions;
 use campanile_process::rgbe_file::write_rgbe;
 use clap::{Args, Subcommand, ValueEnum};
+
+mod align;
 
 use super::verdicts;
 use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
@@ -130,6 +133,11 @@ pub struct CalibrateArgs {
     /// failed curve exits 3.
     #[arg(long, value_name = "FILE.ron")]
     thresholds: Option<PathBuf>,
+    /// Align a hand-held bracket to its middle exposure first (translation
+    /// and rotation up to 3°, to a fraction of a pixel), printing the
+    /// transform found for each image.
+    #[arg(long)]
+    align: bool,
 }
 
 #[derive(Debug, Args)]
@@ -172,6 +180,17 @@ pub struct MergeArgs {
     /// all-black or all-white bracket) exits 3.
     #[arg(long, value_name = "FILE.ron")]
     thresholds: Option<PathBuf>,
+    /// Align a hand-held bracket to its middle exposure first (translation
+    /// and rotation up to 3°, to a fraction of a pixel), printing the
+    /// transform found for each image. Pixels that no exposure covers after
+    /// alignment are masked.
+    #[arg(long)]
+    align: bool,
+    /// Exclude samples inconsistent (beyond 4σ of the noise model, with a 5%
+    /// floor) with the middle exposure's radiance, so a moving object comes
+    /// from one exposure instead of a blend of its positions.
+    #[arg(long)]
+    deghost: bool,
 }
 
 /// A radiance map's file format.
@@ -314,7 +333,10 @@ fn write(path: &Path, text: &str) -> Result<()> {
 
 fn calibrate(a: &CalibrateArgs) -> Result<()> {
     let q = verdicts::thresholds(a.thresholds.as_deref(), None)?;
-    let bracket = load(&a.bracket)?;
+    let mut bracket = load(&a.bracket)?;
+    if a.align {
+        bracket = align::aligned(&bracket)?;
+    }
     let sampling = SampleOptions {
         samples: a.samples,
         seed: a.seed,
@@ -390,7 +412,10 @@ fn per_channel(name: &str, v: &[f64]) -> Result<[f64; 3]> {
 
 fn merge_cmd(a: &MergeArgs) -> Result<()> {
     let q = verdicts::thresholds(a.thresholds.as_deref(), None)?;
-    let bracket = load(&a.bracket)?;
+    let mut bracket = load(&a.bracket)?;
+    if a.align {
+        bracket = align::aligned(&bracket)?;
+    }
     let text = std::fs::read_to_string(&a.curve).with_context(|| format!("reading curve {}", a.curve.display()))?;
     let curve = ResponseCurve::from_csv(&text, &a.curve).context("reading the curve")?;
     let lens = match &a.lens {
@@ -409,7 +434,13 @@ fn merge_cmd(a: &MergeArgs) -> Result<()> {
         radiometric_scale: per_channel("scale", &a.scale)?,
         falloff: lens.map(|l| l.falloff),
     };
-    let mut map = merge(&bracket, &curve, &opts).context("merging")?;
+    let mut map = if a.deghost {
+        let (map, stats) = merge_deghosted(&bracket, &curve, &opts, &DeghostOptions::default()).context("merging")?;
+        align::report_deghost(&stats)?;
+        map
+    } else {
+        merge(&bracket, &curve, &opts).context("merging")?
+    };
     if let Some(l) = lens
         && (l.distortion.a != 0.0 || l.distortion.b != 0.0)
     {

@@ -11,3 +11,4 @@ pub mod image;
 pub mod response;
 pub mod sensor;
 pub mod test_chart;
+pub mod textured_scene;

@@ -144,6 +144,59 @@ impl Bracket {
         &self.white_points
     }
 
+    /// The same exposure times with `images` in place of the images (for
+    /// resampled versions of them, e.g. aligned ones): one image per
+    /// exposure, of the same size and bit depth, codes within range. The
+    /// brightness order is not checked again (a resampled image may have
+    /// uncovered, black borders).
+    pub fn with_images(&self, images: Vec<CodeImage>) -> Result<Self, HdrError> {
+        if images.len() != self.images.len() {
+            return Err(HdrError::TimeCountMismatch {
+                images: images.len(),
+                times: self.times_s.len(),
+            });
+        }
+        let first = &self.images[0];
+        for img in &images {
+            if (img.width, img.height) != (first.width, first.height) || img.data.len() != first.data.len() {
+                return Err(HdrError::SizeMismatch {
+                    image: img.label.clone(),
+                    width: img.width,
+                    height: img.height,
+                    first: first.label.clone(),
+                    first_width: first.width,
+                    first_height: first.height,
+                });
+            }
+            if img.bits != first.bits {
+                return Err(HdrError::BitDepthMismatch {
+                    image: img.label.clone(),
+                    bits: img.bits,
+                    first: first.label.clone(),
+                    first_bits: first.bits,
+                });
+            }
+            let max = img.max_code();
+            if let Some(i) = img.data.iter().position(|&z| z > max) {
+                let p = i / 3;
+                return Err(HdrError::CodeOutOfRange {
+                    image: img.label.clone(),
+                    x: p % img.width,
+                    y: p / img.width,
+                    channel: i % 3,
+                    code: img.data[i],
+                    bits: img.bits,
+                    max,
+                });
+            }
+        }
+        Ok(Self {
+            images,
+            times_s: self.times_s.clone(),
+            white_points: self.white_points.clone(),
+        })
+    }
+
     /// The images, shortest exposure first.
     pub fn images(&self) -> &[CodeImage] {
         &self.images

@@ -29,7 +29,11 @@ pub enum HdrError {
         time_s: f64,
     },
     /// Two images carry the same exposure time.
-    #[error("images '{first}' and '{second}' both have exposure time {time_s} s: expected distinct times")]
+    #[error(
+        "images '{first}' and '{second}' both have exposure time {time_s} s: expected distinct times \
+         (some phones write the same EXIF time for different frames: leave one out, or give the true \
+         times with --times or --list)"
+    )]
     DuplicateTime {
         /// First image.
         first: String,

@@ -108,18 +108,18 @@ impl RadianceMap {
 
 /// Per (exposure, channel) tables of weight and weighted radiance, plus the
 /// bounds used for clipped pixels.
-struct Tables {
-    codes: usize,
+pub(super) struct Tables {
+    pub(super) codes: usize,
     /// `[j][c][z]` → (w, w·X), flattened.
-    lut: Vec<[f32; 2]>,
+    pub(super) lut: Vec<[f32; 2]>,
     /// Per channel: lower bound for saturated pixels, upper bound for underexposed ones.
     sat_bound: [f32; 3],
     dark_bound: [f32; 3],
     /// Variance scale (the tables' weights are normalized by it).
-    var_scale: [f64; 3],
+    pub(super) var_scale: [f64; 3],
 }
 
-fn build_tables(bracket: &Bracket, curve: &ResponseCurve, noise: &NoiseModel) -> Tables {
+pub(super) fn build_tables(bracket: &Bracket, curve: &ResponseCurve, noise: &NoiseModel) -> Tables {
     let codes = usize::from(bracket.images()[0].max_code()) + 1;
     let zmax = codes - 1;
     let times = bracket.times_s();
@@ -192,6 +192,44 @@ pub fn merge_into(
     opts: &MergeOptions,
     out: &mut RadianceMap,
 ) -> Result<(), HdrError> {
+    check_inputs(bracket, curve, opts)?;
+    let t = build_tables(bracket, curve, &opts.noise);
+    let (w, h) = (bracket.width(), bracket.height());
+    let zmax = (t.codes - 1) as u16;
+    let (gain, var_gain) = gains(&t, opts);
+    out.width = w;
+    out.height = h;
+    out.rgb.resize(w * h * 3, 0.0);
+    out.variance.resize(w * h * 3, 0.0);
+    out.mask.resize(w * h, 0);
+    let ctx = PassContext {
+        images: bracket.images().iter().map(|im| im.data.as_slice()).collect(),
+        tables: &t,
+        falloff: opts.falloff,
+        gain,
+        var_gain,
+        zmax,
+        width: w,
+        height: h,
+    };
+    // One monomorphized pass per bit depth: the tables are fixed-size arrays
+    // indexed by masked codes, so the inner loop has no bounds checks.
+    match bracket.bits() {
+        8 => pass::<256>(&ctx, out),
+        9 => pass::<512>(&ctx, out),
+        10 => pass::<1024>(&ctx, out),
+        11 => pass::<2048>(&ctx, out),
+        12 => pass::<4096>(&ctx, out),
+        13 => pass::<8192>(&ctx, out),
+        14 => pass::<16384>(&ctx, out),
+        15 => pass::<32768>(&ctx, out),
+        _ => pass::<65536>(&ctx, out),
+    }
+    Ok(())
+}
+
+/// The checks of [`merge`]: curve depth, positive calibrations, a sane noise model.
+pub(super) fn check_inputs(bracket: &Bracket, curve: &ResponseCurve, opts: &MergeOptions) -> Result<(), HdrError> {
     if curve.bits != bracket.bits() {
         return Err(HdrError::CurveBitsMismatch {
             curve_bits: curve.bits,
@@ -225,40 +263,47 @@ pub fn merge_into(
             expected: "full well > 0 and read noise ≥ 0",
         });
     }
-    let t = build_tables(bracket, curve, &opts.noise);
-    let (w, h) = (bracket.width(), bracket.height());
-    let zmax = (t.codes - 1) as u16;
+    Ok(())
+}
+
+/// Gain and variance gain per channel (radiometric scale over ND transmittance).
+pub(super) fn gains(t: &Tables, opts: &MergeOptions) -> ([f32; 3], [f32; 3]) {
     let gain: [f32; 3] = std::array::from_fn(|c| (opts.radiometric_scale[c] / opts.nd_transmittance[c]) as f32);
     let var_gain: [f32; 3] = std::array::from_fn(|c| (f64::from(gain[c]).powi(2) * t.var_scale[c]) as f32);
-    out.width = w;
-    out.height = h;
-    out.rgb.resize(w * h * 3, 0.0);
-    out.variance.resize(w * h * 3, 0.0);
-    out.mask.resize(w * h, 0);
-    let ctx = PassContext {
-        images: bracket.images().iter().map(|im| im.data.as_slice()).collect(),
-        tables: &t,
-        falloff: opts.falloff,
-        gain,
-        var_gain,
-        zmax,
-        width: w,
-        height: h,
-    };
-    // One monomorphized pass per bit depth: the tables are fixed-size arrays
-    // indexed by masked codes, so the inner loop has no bounds checks.
-    match bracket.bits() {
-        8 => pass::<256>(&ctx, out),
-        9 => pass::<512>(&ctx, out),
-        10 => pass::<1024>(&ctx, out),
-        11 => pass::<2048>(&ctx, out),
-        12 => pass::<4096>(&ctx, out),
-        13 => pass::<8192>(&ctx, out),
-        14 => pass::<16384>(&ctx, out),
-        15 => pass::<32768>(&ctx, out),
-        _ => pass::<65536>(&ctx, out),
+    (gain, var_gain)
+}
+
+/// Writes one pixel from its sums `Σw`, `Σw·X` per channel; returns its mask.
+/// A channel with no weight gets the bound of its clipping, decided by the
+/// shortest exposure's code `shortest` (saturated if at `zmax`).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(super) fn finish_pixel(
+    t: &Tables,
+    (sw, swx): ([f32; 3], [f32; 3]),
+    shortest: &[u16],
+    zmax: u16,
+    (gain, var_gain): ([f32; 3], [f32; 3]),
+    falloff: f32,
+    rgb: &mut [f32],
+    var: &mut [f32],
+) -> u8 {
+    let mut m = 0u8;
+    for c in 0..3 {
+        if sw[c] > 0.0 {
+            rgb[c] = swx[c] / sw[c] * gain[c] / falloff;
+            var[c] = var_gain[c] / (sw[c] * falloff * falloff);
+        } else if shortest[c] >= zmax {
+            m |= MASK_SATURATED << c;
+            rgb[c] = t.sat_bound[c] * gain[c] / falloff;
+            var[c] = f32::INFINITY;
+        } else {
+            m |= MASK_UNDEREXPOSED << c;
+            rgb[c] = t.dark_bound[c] * gain[c] / falloff;
+            var[c] = f32::INFINITY;
+        }
     }
-    Ok(())
+    m
 }
 
 /// What the pixel pass needs.
@@ -311,22 +356,17 @@ fn pass<const N: usize>(ctx: &PassContext, out: &mut RadianceMap) {
                 let falloff = ctx
                     .falloff
                     .map_or(1.0, |f| f.at_r2(normalized_r2(x, y, w, h)).max(1e-6) as f32);
-                let mut m = 0u8;
-                for c in 0..3 {
-                    let k = x * 3 + c;
-                    if sw[c] > 0.0 {
-                        rgb_row[k] = swx[c] / sw[c] * gain[c] / falloff;
-                        var_row[k] = var_gain[c] / (sw[c] * falloff * falloff);
-                    } else if shortest[base + k] >= ctx.zmax {
-                        m |= MASK_SATURATED << c;
-                        rgb_row[k] = t.sat_bound[c] * gain[c] / falloff;
-                        var_row[k] = f32::INFINITY;
-                    } else {
-                        m |= MASK_UNDEREXPOSED << c;
-                        rgb_row[k] = t.dark_bound[c] * gain[c] / falloff;
-                        var_row[k] = f32::INFINITY;
-                    }
-                }
+                let k = x * 3;
+                let m = finish_pixel(
+                    t,
+                    (sw, swx),
+                    &shortest[base + k..base + k + 3],
+                    ctx.zmax,
+                    (gain, var_gain),
+                    falloff,
+                    &mut rgb_row[k..k + 3],
+                    &mut var_row[k..k + 3],
+                );
                 *mask_out = m;
             }
         });

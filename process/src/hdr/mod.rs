@@ -1,6 +1,8 @@
 //! Camera response recovery and HDR assembly.
 //!
 //! - [`bracket`]: a validated exposure bracket (sizes, bit depths, times).
+//! - [`align`]: registration of hand-held brackets (median threshold bitmaps, then sub-pixel Lucas–Kanade).
+//! - [`deghost`]: exclusion of samples inconsistent with the reference exposure (moving objects).
 //! - [`bracket_list`]: bracket list files and `1/30`-style times.
 //! - [`sampling`]: seeded, intensity-stratified, edge- and motion-free sample selection.
 //! - [`debevec`]: Debevec–Malik response recovery (f64 Schur-complement normal equations).
@@ -16,11 +18,13 @@
 //! - [`white_point`]: each frame's effective white point per channel (clipping below the largest code).
 //! - [`error`]: the typed errors of all of the above.
 
+pub mod align;
 pub mod bracket;
 pub mod bracket_list;
 pub mod curve;
 pub mod curve_plot;
 pub mod debevec;
+pub mod deghost;
 pub mod error;
 pub mod exposure_metadata;
 pub mod image_file;
