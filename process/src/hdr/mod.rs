@@ -12,20 +12,30 @@
 //! - [`lens`]: the radial falloff and distortion model `1 + a r² + b r⁴` and its fit.
 //! - [`resampled`]: detection of resampled (downscaled) 8-bit input.
 //! - [`image_file`]: reading brackets from PNG/TIFF files.
-//! - [`error`]: the typed errors of all of the above.
+//! - [`raw_file`]: reading camera RAW files (rawler) into [`linear_frame`]s.
+//! - [`linear_merge`]: merging linear frames without a response curve.
+//! - [`dng_file`]: writing DNG files (for the simulated RAW path).
+//! - [`tiff_structure`]: the IFD structure of a TIFF/DNG, without its pixels.
+//! - [`error`]: the typed errors of all of the above ([`raw_error`] for the RAW path).
 
 pub mod bracket;
 pub mod bracket_list;
 pub mod curve;
 pub mod curve_plot;
 pub mod debevec;
+pub mod dng_file;
 pub mod error;
 pub mod image_file;
 pub mod lens;
+pub mod linear_frame;
+pub mod linear_merge;
 pub mod merge;
 pub mod noise_bias;
+pub mod raw_error;
+pub mod raw_file;
 pub mod resampled;
 pub mod robertson;
 pub mod sampling;
+pub mod tiff_structure;
 
 pub use error::HdrError;
