@@ -19,6 +19,9 @@ use campanile_process::hdr::robertson::{RobertsonOptions, calibrate_robertson};
 use campanile_process::hdr::sampling::SampleOptions;
 use clap::{Args, Subcommand, ValueEnum};
 
+#[path = "hdr_raw.rs"]
+mod hdr_raw;
+
 use super::verdicts;
 use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
 use campanile_process::quality::{QualityReport, gates};
@@ -27,12 +30,18 @@ use campanile_process::quality::{QualityReport, gates};
 pub enum HdrCommand {
     /// Recover the camera response curve from an exposure bracket.
     ///
+    /// PNG/TIFF only: RAW frames are linear and need no curve.
     /// Writes the curve as CSV (g(z) = ln relative exposure per code and
     /// channel, with its 1σ uncertainty and support) and an SVG plot with the
     /// ±2σ band. 8-bit images that were resampled after capture are refused.
     #[command(verbatim_doc_comment)]
     Calibrate(CalibrateArgs),
     /// Merge an exposure bracket into an OpenEXR radiance map.
+    ///
+    /// PNG/TIFF brackets merge through a response curve (--curve). RAW
+    /// brackets (DNG, CR2, CR3, NEF, ARW, RAF, RW2, ORF, PEF, SRW) merge
+    /// linearly with no curve: exposure time, f-number and ISO come from
+    /// the files (relative exposure t·ISO/N²), clipping from the white level.
     ///
     /// Channels: R, G, B (radiance), variance.R/G/B, valid (1/0) and mask
     /// (bits: saturated 1<<c, underexposed 8<<c). Pixels clipped in every
@@ -50,7 +59,9 @@ pub enum HdrCommand {
 
 #[derive(Debug, Args)]
 pub struct BracketArgs {
-    /// Images of the bracket (PNG or TIFF, 8 or 16 bits).
+    /// Images of the bracket: PNG or TIFF (8 or 16 bits), or camera RAW
+    /// (DNG, CR2, CR3, NEF, ARW, RAF, RW2, ORF, PEF, SRW; a DNG under any name).
+    /// RAW times, f-numbers and ISOs come from the files unless --times is given.
     #[arg(value_name = "IMAGE")]
     images: Vec<PathBuf>,
     /// Exposure times in seconds, one per image, comma separated ("1/30" allowed).
@@ -108,9 +119,14 @@ pub struct CalibrateArgs {
 pub struct MergeArgs {
     #[command(flatten)]
     bracket: BracketArgs,
-    /// Response curve (CSV from `hdr calibrate`).
+    /// Response curve (CSV from `hdr calibrate`); required for PNG/TIFF,
+    /// not used for RAW (linear) frames.
     #[arg(long)]
-    curve: PathBuf,
+    curve: Option<PathBuf>,
+    /// Colour space of a merged RAW bracket (camera: the sensor's own
+    /// channels, as everywhere in the project).
+    #[arg(long, value_enum, default_value_t = hdr_raw::RawColor::Camera)]
+    raw_color: hdr_raw::RawColor,
     /// Output radiance map (OpenEXR).
     #[arg(long, short)]
     out: PathBuf,
@@ -214,6 +230,7 @@ fn write(path: &Path, text: &str) -> Result<()> {
 
 fn calibrate(a: &CalibrateArgs) -> Result<()> {
     let q = verdicts::thresholds(a.thresholds.as_deref(), None)?;
+    hdr_raw::refuse_raw_calibration(&a.bracket)?;
     let bracket = load(&a.bracket)?;
     let sampling = SampleOptions {
         samples: a.samples,
@@ -291,10 +308,19 @@ fn per_channel(name: &str, v: &[f64]) -> Result<[f64; 3]> {
 }
 
 fn merge_cmd(a: &MergeArgs) -> Result<()> {
+    if hdr_raw::is_raw_bracket(&a.bracket)? {
+        return hdr_raw::merge_raw(a);
+    }
     let q = verdicts::thresholds(a.thresholds.as_deref(), None)?;
+    let curve_path = a.curve.as_deref().ok_or_else(|| {
+        super::exit::bad_input(
+            "--curve is required for PNG/TIFF brackets (run `campanile hdr calibrate` first); only RAW frames merge without one",
+        )
+    })?;
     let bracket = load(&a.bracket)?;
-    let text = std::fs::read_to_string(&a.curve).with_context(|| format!("reading curve {}", a.curve.display()))?;
-    let curve = ResponseCurve::from_csv(&text, &a.curve).context("reading the curve")?;
+    let text =
+        std::fs::read_to_string(curve_path).with_context(|| format!("reading curve {}", curve_path.display()))?;
+    let curve = ResponseCurve::from_csv(&text, curve_path).context("reading the curve")?;
     let lens = match &a.lens {
         Some(p) => {
             let t = std::fs::read_to_string(p).with_context(|| format!("reading lens model {}", p.display()))?;
@@ -331,7 +357,7 @@ fn merge_cmd(a: &MergeArgs) -> Result<()> {
         .file_name()
         .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
     let mut quality = gates::radiance(&name, &map, false, &q);
-    if let Some(curve) = verdicts::of_input(&a.curve)? {
+    if let Some(curve) = verdicts::of_input(curve_path)? {
         quality.inherit(&curve);
     }
     verdicts::finish(&QualityReport::new(vec![quality], &q), &verdicts::beside(&a.out))
