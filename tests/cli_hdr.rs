@@ -5,6 +5,8 @@
 #[path = "cli_hdr/align.rs"]
 mod align;
 mod common;
+#[path = "cli_hdr/raw.rs"]
+mod raw;
 
 use std::path::Path;
 

@@ -17,13 +17,14 @@ use campanile_process::hdr::curve_plot::curve_plot_svg;
 use campanile_process::hdr::debevec::{DEFAULT_LAMBDA, DebevecOptions, Smoothness, calibrate_debevec};
 use campanile_process::hdr::deghost::{DeghostOptions, merge_deghosted};
 use campanile_process::hdr::lens::{LensModel, fit_distortion, fit_falloff, undistort_map};
-use campanile_process::hdr::merge::{MergeOptions, NoiseModel, merge};
+use campanile_process::hdr::merge::{MergeOptions, NoiseModel, RadianceMap, merge};
 use campanile_process::hdr::robertson::{RobertsonOptions, calibrate_robertson};
 use campanile_process::hdr::sampling::SampleOptions;
 use campanile_process::rgbe_file::write_rgbe;
 use clap::{Args, Subcommand, ValueEnum};
 
 mod align;
+mod raw;
 
 use super::verdicts;
 use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
@@ -34,7 +35,8 @@ pub enum HdrCommand {
     /// Recover the camera response curve from an exposure bracket.
     ///
     /// Input: PNG, TIFF or JPEG files, 8 or 16 bits per sample, grey or RGB
-    /// (alpha ignored), turned upright by their EXIF orientation. Exposure
+    /// (alpha ignored), turned upright by their EXIF orientation (RAW frames
+    /// are linear and need no curve: merge them directly). Exposure
     /// times come from --times, from --list, or else from each file's EXIF
     /// (ExposureTime, with FNumber and ISO when every frame has them: the
     /// relative exposure is t·ISO/N², so brackets that vary aperture or ISO
@@ -52,7 +54,12 @@ pub enum HdrCommand {
     Calibrate(CalibrateArgs),
     /// Merge an exposure bracket into a radiance map (OpenEXR or Radiance RGBE).
     ///
-    /// Input as for `calibrate`. Output by OUT's extension or --format:
+    /// Input as for `calibrate`, or camera RAW (DNG, CR2, CR3, NEF, ARW, RAF,
+    /// RW2, ORF, PEF, SRW; a DNG under any name), which merges linearly with
+    /// no --curve: exposure time, f-number and ISO from the files (relative
+    /// exposure t·ISO/N²), clipping from the white level.
+    ///
+    /// Output by OUT's extension or --format:
     /// - .exr (default): plain RGB (float, or half with --half), which every
     ///   viewer opens; with --with-variance also variance.R/G/B, valid (1/0)
     ///   and mask (bits: saturated 1<<c, underexposed 8<<c);
@@ -64,6 +71,7 @@ pub enum HdrCommand {
     /// Example:
     ///   campanile hdr merge IMG_*.JPG --curve curve.csv -o scene.exr
     ///   campanile hdr merge IMG_*.JPG --curve curve.csv -o scene.hdr
+    ///   campanile hdr merge DSC_*.NEF -o scene.exr
     #[command(verbatim_doc_comment)]
     Merge(MergeArgs),
     /// Fit the lens model 1 + a r² + b r⁴ (falloff and distortion).
@@ -77,7 +85,9 @@ pub enum HdrCommand {
 
 #[derive(Debug, Args)]
 pub struct BracketArgs {
-    /// Images of the bracket (PNG, TIFF or JPEG; 8 or 16 bits).
+    /// Images of the bracket: PNG, TIFF or JPEG (8 or 16 bits), or camera
+    /// RAW for `merge` (DNG, CR2, CR3, NEF, ARW, RAF, RW2, ORF, PEF, SRW; a
+    /// DNG under any name).
     #[arg(value_name = "IMAGE")]
     images: Vec<PathBuf>,
     /// Exposure times in seconds, one per image, comma separated ("1/30"
@@ -144,9 +154,14 @@ pub struct CalibrateArgs {
 pub struct MergeArgs {
     #[command(flatten)]
     bracket: BracketArgs,
-    /// Response curve (CSV from `hdr calibrate`).
+    /// Response curve (CSV from `hdr calibrate`); required for PNG/TIFF,
+    /// not used for RAW (linear) frames.
     #[arg(long)]
-    curve: PathBuf,
+    curve: Option<PathBuf>,
+    /// Colour space of a merged RAW bracket (camera: the sensor's own
+    /// channels, as everywhere in the project).
+    #[arg(long, value_enum, default_value_t = raw::RawColor::Camera)]
+    raw_color: raw::RawColor,
     /// Output radiance map: .exr (OpenEXR) or .hdr (Radiance RGBE).
     #[arg(long, short)]
     out: PathBuf,
@@ -333,6 +348,7 @@ fn write(path: &Path, text: &str) -> Result<()> {
 
 fn calibrate(a: &CalibrateArgs) -> Result<()> {
     let q = verdicts::thresholds(a.thresholds.as_deref(), None)?;
+    raw::refuse_raw_calibration(&a.bracket)?;
     let mut bracket = load(&a.bracket)?;
     if a.align {
         bracket = align::aligned(&bracket)?;
@@ -410,14 +426,50 @@ fn per_channel(name: &str, v: &[f64]) -> Result<[f64; 3]> {
     }
 }
 
+/// The output format: `--format`, else by OUT's extension; the
+/// OpenEXR-only options refused for Radiance RGBE.
+fn output_format(a: &MergeArgs) -> Result<OutputFormat> {
+    let format = a.format.unwrap_or_else(|| {
+        let hdr = a.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("hdr"));
+        if hdr { OutputFormat::Hdr } else { OutputFormat::Exr }
+    });
+    if format == OutputFormat::Hdr && (a.with_variance || a.half) {
+        return Err(super::exit::bad_input(
+            "--with-variance and --half are OpenEXR options: Radiance RGBE (.hdr) holds colour only",
+        ));
+    }
+    Ok(format)
+}
+
+/// Writes a merged map as `hdr merge`'s options ask.
+fn write_map(a: &MergeArgs, format: OutputFormat, map: &RadianceMap) -> Result<()> {
+    match format {
+        OutputFormat::Hdr => write_rgbe(map, &a.out),
+        OutputFormat::Exr if a.with_variance => write_radiance_exr(map, &a.out),
+        OutputFormat::Exr if a.half => write_rgb_exr(map, &a.out, ExrPrecision::Half),
+        OutputFormat::Exr => write_rgb_exr(map, &a.out, ExrPrecision::Float),
+    }
+    .context("writing the radiance map")
+}
+
 fn merge_cmd(a: &MergeArgs) -> Result<()> {
+    let format = output_format(a)?;
+    if raw::is_raw_bracket(&a.bracket)? {
+        return raw::merge_raw(a, format);
+    }
     let q = verdicts::thresholds(a.thresholds.as_deref(), None)?;
+    let curve_path = a.curve.as_deref().ok_or_else(|| {
+        super::exit::bad_input(
+            "--curve is required for PNG/TIFF/JPEG brackets (run `campanile hdr calibrate` first); only RAW frames merge without one",
+        )
+    })?;
     let mut bracket = load(&a.bracket)?;
     if a.align {
         bracket = align::aligned(&bracket)?;
     }
-    let text = std::fs::read_to_string(&a.curve).with_context(|| format!("reading curve {}", a.curve.display()))?;
-    let curve = ResponseCurve::from_csv(&text, &a.curve).context("reading the curve")?;
+    let text =
+        std::fs::read_to_string(curve_path).with_context(|| format!("reading curve {}", curve_path.display()))?;
+    let curve = ResponseCurve::from_csv(&text, curve_path).context("reading the curve")?;
     let lens = match &a.lens {
         Some(p) => {
             let t = std::fs::read_to_string(p).with_context(|| format!("reading lens model {}", p.display()))?;
@@ -446,29 +498,7 @@ fn merge_cmd(a: &MergeArgs) -> Result<()> {
     {
         map = undistort_map(&map, &l.distortion);
     }
-    let format = a.format.unwrap_or_else(|| {
-        let hdr = a.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("hdr"));
-        if hdr { OutputFormat::Hdr } else { OutputFormat::Exr }
-    });
-    match format {
-        OutputFormat::Hdr if a.with_variance || a.half => {
-            return Err(super::exit::bad_input(
-                "--with-variance and --half are OpenEXR options: Radiance RGBE (.hdr) holds colour only",
-            ));
-        }
-        OutputFormat::Hdr => write_rgbe(&map, &a.out),
-        OutputFormat::Exr if a.with_variance => write_radiance_exr(&map, &a.out),
-        OutputFormat::Exr => write_rgb_exr(
-            &map,
-            &a.out,
-            if a.half {
-                ExrPrecision::Half
-            } else {
-                ExrPrecision::Float
-            },
-        ),
-    }
-    .context("writing the radiance map")?;
+    write_map(a, format, &map)?;
     let invalid = map.mask.iter().filter(|&&m| m != 0).count();
     outln!(
         "wrote {} ({}×{}, {} exposures; {invalid} pixels clipped in some channel in every exposure)",
@@ -482,7 +512,7 @@ fn merge_cmd(a: &MergeArgs) -> Result<()> {
         .file_name()
         .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
     let mut quality = gates::radiance(&name, &map, false, &q);
-    if let Some(curve) = verdicts::of_input(&a.curve)? {
+    if let Some(curve) = verdicts::of_input(curve_path)? {
         quality.inherit(&curve);
     }
     verdicts::finish(&QualityReport::new(vec![quality], &q), &verdicts::beside(&a.out))

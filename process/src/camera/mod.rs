@@ -7,6 +7,7 @@
 //! monotone response `f` ([`response::ParametricResponse`]) and quantization to
 //! 8, 12 or 16 bits ([`sensor::CameraModel`]).
 
+pub mod bayer;
 pub mod image;
 pub mod response;
 pub mod sensor;

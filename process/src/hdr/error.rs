@@ -205,4 +205,7 @@ pub enum HdrError {
         /// Cause.
         cause: exr::error::Error,
     },
+    /// Reading a RAW file or merging linear frames (see [`super::raw_error`]).
+    #[error(transparent)]
+    Raw(#[from] super::raw_error::RawError),
 }

@@ -12,11 +12,15 @@
 //! - [`curve_plot`]: SVG plot of a curve with its uncertainty band.
 //! - [`merge`]: the single-pass, LUT-driven, noise-optimal radiance merge.
 //! - [`lens`]: the radial falloff and distortion model `1 + a r² + b r⁴` and its fit.
-//! - [`resampled`]: detection of resampled (downscaled) 8-bit input.
+//! - [`resampled`]: a statistic of resampling in 8-bit images (measured, not a check).
 //! - [`image_file`]: reading brackets from PNG/TIFF/JPEG files, turned upright.
 //! - [`exposure_metadata`]: EXIF exposure time, f-number, ISO, orientation; effective times.
 //! - [`white_point`]: each frame's effective white point per channel (clipping below the largest code).
-//! - [`error`]: the typed errors of all of the above.
+//! - [`raw_file`]: reading camera RAW files (rawler) into [`linear_frame`]s.
+//! - [`linear_merge`]: merging linear frames without a response curve.
+//! - [`dng_file`]: writing DNG files (for the simulated RAW path).
+//! - [`tiff_structure`]: the IFD structure of a TIFF/DNG, without its pixels.
+//! - [`error`]: the typed errors of all of the above ([`raw_error`] for the RAW path).
 
 pub mod align;
 pub mod bracket;
@@ -25,15 +29,21 @@ pub mod curve;
 pub mod curve_plot;
 pub mod debevec;
 pub mod deghost;
+pub mod dng_file;
 pub mod error;
 pub mod exposure_metadata;
 pub mod image_file;
 pub mod lens;
+pub mod linear_frame;
+pub mod linear_merge;
 pub mod merge;
 pub mod noise_bias;
+pub mod raw_error;
+pub mod raw_file;
 pub mod resampled;
 pub mod robertson;
 pub mod sampling;
+pub mod tiff_structure;
 pub mod white_point;
 
 pub use error::HdrError;
