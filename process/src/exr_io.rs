@@ -39,9 +39,19 @@ pub fn write_radiance_exr(map: &RadianceMap, path: &Path) -> std::result::Result
         "mask",
         FlatSamples::F32(map.mask.iter().map(|&m| f32::from(m)).collect()),
     ));
+    write_layer(map, LayerAttributes::named("radiance"), channels, path)
+}
+
+/// Writes one ZIP-compressed scan-line layer of `map`'s size.
+fn write_layer(
+    map: &RadianceMap,
+    attributes: LayerAttributes,
+    channels: Vec<AnyChannel<FlatSamples>>,
+    path: &Path,
+) -> std::result::Result<(), HdrError> {
     let layer = Layer::new(
         (map.width, map.height),
-        LayerAttributes::named("radiance"),
+        attributes,
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(SmallVec::from_vec(channels)),
     );
@@ -80,19 +90,7 @@ pub fn write_rgb_exr(map: &RadianceMap, path: &Path, precision: ExrPrecision) ->
         .enumerate()
         .map(|(c, name)| AnyChannel::new(*name, plane(c)))
         .collect();
-    let layer = Layer::new(
-        (map.width, map.height),
-        LayerAttributes::default(),
-        Encoding::SMALL_LOSSLESS,
-        AnyChannels::sort(SmallVec::from_vec(channels)),
-    );
-    Image::from_layer(layer)
-        .write()
-        .to_file(path)
-        .map_err(|cause| HdrError::Exr {
-            path: path.to_path_buf(),
-            cause,
-        })
+    write_layer(map, LayerAttributes::default(), channels, path)
 }
 
 /// The first layer of the OpenEXR file at `path`, all channels as flat

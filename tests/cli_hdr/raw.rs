@@ -161,5 +161,5 @@ fn raw_usage_errors_exit_2_with_the_reason() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("--curve is required for PNG/TIFF brackets"), "{err}");
+    assert!(err.contains("--curve is required for PNG/TIFF/JPEG brackets"), "{err}");
 }

@@ -41,59 +41,7 @@ impl Bracket {
                     time_s: t,
                 });
             }
-            if !matches!(img.bits, 8..=16) {
-                return Err(HdrError::BadImage {
-                    image: img.label.clone(),
-                    what: format!("{} bits per sample: expected 8 to 16", img.bits),
-                });
-            }
-            if img.width == 0 || img.height == 0 {
-                return Err(HdrError::BadImage {
-                    image: img.label.clone(),
-                    what: "image is empty (0 pixels)".into(),
-                });
-            }
-            let expected = img.width * img.height * 3;
-            if img.data.len() != expected {
-                return Err(HdrError::BufferLength {
-                    image: img.label.clone(),
-                    len: img.data.len(),
-                    width: img.width,
-                    height: img.height,
-                    expected,
-                });
-            }
-            if (img.width, img.height) != (first.width, first.height) {
-                return Err(HdrError::SizeMismatch {
-                    image: img.label.clone(),
-                    width: img.width,
-                    height: img.height,
-                    first: first.label.clone(),
-                    first_width: first.width,
-                    first_height: first.height,
-                });
-            }
-            if img.bits != first.bits {
-                return Err(HdrError::BitDepthMismatch {
-                    image: img.label.clone(),
-                    bits: img.bits,
-                    first: first.label.clone(),
-                    first_bits: first.bits,
-                });
-            }
-            let max = img.max_code();
-            if let Some(i) = img.data.iter().position(|&z| z > max) {
-                let p = i / 3;
-                return Err(HdrError::CodeOutOfRange {
-                    image: img.label.clone(),
-                    x: p % img.width,
-                    y: p / img.width,
-                    channel: i % 3,
-                    code: img.data[i],
-                    bits: img.bits,
-                    max,
-                });
-            }
+            check_image(img, first)?;
         }
         let mut order: Vec<usize> = (0..images.len()).collect();
         order.sort_by(|&a, &b| times_s[a].total_cmp(&times_s[b]));
@@ -158,37 +106,7 @@ impl Bracket {
         }
         let first = &self.images[0];
         for img in &images {
-            if (img.width, img.height) != (first.width, first.height) || img.data.len() != first.data.len() {
-                return Err(HdrError::SizeMismatch {
-                    image: img.label.clone(),
-                    width: img.width,
-                    height: img.height,
-                    first: first.label.clone(),
-                    first_width: first.width,
-                    first_height: first.height,
-                });
-            }
-            if img.bits != first.bits {
-                return Err(HdrError::BitDepthMismatch {
-                    image: img.label.clone(),
-                    bits: img.bits,
-                    first: first.label.clone(),
-                    first_bits: first.bits,
-                });
-            }
-            let max = img.max_code();
-            if let Some(i) = img.data.iter().position(|&z| z > max) {
-                let p = i / 3;
-                return Err(HdrError::CodeOutOfRange {
-                    image: img.label.clone(),
-                    x: p % img.width,
-                    y: p / img.width,
-                    channel: i % 3,
-                    code: img.data[i],
-                    bits: img.bits,
-                    max,
-                });
-            }
+            check_image(img, first)?;
         }
         Ok(Self {
             images,
@@ -231,6 +149,66 @@ impl Bracket {
     pub fn is_empty(&self) -> bool {
         self.images.is_empty()
     }
+}
+
+/// One image of a bracket whose first image is `first`: 8 to 16 bits, not
+/// empty, a buffer of `width · height · 3` codes, the size and depth of the
+/// first, every code within its depth.
+fn check_image(img: &CodeImage, first: &CodeImage) -> Result<(), HdrError> {
+    if !matches!(img.bits, 8..=16) {
+        return Err(HdrError::BadImage {
+            image: img.label.clone(),
+            what: format!("{} bits per sample: expected 8 to 16", img.bits),
+        });
+    }
+    if img.width == 0 || img.height == 0 {
+        return Err(HdrError::BadImage {
+            image: img.label.clone(),
+            what: "image is empty (0 pixels)".into(),
+        });
+    }
+    let expected = img.width * img.height * 3;
+    if img.data.len() != expected {
+        return Err(HdrError::BufferLength {
+            image: img.label.clone(),
+            len: img.data.len(),
+            width: img.width,
+            height: img.height,
+            expected,
+        });
+    }
+    if (img.width, img.height) != (first.width, first.height) {
+        return Err(HdrError::SizeMismatch {
+            image: img.label.clone(),
+            width: img.width,
+            height: img.height,
+            first: first.label.clone(),
+            first_width: first.width,
+            first_height: first.height,
+        });
+    }
+    if img.bits != first.bits {
+        return Err(HdrError::BitDepthMismatch {
+            image: img.label.clone(),
+            bits: img.bits,
+            first: first.label.clone(),
+            first_bits: first.bits,
+        });
+    }
+    let max = img.max_code();
+    if let Some(i) = img.data.iter().position(|&z| z > max) {
+        let p = i / 3;
+        return Err(HdrError::CodeOutOfRange {
+            image: img.label.clone(),
+            x: p % img.width,
+            y: p / img.width,
+            channel: i % 3,
+            code: img.data[i],
+            bits: img.bits,
+            max,
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]
