@@ -154,7 +154,7 @@ pub struct CalibrateArgs {
 pub struct MergeArgs {
     #[command(flatten)]
     bracket: BracketArgs,
-    /// Response curve (CSV from `hdr calibrate`); required for PNG/TIFF,
+    /// Response curve (CSV from `hdr calibrate`); required for PNG/TIFF/JPEG,
     /// not used for RAW (linear) frames.
     #[arg(long)]
     curve: Option<PathBuf>,
