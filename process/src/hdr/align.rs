@@ -862,8 +862,7 @@ pub(crate) mod tests {
     use crate::camera::image::RadianceImage;
     use crate::camera::sensor::CameraModel;
     use crate::camera::textured_scene::textured_scene;
-    use crate::hdr::curve::ResponseCurve;
-    use crate::hdr::curve::{ChannelCurve, node_code, node_count};
+    use crate::hdr::merge::tests::true_curve;
     use crate::hdr::merge::{MergeOptions, merge};
 
     /// The scene as image `j` sees it: pixel `s` shows the scene at `T⁻¹(s)`.
@@ -897,22 +896,6 @@ pub(crate) mod tests {
             .map(|(j, (&t, &tr))| cam.photograph(&render(w, h, tr), t, seed + j as u64))
             .collect();
         Bracket::new(imgs, TIMES.to_vec()).unwrap()
-    }
-
-    pub(crate) fn true_curve(cam: &CameraModel) -> ResponseCurve {
-        let bits = cam.sensor.bits;
-        let n = node_count(bits);
-        let ch = |c: usize| ChannelCurve {
-            ln_exposure: (0..n)
-                .map(|k| cam.true_ln_exposure(node_code(bits, k).max(0.5), c))
-                .collect(),
-            ln_exposure_std: vec![0.0; n],
-            support: vec![0; n],
-        };
-        ResponseCurve {
-            bits,
-            channels: [ch(0), ch(1), ch(2)],
-        }
     }
 
     #[test]

@@ -202,11 +202,6 @@ pub fn load_bracket_files(paths: &[PathBuf], times_s: Option<&[f64]>) -> Result<
     Ok((Bracket::new(images, times)?, records))
 }
 
-/// Reads and validates a bracket from image files and their times.
-pub fn load_bracket(paths: &[PathBuf], times_s: &[f64]) -> Result<Bracket, HdrError> {
-    load_bracket_files(paths, Some(times_s)).map(|(b, _)| b)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

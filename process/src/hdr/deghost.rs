@@ -206,8 +206,9 @@ mod tests {
     use crate::camera::image::RadianceImage;
     use crate::camera::sensor::CameraModel;
     use crate::camera::test_chart::hdr_chart;
-    use crate::hdr::align::tests::{TIMES, true_curve};
+    use crate::hdr::align::tests::TIMES;
     use crate::hdr::merge::merge;
+    use crate::hdr::merge::tests::true_curve;
 
     const SIDE: usize = 12;
     /// The object's radiance: 2–6× the background under it, unclipped up to

@@ -404,7 +404,7 @@ fn median(v: &mut [f64]) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::camera::image::CodeImage;
     use crate::camera::sensor::CameraModel;
@@ -412,7 +412,8 @@ mod tests {
     use crate::hdr::curve::{ChannelCurve, node_code, node_count};
     use crate::hdr::debevec::{DebevecOptions, calibrate_debevec};
 
-    fn true_curve(cam: &CameraModel) -> ResponseCurve {
+    /// The camera model's own curve, sampled at the curve nodes.
+    pub(crate) fn true_curve(cam: &CameraModel) -> ResponseCurve {
         let bits = cam.sensor.bits;
         let n = node_count(bits);
         let ch = |c: usize| ChannelCurve {

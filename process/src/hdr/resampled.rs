@@ -22,7 +22,6 @@
 //! −0.57 to +0.30), and no threshold separates the two. So calibration no
 //! longer looks at it, and `--allow-resampled` is accepted and ignored.
 
-use super::bracket::Bracket;
 use crate::camera::image::CodeImage;
 
 /// The former refusal limit (mean lag-1 autocorrelation of second
@@ -88,7 +87,7 @@ pub fn second_difference_autocorrelation(img: &CodeImage, c: usize) -> Option<(f
     Some((out[0].0 / out[0].1, out[1].0 / out[1].1, n))
 }
 
-/// The resampling statistic of a bracket's middle exposure.
+/// The resampling statistic of an image.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResamplingEvidence {
     /// The image examined.
@@ -110,15 +109,9 @@ impl ResamplingEvidence {
     }
 }
 
-/// The statistic of an 8-bit bracket's middle exposure (central crop of at
-/// most 512² pixels, green channel); `None` for deeper brackets (the concern
-/// is re-quantized 8-bit output) and for images without enough noise to
-/// judge.
-pub fn assess_resampling(bracket: &Bracket) -> Option<ResamplingEvidence> {
-    if bracket.bits() != 8 {
-        return None;
-    }
-    let img = &bracket.images()[bracket.len() / 2];
+/// The statistic of one image: the green channel of its central crop (at
+/// most 512² pixels); `None` for images without enough noise to judge.
+pub fn central_crop_statistic(img: &CodeImage) -> Option<ResamplingEvidence> {
     // A central crop of at most CHECK_SIZE² pixels is plenty of evidence.
     let (cw, ch) = (img.width.min(CHECK_SIZE), img.height.min(CHECK_SIZE));
     let (x0, y0) = ((img.width - cw) / 2, (img.height - ch) / 2);
@@ -177,8 +170,7 @@ mod tests {
             (rh + 2.0 / 3.0).abs() < 0.12 && (rv + 2.0 / 3.0).abs() < 0.12,
             "native: {rh} {rv}"
         );
-        let b = Bracket::new(native.clone(), SEVEN_STOP_TIMES_S.to_vec()).unwrap();
-        let e = assess_resampling(&b).unwrap();
+        let e = central_crop_statistic(&native[3]).unwrap();
         assert!(!e.looks_resampled(), "native: {e:?}");
         for (w, h, f) in [
             (96, 64, FilterType::Triangle),
@@ -186,8 +178,7 @@ mod tests {
             (120, 80, FilterType::Lanczos3),
         ] {
             let small: Vec<CodeImage> = native.iter().map(|im| downscale(im, w, h, f)).collect();
-            let b = Bracket::new(small, SEVEN_STOP_TIMES_S.to_vec()).unwrap();
-            let e = assess_resampling(&b).unwrap();
+            let e = central_crop_statistic(&small[3]).unwrap();
             assert!(e.looks_resampled(), "{w}x{h} {f:?}: {e:?}");
         }
     }
