@@ -30,7 +30,10 @@ Three readings of t_a / t_b:
   channel against the others; an error of the times cannot hide in it.
 
 Curves: every `<set>/<name>.csv` that exists among campanile_debevec,
-campanile_robertson, opencv_debevec, opencv_robertson, pfstools_robertson;
+campanile_robertson, opencv_debevec, opencv_robertson, pfstools_robertson
+(peers.py, campanile_curves.sh), hdrgen_rerun and hdrgen_rerun_noadj
+(hdrgen_rerun.sh: hdrgen's own fit on the set, with and without its
+exposure adjustment `-e`);
 the maker's hdrgen curve read from `<set>/Response_function.rsp` twice: as
 hdrgen evaluates it (hdrgen_rsp.py, from panlib phdrimg.h/.cpp:
 x = (code + 0.5)/256, linear toe through zero below code 19; `hdrgen_rsp`)
@@ -43,7 +46,7 @@ Run (bench venv, outside the repository; sets from fetch_sets.sh):
     venv=$(bench/venv.sh opencv-python-headless numpy)
     "$venv/bin/python" validation/hdr/consistency.py [--set radiantlab-eos] \
         [--samples 400000] [--seed 1] [--lo 10 --hi 245] \
-        [--curve NAME=PATH ...] [--csv OUT.csv] [--md OUT.md]
+        [--curve NAME=PATH ...] [--csv OUT.csv] [--md OUT.md] [--svg OUT.svg]
 
 The sampled codes are cached in `<set>/consistency_samples_<seed>_<n>.npz`
 (first run decodes every frame once: ~1 min for the 18 × 21 MP EOS set).
@@ -53,7 +56,8 @@ Prints (and writes with --md) markdown tables, stops:
    over all pixel pairs, and the number of pairs;
 2. per curve, blue and the other channels, the mean e and the RMS by code of
    the longer exposure z_a (bins 10–31, 32–63, … 224–HI), `pair` reading.
---csv writes every figure in long form: reading, curve, channel, bin_lo,
+--svg draws the mean error by code (8-code bins, `pair` reading), one line
+per curve, one panel per channel. --csv writes every figure in long form: reading, curve, channel, bin_lo,
 bin_hi, n, rms_stops, mean_stops, median_abs_stops.
 """
 
@@ -76,6 +80,8 @@ FILE_CURVES = [
     "opencv_debevec",
     "opencv_robertson",
     "pfstools_robertson",
+    "hdrgen_rerun",
+    "hdrgen_rerun_noadj",
 ]
 BINS = [(10, 31), (32, 63), (64, 95), (96, 127), (128, 159), (160, 191), (192, 223), (224, 255)]
 
@@ -191,6 +197,72 @@ def stats(e):
     return (e.size, float(np.sqrt(np.mean(e * e))), float(e.mean()), float(np.median(np.abs(e))))
 
 
+def fine_bins(es, zs, lo, hi, width=8):
+    """Per channel: [(bin centre, mean e, n)] over bins of `width` codes."""
+    out = []
+    for e, z in zip(es, zs):
+        pts = []
+        for b0 in range(lo, hi + 1, width):
+            m = (z >= b0) & (z < min(b0 + width, hi + 1))
+            if m.sum() >= 200:
+                pts.append((b0 + (min(b0 + width, hi + 1) - b0 - 1) / 2, float(e[m].mean()), int(m.sum())))
+        out.append(pts)
+    return out
+
+
+COLOURS = {
+    "campanile_debevec": "#1f77b4",
+    "campanile_robertson": "#17becf",
+    "opencv_debevec": "#ff7f0e",
+    "opencv_robertson": "#bcbd22",
+    "pfstools_robertson": "#9467bd",
+    "hdrgen_rsp": "#d62728",
+    "hdrgen_code255": "#e377c2",
+    "hdrgen_rerun": "#8c564b",
+    "hdrgen_rerun_noadj": "#7f7f7f",
+}
+
+
+def plot_svg(fine, a):
+    """Three panels (R, G, B): mean pixel-pair error (stops) against the code
+    of the longer exposure, one line per curve."""
+    pw, ph, ml, mt, gap = 300, 220, 50, 30, 30
+    ymin, ymax = -0.3, 0.3
+    w = ml + 3 * (pw + gap) + 140
+    h = mt + ph + 50
+    o = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="11">']
+    o.append(f'<rect width="{w}" height="{h}" fill="white"/>')
+    o.append(
+        f'<text x="{ml}" y="16" font-size="13">Mean pixel-pair error (stops) vs code of the longer exposure, '
+        f"set {a.set}, `pair` reading ({a.samples} uniform pixels)</text>"
+    )
+    for p, ch in enumerate("RGB"):
+        x0 = ml + p * (pw + gap)
+        sx = lambda z: x0 + (z - a.lo) / (a.hi - a.lo) * pw  # noqa: E731
+        sy = lambda v: mt + (ymax - min(max(v, ymin), ymax)) / (ymax - ymin) * ph  # noqa: E731
+        o.append(f'<rect x="{x0}" y="{mt}" width="{pw}" height="{ph}" fill="none" stroke="#888"/>')
+        for v in (-0.2, -0.1, 0.0, 0.1, 0.2):
+            o.append(
+                f'<line x1="{x0}" x2="{x0 + pw}" y1="{sy(v):.1f}" y2="{sy(v):.1f}" stroke="{"#444" if v == 0 else "#ddd"}"/>'
+            )
+            if p == 0:
+                o.append(f'<text x="{x0 - 5}" y="{sy(v) + 4:.1f}" text-anchor="end">{v:+.1f}</text>')
+        for z in (32, 64, 128, 192, 245):
+            o.append(f'<text x="{sx(z):.1f}" y="{mt + ph + 14}" text-anchor="middle">{z}</text>')
+        o.append(f'<text x="{x0 + pw / 2}" y="{mt + ph + 30}" text-anchor="middle">{ch}: code z_a</text>')
+        for name, per in fine.items():
+            pts = " ".join(f"{sx(z):.1f},{sy(v):.1f}" for z, v, _ in per[p])
+            sw = 2.2 if name in ("hdrgen_rsp", "campanile_debevec") else 1.2
+            o.append(f'<polyline points="{pts}" fill="none" stroke="{COLOURS.get(name, "#000")}" stroke-width="{sw}"/>')
+    lx = ml + 3 * (pw + gap)
+    for i, name in enumerate(fine):
+        y = mt + 10 + 16 * i
+        o.append(f'<line x1="{lx}" x2="{lx + 20}" y1="{y}" y2="{y}" stroke="{COLOURS.get(name, "#000")}" stroke-width="2"/>')
+        o.append(f'<text x="{lx + 24}" y="{y + 4}">{name}</text>')
+    o.append("</svg>")
+    return "\n".join(o) + "\n"
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--set", default="radiantlab-eos")
@@ -202,6 +274,7 @@ def main():
     ap.add_argument("--only", help="comma-separated curve names to report (default all)")
     ap.add_argument("--csv")
     ap.add_argument("--md")
+    ap.add_argument("--svg", help="plot of the mean error by code of the longer exposure (8-code bins, `pair` reading)")
     a = ap.parse_args()
     d = sets_root() / a.set
     files, times = read_times(d)
@@ -242,9 +315,12 @@ def main():
     out.append("| reading | curve | R RMS / mean | G RMS / mean | B RMS / mean | B median abs | pairs (B) |")
     out.append("|---|---|---|---|---|---|---|")
     binned = {}
+    fine = {}
     for rname, (ln_t, fit) in readings.items():
         for cname, curve in curves.items():
             es, zs = pair_errors(codes, ln_t, curve, a.lo, a.hi, valid, fit)
+            if rname == "pair":
+                fine[cname] = fine_bins(es, zs, a.lo, a.hi)
             cells = []
             for c, ch in enumerate("rgb"):
                 n, rms, mean, med = stats(es[c])
@@ -274,6 +350,8 @@ def main():
     print(text)
     if a.md:
         pathlib.Path(a.md).write_text(text + "\n")
+    if a.svg:
+        pathlib.Path(a.svg).write_text(plot_svg(fine, a))
     if a.csv:
         with open(a.csv, "w", newline="") as f:
             w = csv.writer(f, lineterminator="\n")
