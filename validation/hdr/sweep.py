@@ -12,6 +12,10 @@ the row says) on the full set with --times from times.txt; then, per channel:
 - `pixels`: the RMS pixel-pair error of consistency.py, `pair` and `exif`
   readings, on consistency.py's cached uniform samples.
 
+Rows `blend_maker_α` are no calibration: (1 − α)·default + α·maker, what
+tuning Campanile's curve toward the maker's would cost in pixel consistency
+(α = 1 is the maker's curve).
+
     venv=$(bench/venv.sh opencv-python-headless numpy)
     BIN=/work/main/target/release/campanile "$venv/bin/python" validation/hdr/sweep.py \
         [--set radiantlab-eos] [--csv OUT.csv] [--md OUT.md]
@@ -51,6 +55,8 @@ CONFIGS = [
     ("fit_times", ["--fit-times"]),
     ("robertson", ["--method", "robertson"]),
 ]
+
+BLENDS = [0.1, 0.2, 0.3, 0.5, 1.0]
 
 
 def agreement(a, b, lo, hi):
@@ -98,6 +104,12 @@ def main():
                 raise SystemExit(f"sweep.py: {name}: exit {r.returncode}: {r.stderr.strip()[-400:]}")
             print(f"  {name}: {secs[name]:.0f} s", file=sys.stderr)
         curves[name] = consistency.read_ln_curve(path)
+    # Tuning toward the maker, for what it costs in pixel consistency:
+    # (1 − α)·default + α·maker, per channel.
+    for alpha in BLENDS:
+        name = f"blend_maker_{alpha:g}"
+        curves[name] = (1 - alpha) * curves["default"] + alpha * maker
+        configs = configs + [(name, None)]
     valid = np.ones(256, bool)
     for v in list(curves.values()) + [maker]:
         valid &= np.isfinite(v).all(axis=1)
