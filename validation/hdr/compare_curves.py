@@ -28,6 +28,7 @@ CURVES = [
     ("opencv_robertson", "OpenCV Robertson"),
     ("pfstools_robertson", "pfstools Robertson"),
     ("hdrgen_rsp", "hdrgen .rsp (maker)"),
+    ("hdrgen_rerun", "hdrgen re-run on the set"),
 ]
 
 # Pairs reported: Campanile against every peer, then the peers against the
@@ -43,6 +44,12 @@ PAIRS = [
     ("pfstools_robertson", "hdrgen_rsp"),
     ("campanile_robertson", "hdrgen_rsp"),
     ("opencv_debevec", "opencv_robertson"),
+    # hdrgen itself on the set's frames (hdrgen_rerun.sh), against the maker's
+    # .rsp and Campanile.
+    ("campanile_debevec", "hdrgen_rerun"),
+    ("campanile_robertson", "hdrgen_rerun"),
+    ("opencv_robertson", "hdrgen_rerun"),
+    ("hdrgen_rerun", "hdrgen_rsp"),
 ]
 
 

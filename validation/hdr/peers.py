@@ -10,8 +10,9 @@ ln of relative exposure per 8-bit code, NaN where the tool gives none):
   implementation) when the Debian package is installed
   (`<set>/pfstools_robertson.csv`);
 - the hdrgen response curve a set ships (`Response_function.rsp`, three
-  polynomials in the normalized code, highest power first, mapping code/255
-  to relative linear exposure), converted to ln exposure per code
+  polynomials in the normalized code, highest power first), evaluated as
+  hdrgen does (hdrgen_rsp.py: x = (code + 0.5)/256, linear toe below code
+  19) and converted to ln exposure per code
   (`<set>/hdrgen_rsp.csv`).
 
 Run with the bench venv (outside the repository):
@@ -37,6 +38,9 @@ import time
 
 import cv2
 import numpy as np
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import hdrgen_rsp  # noqa: E402
 
 
 def sets_root():
@@ -170,21 +174,17 @@ def pfstools_curve(files, images, times, out_dir, stride):
 
 
 def rsp_curve(rsp_path, out_dir):
-    """hdrgen .rsp: per channel "ORDER c_ORDER ... c_0", f(x) = sum c_k x^k, x = code/255."""
-    lines = [ln.split() for ln in rsp_path.read_text().splitlines() if ln.strip()]
-    if len(lines) != 3:
-        raise SystemExit(f"peers.py: {rsp_path}: expected 3 polynomials (R, G, B), found {len(lines)}")
-    x = np.arange(256) / 255.0
-    ln = np.full((256, 3), np.nan)
-    for c, parts in enumerate(lines):
-        order = int(parts[0])
-        coef = [float(v) for v in parts[1:]]
-        if len(coef) != order + 1:
-            raise SystemExit(f"peers.py: {rsp_path} line {c + 1}: order {order} needs {order + 1} coefficients, found {len(coef)}")
-        f = np.polyval(coef, x)  # highest power first, as hdrgen writes them
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ln[:, c] = np.where(f > 0, np.log(f), np.nan)
-    write_curve(out_dir / "hdrgen_rsp.csv", ln, f"hdrgen response {rsp_path.name} (polynomials in code/255)")
+    """hdrgen .rsp as hdrgen evaluates it (hdrgen_rsp.py: x = (code + 0.5)/256,
+    linear toe below code 19), as ln exposure per code."""
+    try:
+        ln = np.array(hdrgen_rsp.ln_curve(rsp_path))
+    except ValueError as e:
+        raise SystemExit(f"peers.py: {e}")
+    write_curve(
+        out_dir / "hdrgen_rsp.csv",
+        ln,
+        f"hdrgen response {rsp_path.name} (as hdrgen evaluates it: x = (code + 0.5)/256, linear toe below code 19)",
+    )
 
 
 def main():
