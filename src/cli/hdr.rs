@@ -6,9 +6,11 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow};
+use campanile_process::camera::image::max_code;
 use campanile_process::exr_io::{ExrPrecision, read_rgb_exr, write_radiance_exr, write_rgb_exr};
 use campanile_process::hdr::HdrError;
 use campanile_process::hdr::bracket::Bracket;
+use campanile_process::hdr::bracket_files::BracketFiles;
 use campanile_process::hdr::bracket_list::{
     FrameRecord, TimeSource, load_bracket_files, parse_time_s, read_bracket_list,
 };
@@ -16,10 +18,14 @@ use campanile_process::hdr::curve::ResponseCurve;
 use campanile_process::hdr::curve_plot::curve_plot_svg;
 use campanile_process::hdr::debevec::{DEFAULT_LAMBDA, DebevecOptions, Smoothness, calibrate_debevec};
 use campanile_process::hdr::deghost::{DeghostOptions, merge_deghosted};
+use campanile_process::hdr::exposure_codes::ExposureCodes;
 use campanile_process::hdr::lens::{LensModel, fit_distortion, fit_falloff, undistort_map};
 use campanile_process::hdr::merge::{MergeOptions, NoiseModel, RadianceMap, merge};
+use campanile_process::hdr::merge_stream::merge_files;
 use campanile_process::hdr::robertson::{RobertsonOptions, calibrate_robertson};
+use campanile_process::hdr::sampled_bracket::SampledBracket;
 use campanile_process::hdr::sampling::SampleOptions;
+use campanile_process::hdr::white_point::WhitePoint;
 use campanile_process::rgbe_file::write_rgbe;
 use clap::{Args, Subcommand, ValueEnum};
 
@@ -28,7 +34,7 @@ mod raw;
 
 use super::verdicts;
 use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
-use campanile_process::quality::{QualityReport, gates};
+use campanile_process::quality::{ProductQuality, Quality, QualityReport, gates};
 
 #[derive(Debug, Subcommand)]
 pub enum HdrCommand {
@@ -267,11 +273,12 @@ fn is_output_error(e: &anyhow::Error) -> bool {
     e.chain().any(|c| c.to_string().starts_with("writing "))
 }
 
-fn load(args: &BracketArgs) -> Result<Bracket> {
-    let (paths, times) = match &args.list {
+/// The bracket's files and the times given for them (`None`: from EXIF).
+fn paths_and_times(args: &BracketArgs) -> Result<(Vec<PathBuf>, Option<Vec<f64>>)> {
+    match &args.list {
         Some(list) => {
             let (p, t) = read_bracket_list(list).with_context(|| format!("reading bracket list {}", list.display()))?;
-            (p, Some(t))
+            Ok((p, Some(t)))
         }
         None => {
             if args.images.is_empty() {
@@ -287,17 +294,40 @@ fn load(args: &BracketArgs) -> Result<Bracket> {
                         .ok_or_else(|| anyhow!("--times: '{t}' is not a time in seconds > 0 (e.g. 0.033 or 1/30)"))
                 })
                 .collect::<Result<Vec<_>>>()?;
-            (args.images.clone(), (!times.is_empty()).then_some(times))
+            Ok((args.images.clone(), (!times.is_empty()).then_some(times)))
         }
-    };
+    }
+}
+
+/// The bracket's files with their times, sorted, to be read one frame at a time.
+fn open_files(args: &BracketArgs) -> Result<BracketFiles> {
+    let (paths, times) = paths_and_times(args)?;
+    let files = BracketFiles::open(&paths, times.as_deref()).context("reading the bracket")?;
+    report_exif(files.records())?;
+    Ok(files)
+}
+
+/// The whole bracket in memory (for alignment and deghosting, which look
+/// at every frame at once).
+fn load(args: &BracketArgs) -> Result<Bracket> {
+    let (paths, times) = paths_and_times(args)?;
     let (bracket, frames) = load_bracket_files(&paths, times.as_deref()).context("reading the bracket")?;
-    report_frames(&frames, &bracket)?;
+    report_exif(&frames)?;
+    let labels: Vec<&str> = bracket.images().iter().map(|im| im.label.as_str()).collect();
+    report_white_points(&labels, bracket.white_points(), bracket.images()[0].max_code())?;
     Ok(bracket)
 }
 
-/// One line per frame: its time and where it came from; then each white
-/// point found below the largest code.
-fn report_frames(frames: &[FrameRecord], bracket: &Bracket) -> Result<()> {
+/// Reads `files` one frame at a time into `visit`, with a progress bar.
+fn scan<T>(files: &BracketFiles, what: &str, visit: impl FnOnce(&dyn Fn(usize)) -> Result<T, HdrError>) -> Result<T> {
+    let bar = super::process::bar(files.len() as u64, what);
+    let out = visit(&|k| bar.set_position(k as u64));
+    bar.finish_and_clear();
+    Ok(out?)
+}
+
+/// One line per frame whose time came from EXIF: its time and where from.
+fn report_exif(frames: &[FrameRecord]) -> Result<()> {
     for f in frames.iter().filter(|f| f.source == TimeSource::Exif) {
         let m = &f.metadata;
         let mut what = vec![format!("{} s", m.exposure_time_s.map_or_else(String::new, shutter))];
@@ -315,15 +345,19 @@ fn report_frames(frames: &[FrameRecord], bracket: &Bracket) -> Result<()> {
             f.time_s
         )?;
     }
-    for (img, wp) in bracket.images().iter().zip(bracket.white_points()) {
+    Ok(())
+}
+
+/// One line per white point found below the largest code (frames by
+/// ascending exposure, labelled).
+fn report_white_points(labels: &[&str], white: &[[Option<WhitePoint>; 3]], max_code: u16) -> Result<()> {
+    for (label, wp) in labels.iter().zip(white) {
         for (c, p) in wp.iter().enumerate() {
             if let Some(p) = p {
                 outln!(
-                    "{}: {} piles up at code {} (below the largest, {}): codes ≥ {} treated as clipped ({} pixels)",
-                    img.label,
+                    "{label}: {} piles up at code {} (below the largest, {max_code}): codes ≥ {} treated as clipped ({} pixels)",
                     ["red", "green", "blue"][c],
                     p.code,
-                    img.max_code(),
                     p.clipped_from,
                     p.pixels
                 )?;
@@ -331,6 +365,11 @@ fn report_frames(frames: &[FrameRecord], bracket: &Bracket) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The labels of a bracket's files, shortest exposure first.
+fn labels(files: &BracketFiles) -> Vec<String> {
+    files.records().iter().map(|r| r.path.display().to_string()).collect()
 }
 
 /// A time as photographers write it: "1/250" below a second, else decimal.
@@ -349,16 +388,40 @@ fn write(path: &Path, text: &str) -> Result<()> {
 fn calibrate(a: &CalibrateArgs) -> Result<()> {
     let q = verdicts::thresholds(a.thresholds.as_deref(), None)?;
     raw::refuse_raw_calibration(&a.bracket)?;
-    let mut bracket = load(&a.bracket)?;
-    if a.align {
-        bracket = align::aligned(&bracket)?;
-    }
     let sampling = SampleOptions {
         samples: a.samples,
         seed: a.seed,
         ..Default::default()
     };
-    let (curve, method, quality) = match a.method {
+    let (curve, method, quality) = if a.align {
+        let bracket = align::aligned(&load(&a.bracket)?)?;
+        recover(&bracket, a, sampling, &q)?
+    } else {
+        // One frame at a time, keeping the pixels sampling looks at.
+        let files = open_files(&a.bracket)?;
+        let (sampled, white) = scan(&files, "reading frames", |p| SampledBracket::read(&files, &sampling, p))
+            .context("reading the bracket")?;
+        let labels = labels(&files);
+        let labels: Vec<&str> = labels.iter().map(String::as_str).collect();
+        report_white_points(&labels, &white, sampled.max_code())?;
+        recover(&sampled, a, sampling, &q)?
+    };
+    write(&a.out, &curve.to_csv(&method))?;
+    let plot = a.plot.clone().unwrap_or_else(|| a.out.with_extension("svg"));
+    let svg = curve_plot_svg(&curve, &format!("Response curve ({method})")).context("plotting the curve")?;
+    write(&plot, &svg)?;
+    outln!("wrote {} and {}", a.out.display(), plot.display())?;
+    verdicts::finish(&QualityReport::new(vec![quality], &q), &verdicts::beside(&a.out))
+}
+
+/// The response by `a.method` from `bracket`, its method line and verdict.
+fn recover<B: ExposureCodes>(
+    bracket: &B,
+    a: &CalibrateArgs,
+    sampling: SampleOptions,
+    q: &Quality,
+) -> Result<(ResponseCurve, String, ProductQuality)> {
+    Ok(match a.method {
         Method::Debevec => {
             let opts = DebevecOptions {
                 lambda: a.lambda,
@@ -367,7 +430,7 @@ fn calibrate(a: &CalibrateArgs) -> Result<()> {
                 fit_exposure_times: a.fit_times,
                 ..Default::default()
             };
-            let cal = calibrate_debevec(&bracket, &opts).context("recovering the response (Debevec–Malik)")?;
+            let cal = calibrate_debevec(bracket, &opts).context("recovering the response (Debevec–Malik)")?;
             for (c, d) in cal.channels.iter().enumerate() {
                 outln!(
                     "channel {}: {} samples, {} observations, residual RMS {:.4}, {} nodes made monotone, \
@@ -389,7 +452,7 @@ fn calibrate(a: &CalibrateArgs) -> Result<()> {
                     )?;
                 }
             }
-            let quality = gates::response(&cal, bracket.len(), bracket.len(), &q);
+            let quality = gates::response(&cal, bracket.exposures(), bracket.exposures(), q);
             (cal.curve, cal.method, quality)
         }
         Method::Robertson => {
@@ -397,22 +460,16 @@ fn calibrate(a: &CalibrateArgs) -> Result<()> {
                 sampling,
                 ..Default::default()
             };
-            let (curve, iters) = calibrate_robertson(&bracket, &opts).context("recovering the response (Robertson)")?;
+            let (curve, iters) = calibrate_robertson(bracket, &opts).context("recovering the response (Robertson)")?;
             outln!("Robertson: {iters:?} iterations (R, G, B)")?;
-            let quality = gates::response_curve(&curve, bracket.len(), bracket.len(), &q);
+            let quality = gates::response_curve(&curve, bracket.exposures(), bracket.exposures(), q);
             (
                 curve,
                 format!("robertson samples={} seed={}", a.samples, a.seed),
                 quality,
             )
         }
-    };
-    write(&a.out, &curve.to_csv(&method))?;
-    let plot = a.plot.clone().unwrap_or_else(|| a.out.with_extension("svg"));
-    let svg = curve_plot_svg(&curve, &format!("Response curve ({method})")).context("plotting the curve")?;
-    write(&plot, &svg)?;
-    outln!("wrote {} and {}", a.out.display(), plot.display())?;
-    verdicts::finish(&QualityReport::new(vec![quality], &q), &verdicts::beside(&a.out))
+    })
 }
 
 fn per_channel(name: &str, v: &[f64]) -> Result<[f64; 3]> {
@@ -463,10 +520,6 @@ fn merge_cmd(a: &MergeArgs) -> Result<()> {
             "--curve is required for PNG/TIFF/JPEG brackets (run `campanile hdr calibrate` first); only RAW frames merge without one",
         )
     })?;
-    let mut bracket = load(&a.bracket)?;
-    if a.align {
-        bracket = align::aligned(&bracket)?;
-    }
     let text =
         std::fs::read_to_string(curve_path).with_context(|| format!("reading curve {}", curve_path.display()))?;
     let curve = ResponseCurve::from_csv(&text, curve_path).context("reading the curve")?;
@@ -486,13 +539,34 @@ fn merge_cmd(a: &MergeArgs) -> Result<()> {
         radiometric_scale: per_channel("scale", &a.scale)?,
         falloff: lens.map(|l| l.falloff),
     };
-    let mut map = if a.deghost {
-        let (map, stats) = merge_deghosted(&bracket, &curve, &opts, &DeghostOptions::default()).context("merging")?;
-        align::report_deghost(&stats)?;
-        map
+    let (mut map, exposures) = if a.align || a.deghost {
+        let mut bracket = load(&a.bracket)?;
+        if a.align {
+            bracket = align::aligned(&bracket)?;
+        }
+        let map = if a.deghost {
+            let (map, stats) =
+                merge_deghosted(&bracket, &curve, &opts, &DeghostOptions::default()).context("merging")?;
+            align::report_deghost(&stats)?;
+            map
+        } else {
+            merge(&bracket, &curve, &opts).context("merging")?
+        };
+        (map, bracket.len())
     } else {
-        merge(&bracket, &curve, &opts).context("merging")?
+        // One frame at a time into per-pixel sums (bounded memory).
+        let files = open_files(&a.bracket)?;
+        let (map, white) =
+            scan(&files, "merging frames", |p| merge_files(&files, &curve, &opts, p)).context("merging")?;
+        let labels = labels(&files);
+        let labels: Vec<&str> = labels.iter().map(String::as_str).collect();
+        report_white_points(&labels, &white, max_code(curve.bits))?;
+        (map, files.len())
     };
+    if !(a.with_variance || a.align || a.deghost) {
+        // Only the OpenEXR with variance writes it: free it before writing.
+        map.variance = Vec::new();
+    }
     if let Some(l) = lens
         && (l.distortion.a != 0.0 || l.distortion.b != 0.0)
     {
@@ -505,7 +579,7 @@ fn merge_cmd(a: &MergeArgs) -> Result<()> {
         a.out.display(),
         map.width,
         map.height,
-        bracket.len()
+        exposures
     )?;
     let name = a
         .out

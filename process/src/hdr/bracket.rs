@@ -153,8 +153,8 @@ impl Bracket {
 
 /// One image of a bracket whose first image is `first`: 8 to 16 bits, not
 /// empty, a buffer of `width · height · 3` codes, the size and depth of the
-/// first, every code within its depth.
-fn check_image(img: &CodeImage, first: &CodeImage) -> Result<(), HdrError> {
+/// first, every code within its depth (`first`'s codes are not read).
+pub(super) fn check_image(img: &CodeImage, first: &CodeImage) -> Result<(), HdrError> {
     if !matches!(img.bits, 8..=16) {
         return Err(HdrError::BadImage {
             image: img.label.clone(),

@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 
 use super::HdrError;
 use super::bracket::Bracket;
+use super::bracket_files::BracketFiles;
 use super::exposure_metadata::{ExposureMetadata, effective_times};
 use super::image_file::read_frame;
 
@@ -167,39 +168,19 @@ pub struct FrameRecord {
 }
 
 /// Reads image files (turned upright by their EXIF orientation) into a
-/// validated bracket. `times_s`: the times given by the user, one per file;
-/// `None` reads them from each file's EXIF ([`effective_times`]).
+/// validated bracket held in memory. `times_s`: the times given by the
+/// user, one per file; `None` reads them from each file's EXIF
+/// ([`effective_times`]). The records come shortest exposure first, as
+/// [`BracketFiles`] sorts them (which reads a bracket one frame at a time
+/// instead).
 pub fn load_bracket_files(paths: &[PathBuf], times_s: Option<&[f64]>) -> Result<(Bracket, Vec<FrameRecord>), HdrError> {
-    if let Some(t) = times_s
-        && t.len() != paths.len()
-    {
-        return Err(HdrError::TimeCountMismatch {
-            images: paths.len(),
-            times: t.len(),
-        });
-    }
-    let mut images = Vec::with_capacity(paths.len());
-    let mut frames = Vec::with_capacity(paths.len());
-    for p in paths {
-        let (img, meta) = read_frame(p)?;
-        images.push(img);
-        frames.push((p.clone(), meta));
-    }
-    let (times, source) = match times_s {
-        Some(t) => (t.to_vec(), TimeSource::Given),
-        None => (effective_times(&frames)?, TimeSource::Exif),
-    };
-    let records = frames
-        .into_iter()
-        .zip(&times)
-        .map(|((path, metadata), &time_s)| FrameRecord {
-            path,
-            metadata,
-            time_s,
-            source,
-        })
-        .collect();
-    Ok((Bracket::new(images, times)?, records))
+    let files = BracketFiles::open(paths, times_s)?;
+    let images = files
+        .records()
+        .iter()
+        .map(|r| read_frame(&r.path).map(|(img, _)| img))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((Bracket::new(images, files.times_s())?, files.records().to_vec()))
 }
 
 #[cfg(test)]

@@ -42,8 +42,8 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use super::HdrError;
-use super::bracket::Bracket;
 use super::curve::{ChannelCurve, ResponseCurve, make_monotone, node_code, node_count, node_position};
+use super::exposure_codes::ExposureCodes;
 use super::noise_bias::{NoiseBiasReport, Observation, correct_noise_bias};
 use super::sampling::{SampleOptions, select_samples};
 
@@ -129,11 +129,13 @@ pub fn hat_weight(code: f64, max_code: f64) -> f64 {
     (code.min(max_code - code) / (0.5 * max_code)).max(0.0)
 }
 
-/// Recovers the response of each channel of `bracket`.
-pub fn calibrate_debevec(bracket: &Bracket, opts: &DebevecOptions) -> Result<Calibration, HdrError> {
-    if bracket.len() < 2 {
-        return Err(HdrError::SingleExposure(bracket.len()));
+/// Recovers the response of each channel of `bracket` (held whole, or
+/// sampled for `opts.sampling` while read from files).
+pub fn calibrate_debevec<B: ExposureCodes>(bracket: &B, opts: &DebevecOptions) -> Result<Calibration, HdrError> {
+    if bracket.exposures() < 2 {
+        return Err(HdrError::SingleExposure(bracket.exposures()));
     }
+    check_sampling(bracket, &opts.sampling)?;
     if !(opts.lambda.is_finite() && opts.lambda >= 0.0) {
         return Err(HdrError::BadOption {
             name: "lambda",
@@ -148,7 +150,7 @@ pub fn calibrate_debevec(bracket: &Bracket, opts: &DebevecOptions) -> Result<Cal
             expected: "a finite σ > 0",
         });
     }
-    let needed = (node_count(bracket.bits()) / (bracket.len() - 1)).max(16);
+    let needed = (node_count(bracket.bits()) / (bracket.exposures() - 1)).max(16);
     let samples: Vec<Vec<usize>> = (0..3)
         .into_par_iter()
         .map(|c| {
@@ -167,7 +169,7 @@ pub fn calibrate_debevec(bracket: &Bracket, opts: &DebevecOptions) -> Result<Cal
     let labelled: Vec<f64> = bracket.times_s().iter().map(|t| t.ln()).collect();
     let mut log_times = labelled.clone();
     if opts.fit_exposure_times {
-        let mut delta_sum = vec![0.0; bracket.len()];
+        let mut delta_sum = vec![0.0; bracket.exposures()];
         for (c, s) in samples.iter().enumerate() {
             let mut set = SolveSettings {
                 lambda: opts.lambda,
@@ -221,6 +223,19 @@ pub fn calibrate_debevec(bracket: &Bracket, opts: &DebevecOptions) -> Result<Cal
     })
 }
 
+/// A bracket read for one sample selection can be calibrated with that
+/// selection only (other pixels were never read).
+pub(super) fn check_sampling<B: ExposureCodes>(bracket: &B, sampling: &SampleOptions) -> Result<(), HdrError> {
+    match bracket.sampled_for() {
+        Some(held) if held != sampling => Err(HdrError::BadOption {
+            name: "sampling",
+            value: format!("{sampling:?}"),
+            expected: "the sample options the bracket was read for",
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// The three channels of a per-channel `Vec` as an array.
 pub(crate) fn to_array3<T>(v: Vec<T>) -> [T; 3] {
     let mut it = v.into_iter();
@@ -250,8 +265,8 @@ struct SolveSettings<'a> {
 type DataRow = ([(usize, f64); 3], usize, f64, f64);
 
 /// One channel's solve.
-fn solve_channel(
-    bracket: &Bracket,
+fn solve_channel<B: ExposureCodes>(
+    bracket: &B,
     c: usize,
     samples: &[usize],
     set: &SolveSettings,
@@ -265,7 +280,7 @@ fn solve_channel(
     } = *set;
     let bits = bracket.bits();
     let n = node_count(bits);
-    let p = bracket.len();
+    let p = bracket.exposures();
     let reference = p / 2;
     // Index of δ_j in the unknown vector, if free.
     let delta_index = |j: usize| -> Option<usize> {
@@ -277,7 +292,8 @@ fn solve_channel(
         }
     };
     let m = if time_prior.is_some() { n + p - 1 } else { n };
-    let maxc = f64::from(bracket.images()[0].max_code());
+    let maxc = f64::from(bracket.max_code());
+    let mut codes = Vec::with_capacity(p);
     let mut s_mat = DMatrix::<f64>::zeros(m, m);
     let mut rhs = DVector::<f64>::zeros(m);
     let mut support = vec![0u32; n];
@@ -288,8 +304,9 @@ fn solve_channel(
         rows.clear();
         let mut d = 0.0;
         let mut be = 0.0;
-        for (j, im) in bracket.images().iter().enumerate() {
-            let z = f64::from(im.data[pix * 3 + c]);
+        bracket.pixel_codes(pix, c, &mut codes);
+        for (j, &z) in codes.iter().enumerate() {
+            let z = f64::from(z);
             let w = hat_weight(z, maxc);
             if w <= 0.0 {
                 continue;
@@ -403,8 +420,9 @@ fn solve_channel(
     let mut all_obs: Vec<Observation> = Vec::with_capacity(samples.len() * p);
     for &pix in samples {
         let mut obs: Vec<(f64, f64)> = Vec::with_capacity(p);
-        for (j, im) in bracket.images().iter().enumerate() {
-            let z = f64::from(im.data[pix * 3 + c]);
+        bracket.pixel_codes(pix, c, &mut codes);
+        for (j, &z) in codes.iter().enumerate() {
+            let z = f64::from(z);
             let w = hat_weight(z, maxc);
             if w <= 0.0 {
                 continue;
@@ -420,10 +438,10 @@ fn solve_channel(
         let d: f64 = obs.iter().map(|o| o.0).sum();
         let e = obs.iter().map(|o| o.0 * o.1).sum::<f64>() / d;
         rss += obs.iter().map(|o| o.0 * (o.1 - e).powi(2)).sum::<f64>();
-        for (j, im) in bracket.images().iter().enumerate() {
+        for (j, &code) in codes.iter().enumerate() {
             let delta = delta_index(j).map_or(0.0, |di| x[di]);
             all_obs.push(Observation {
-                code: im.data[pix * 3 + c],
+                code,
                 ln_exposure: e + log_times[j] + delta,
             });
         }
@@ -465,6 +483,7 @@ mod tests {
     use crate::camera::image::CodeImage;
     use crate::camera::sensor::CameraModel;
     use crate::camera::test_chart::{SEVEN_STOP_TIMES_S, hdr_chart};
+    use crate::hdr::bracket::Bracket;
 
     fn stack(cam: &CameraModel, w: usize, h: usize) -> Vec<CodeImage> {
         let scene = hdr_chart(w, h);

@@ -70,7 +70,7 @@ pub fn merge_deghosted(
     opts: &MergeOptions,
     deghost: &DeghostOptions,
 ) -> Result<(RadianceMap, DeghostStats), HdrError> {
-    check_inputs(bracket, curve, opts)?;
+    check_inputs(bracket.bits(), curve, opts)?;
     let n_img = bracket.len();
     let reference = deghost.reference.unwrap_or_else(|| reference_index(n_img));
     if reference >= n_img {
@@ -94,7 +94,7 @@ pub fn merge_deghosted(
             expected: "a finite number ≥ 0",
         });
     }
-    let t = build_tables(bracket, curve, &opts.noise);
+    let t = build_tables(bracket.bits(), bracket.times_s(), curve, &opts.noise);
     let (w, h) = (bracket.width(), bracket.height());
     let codes = t.codes;
     let zmax = (codes - 1) as u16;
@@ -176,8 +176,7 @@ pub fn merge_deghosted(
                 *mask_out = finish_pixel(
                     &t,
                     (sw, swx),
-                    &images[0][p..p + 3],
-                    zmax,
+                    std::array::from_fn(|c| images[0][p + c] >= zmax),
                     g,
                     falloff,
                     &mut rgb_row[k..k + 3],

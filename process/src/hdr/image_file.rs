@@ -56,13 +56,14 @@ fn read_stored_codes(path: &Path) -> Result<CodeImage, HdrError> {
     let label = path.display().to_string();
     let (width, height) = (img.width() as usize, img.height() as usize);
     let (bits, data) = match img {
+        // The common cases without a copy of the decoded buffer.
+        DynamicImage::ImageRgb8(buf) => (8, buf.into_raw().into_iter().map(u16::from).collect()),
+        DynamicImage::ImageRgb16(buf) => (16, buf.into_raw()),
         DynamicImage::ImageLuma8(_)
         | DynamicImage::ImageLumaA8(_)
-        | DynamicImage::ImageRgb8(_)
         | DynamicImage::ImageRgba8(_) => (8, img.to_rgb8().into_raw().into_iter().map(u16::from).collect()),
         DynamicImage::ImageLuma16(_)
         | DynamicImage::ImageLumaA16(_)
-        | DynamicImage::ImageRgb16(_)
         | DynamicImage::ImageRgba16(_) => (16, img.to_rgb16().into_raw()),
         other => {
             return Err(HdrError::BadImage {

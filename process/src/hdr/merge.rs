@@ -119,10 +119,9 @@ pub(super) struct Tables {
     pub(super) var_scale: [f64; 3],
 }
 
-pub(super) fn build_tables(bracket: &Bracket, curve: &ResponseCurve, noise: &NoiseModel) -> Tables {
-    let codes = usize::from(bracket.images()[0].max_code()) + 1;
+pub(super) fn build_tables(bits: u8, times: &[f64], curve: &ResponseCurve, noise: &NoiseModel) -> Tables {
+    let codes = usize::from(crate::camera::image::max_code(bits)) + 1;
     let zmax = codes - 1;
-    let times = bracket.times_s();
     let p = times.len();
     let mut raw = vec![[0.0f64; 2]; p * 3 * codes];
     let mut sat_bound = [0.0f32; 3];
@@ -192,8 +191,8 @@ pub fn merge_into(
     opts: &MergeOptions,
     out: &mut RadianceMap,
 ) -> Result<(), HdrError> {
-    check_inputs(bracket, curve, opts)?;
-    let t = build_tables(bracket, curve, &opts.noise);
+    check_inputs(bracket.bits(), curve, opts)?;
+    let t = build_tables(bracket.bits(), bracket.times_s(), curve, &opts.noise);
     let (w, h) = (bracket.width(), bracket.height());
     let zmax = (t.codes - 1) as u16;
     let (gain, var_gain) = gains(&t, opts);
@@ -229,11 +228,11 @@ pub fn merge_into(
 }
 
 /// The checks of [`merge`]: curve depth, positive calibrations, a sane noise model.
-pub(super) fn check_inputs(bracket: &Bracket, curve: &ResponseCurve, opts: &MergeOptions) -> Result<(), HdrError> {
-    if curve.bits != bracket.bits() {
+pub(super) fn check_inputs(bits: u8, curve: &ResponseCurve, opts: &MergeOptions) -> Result<(), HdrError> {
+    if curve.bits != bits {
         return Err(HdrError::CurveBitsMismatch {
             curve_bits: curve.bits,
-            image_bits: bracket.bits(),
+            image_bits: bits,
         });
     }
     for (name, v) in [
@@ -274,15 +273,13 @@ pub(super) fn gains(t: &Tables, opts: &MergeOptions) -> ([f32; 3], [f32; 3]) {
 }
 
 /// Writes one pixel from its sums `Σw`, `Σw·X` per channel; returns its mask.
-/// A channel with no weight gets the bound of its clipping, decided by the
-/// shortest exposure's code `shortest` (saturated if at `zmax`).
+/// A channel with no weight gets the bound of its clipping, decided by
+/// whether the shortest exposure's code is the largest (`saturated`).
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 pub(super) fn finish_pixel(
     t: &Tables,
     (sw, swx): ([f32; 3], [f32; 3]),
-    shortest: &[u16],
-    zmax: u16,
+    saturated: [bool; 3],
     (gain, var_gain): ([f32; 3], [f32; 3]),
     falloff: f32,
     rgb: &mut [f32],
@@ -293,7 +290,7 @@ pub(super) fn finish_pixel(
         if sw[c] > 0.0 {
             rgb[c] = swx[c] / sw[c] * gain[c] / falloff;
             var[c] = var_gain[c] / (sw[c] * falloff * falloff);
-        } else if shortest[c] >= zmax {
+        } else if saturated[c] {
             m |= MASK_SATURATED << c;
             rgb[c] = t.sat_bound[c] * gain[c] / falloff;
             var[c] = f32::INFINITY;
@@ -360,8 +357,7 @@ fn pass<const N: usize>(ctx: &PassContext, out: &mut RadianceMap) {
                 let m = finish_pixel(
                     t,
                     (sw, swx),
-                    &shortest[base + k..base + k + 3],
-                    ctx.zmax,
+                    std::array::from_fn(|c| shortest[base + k + c] >= ctx.zmax),
                     (gain, var_gain),
                     falloff,
                     &mut rgb_row[k..k + 3],

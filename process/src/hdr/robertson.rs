@@ -23,9 +23,9 @@
 //! error of the mean of `ln(E_i t_j)` over the node's observations.
 
 use super::HdrError;
-use super::bracket::Bracket;
 use super::curve::{ChannelCurve, ResponseCurve, make_monotone, node_count, node_position};
 use super::debevec::{hat_weight, to_array3};
+use super::exposure_codes::ExposureCodes;
 use super::sampling::{SampleOptions, select_samples};
 
 /// Options of [`calibrate_robertson`].
@@ -47,22 +47,23 @@ impl Default for RobertsonOptions {
 }
 
 /// Recovers the response of each channel; returns the curve and the iterations used per channel.
-pub fn calibrate_robertson(
-    bracket: &Bracket,
+pub fn calibrate_robertson<B: ExposureCodes>(
+    bracket: &B,
     opts: &RobertsonOptions,
 ) -> Result<(ResponseCurve, [usize; 3]), HdrError> {
-    if bracket.len() < 2 {
-        return Err(HdrError::SingleExposure(bracket.len()));
+    if bracket.exposures() < 2 {
+        return Err(HdrError::SingleExposure(bracket.exposures()));
     }
+    super::debevec::check_sampling(bracket, &opts.sampling)?;
     let bits = bracket.bits();
     let n = node_count(bits);
-    let maxc = f64::from(bracket.images()[0].max_code());
+    let maxc = f64::from(bracket.max_code());
     let times = bracket.times_s();
     let mut chans = Vec::with_capacity(3);
     let mut iters = [0usize; 3];
     for (c, iters_c) in iters.iter_mut().enumerate() {
         let samples = select_samples(bracket, c, &opts.sampling);
-        let needed = (n / (bracket.len() - 1)).max(16);
+        let needed = (n / (bracket.exposures() - 1)).max(16);
         if samples.len() < needed {
             return Err(HdrError::TooFewSamples {
                 channel: c,
@@ -72,9 +73,11 @@ pub fn calibrate_robertson(
         }
         // Observations: (sample, node, weight, time).
         let mut obs: Vec<(usize, usize, f64, f64)> = Vec::new();
+        let mut codes = Vec::new();
         for (i, &pix) in samples.iter().enumerate() {
-            for (j, im) in bracket.images().iter().enumerate() {
-                let z = f64::from(im.data[pix * 3 + c]);
+            bracket.pixel_codes(pix, c, &mut codes);
+            for (j, &z) in codes.iter().enumerate() {
+                let z = f64::from(z);
                 let w = hat_weight(z, maxc);
                 if w > 0.0 {
                     let (k, a) = node_position(bits, z);
@@ -189,6 +192,7 @@ mod tests {
     use super::*;
     use crate::camera::sensor::CameraModel;
     use crate::camera::test_chart::hdr_chart;
+    use crate::hdr::bracket::Bracket;
 
     #[test]
     fn recovers_known_curve_to_log_rms_0_03_with_irregular_times() {

@@ -26,9 +26,8 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rayon::prelude::*;
 
-use super::bracket::Bracket;
+use super::exposure_codes::ExposureCodes;
 
 /// Options of [`select_samples`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -60,43 +59,80 @@ const EDGE_MEDIAN_PIXELS: usize = 20_000;
 /// Random pixel draws per requested sample before giving up on rare strata.
 const DRAWS_PER_SAMPLE: usize = 16;
 
+/// The pixels sample selection looks at for one channel, in the order it
+/// looks at them: drawn by the seeded stream alone, so they are known before
+/// any code is read (which lets a bracket read from files keep only these
+/// pixels and their 4-neighbours: [`super::sampled_bracket`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DrawPlan {
+    /// The random pixels whose edge measure sets the threshold.
+    pub edge_pixels: Vec<usize>,
+    /// The candidate pixels, in drawing order (selection stops early when
+    /// every stratum is full).
+    pub draws: Vec<usize>,
+}
+
+/// The [`DrawPlan`] of channel `c` for an image of `width × height` pixels.
+pub fn draw_plan(width: usize, height: usize, c: usize, opts: &SampleOptions) -> DrawPlan {
+    let n = width * height;
+    if width < 3 || height < 3 || opts.samples == 0 {
+        return DrawPlan {
+            edge_pixels: Vec::new(),
+            draws: Vec::new(),
+        };
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
+    rng.set_stream(100 + c as u64);
+    let edge_pixels = (0..EDGE_MEDIAN_PIXELS.min(n)).map(|_| rng.random_range(0..n)).collect();
+    rng.set_stream(c as u64);
+    let draws = (0..(DRAWS_PER_SAMPLE * opts.samples).min(4 * n))
+        .map(|_| rng.random_range(0..n))
+        .collect();
+    DrawPlan { edge_pixels, draws }
+}
+
 /// Selects up to `opts.samples` pixel indices (`y · width + x`) for channel `c`.
 ///
-/// Pixels are drawn at random (seeded) and tested lazily, so the cost grows
-/// with the number of samples, not with the image: each stratum accepts up to
-/// twice its fair share, drawing stops when every stratum is full or after
-/// `min(16 × samples, 4 × pixels)` draws, and the strata are then drained round-robin.
-pub fn select_samples(bracket: &Bracket, c: usize, opts: &SampleOptions) -> Vec<usize> {
+/// Pixels are drawn at random (seeded, [`draw_plan`]) and tested lazily, so
+/// the cost grows with the number of samples, not with the image: each
+/// stratum accepts up to twice its fair share, drawing stops when every
+/// stratum is full or after `min(16 × samples, 4 × pixels)` draws, and the
+/// strata are then drained round-robin.
+pub fn select_samples<B: ExposureCodes + ?Sized>(bracket: &B, c: usize, opts: &SampleOptions) -> Vec<usize> {
     let (w, h) = (bracket.width(), bracket.height());
-    if w < 3 || h < 3 || opts.samples == 0 {
+    let plan = draw_plan(w, h, c, opts);
+    if plan.draws.is_empty() {
         return Vec::new();
     }
-    let images = bracket.images();
-    let maxc = images[0].max_code();
+    let maxc = bracket.max_code();
     let scale = f64::from(maxc) / 255.0;
     let drop_tol = (3.0 * scale).round() as i32;
     let well_exposed = maxc / 10..=maxc - maxc / 10;
-    let sum = |p: usize| -> u32 { images.iter().map(|im| u32::from(im.data[p * 3 + c])).sum() };
     let interior = |p: usize| {
         let (x, y) = (p % w, p / w);
         x > 0 && y > 0 && x + 1 < w && y + 1 < h
     };
+    let mut zp = Vec::new();
+    let mut zq: [Vec<u16>; 4] = Default::default();
     // The largest relative code difference |Z(p) − Z(q)| / mean(Z(p), Z(q)) to a
     // 4-neighbour, in any exposure where p is well exposed; ∞ if never (or border).
     // For gamma-like curves it is about (1/γ) × the relative radiance difference.
-    let edge = |p: usize| -> f32 {
+    let mut edge = |p: usize| -> f32 {
         if !interior(p) {
             return f32::INFINITY;
         }
+        bracket.pixel_codes(p, c, &mut zp);
+        for (q, out) in [p - 1, p + 1, p - w, p + w].into_iter().zip(zq.iter_mut()) {
+            bracket.pixel_codes(q, c, out);
+        }
         let mut m = f32::INFINITY;
-        for im in images {
-            let zp = im.data[p * 3 + c];
+        for (j, &zp) in zp.iter().enumerate() {
             if !well_exposed.contains(&zp) {
                 continue;
             }
             let mut mj = 0.0f32;
-            for q in [p - 1, p + 1, p - w, p + w] {
-                let zq = im.data[q * 3 + c];
+            for zq in &zq {
+                let zq = zq[j];
                 let mean = 0.5 * (f32::from(zp) + f32::from(zq));
                 mj = mj.max(f32::from(zp.abs_diff(zq)) / mean.max(1.0));
             }
@@ -105,11 +141,10 @@ pub fn select_samples(bracket: &Bracket, c: usize, opts: &SampleOptions) -> Vec<
         m
     };
     // Static (codes never fall as exposure rises) and informative (≥ 2 unclipped).
-    let usable = |p: usize| {
+    let usable = |codes: &[u16]| {
         let mut prev = 0i32;
         let mut unclipped = 0;
-        for im in images {
-            let z = im.data[p * 3 + c];
+        for &z in codes {
             let zi = i32::from(z);
             if zi < prev - drop_tol {
                 return false;
@@ -121,12 +156,11 @@ pub fn select_samples(bracket: &Bracket, c: usize, opts: &SampleOptions) -> Vec<
         }
         unclipped >= 2
     };
-    let n = w * h;
     // Edge threshold from a seeded subset.
-    let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
-    rng.set_stream(100 + c as u64);
-    let mut measures: Vec<f32> = (0..EDGE_MEDIAN_PIXELS.min(n))
-        .map(|_| edge(rng.random_range(0..n)))
+    let mut measures: Vec<f32> = plan
+        .edge_pixels
+        .iter()
+        .map(|&p| edge(p))
         .filter(|e| e.is_finite())
         .collect();
     if measures.is_empty() {
@@ -135,33 +169,33 @@ pub fn select_samples(bracket: &Bracket, c: usize, opts: &SampleOptions) -> Vec<
     let mid = measures.len() / 2;
     let median = *measures.select_nth_unstable_by(mid, f32::total_cmp).1;
     let threshold = opts.edge_factor as f32 * median.max(0.01);
-    // Strata of S = Σ_j Z_j over the whole image (one streaming, parallel pass).
-    let sums: Vec<u32> = (0..n).into_par_iter().map(sum).collect();
-    let (smin, smax) = sums
-        .par_iter()
-        .fold(|| (u32::MAX, 0), |a, &s| (a.0.min(s), a.1.max(s)))
-        .reduce(|| (u32::MAX, 0), |a, b| (a.0.min(b.0), a.1.max(b.1)));
+    // Strata of S = Σ_j Z_j over the whole image.
+    let (smin, smax) = bracket.code_sum_range(c);
     let strata = opts.strata.max(1);
-    let span = f64::from(smax - smin) + 1.0;
+    let span = f64::from(smax.saturating_sub(smin)) + 1.0;
     let quota = (2 * opts.samples).div_ceil(strata);
     let mut bins: Vec<Vec<usize>> = vec![Vec::new(); strata];
     let mut full = 0;
-    let mut seen = vec![false; n];
-    rng.set_stream(c as u64);
-    for _ in 0..(DRAWS_PER_SAMPLE * opts.samples).min(4 * n) {
+    let mut seen = vec![false; w * h];
+    let mut codes = Vec::new();
+    for &p in &plan.draws {
         if full == strata {
             break;
         }
-        let p = rng.random_range(0..n);
         if std::mem::replace(&mut seen[p], true) {
             continue;
         }
-        let b = (((f64::from(sums[p] - smin) / span) * strata as f64) as usize).min(strata - 1);
+        bracket.pixel_codes(p, c, &mut codes);
+        let sum: u32 = codes.iter().map(|&z| u32::from(z)).sum();
+        let b = (((f64::from(sum.saturating_sub(smin)) / span) * strata as f64) as usize).min(strata - 1);
         if bins[b].len() >= quota {
             continue;
         }
+        if !usable(&codes) {
+            continue;
+        }
         let e = edge(p);
-        if !e.is_finite() || e > threshold || !usable(p) {
+        if !e.is_finite() || e > threshold {
             continue;
         }
         bins[b].push(p);
@@ -195,6 +229,7 @@ mod tests {
     use super::*;
     use crate::camera::sensor::CameraModel;
     use crate::camera::test_chart::{SEVEN_STOP_TIMES_S, hdr_chart};
+    use crate::hdr::bracket::Bracket;
 
     fn bracket() -> Bracket {
         let cam = CameraModel::typical(8);

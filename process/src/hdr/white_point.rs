@@ -40,6 +40,9 @@ pub const PILE_UP_RATIO: f64 = 8.0;
 /// neighbouring exposure.
 pub const CONFIRM_FRACTION: f64 = 0.5;
 
+/// Per frame (shortest exposure first) and channel, the white point found, if any.
+pub type WhitePoints = Vec<[Option<WhitePoint>; 3]>;
+
 /// A detected white point below the largest code.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct WhitePoint {
@@ -54,70 +57,158 @@ pub struct WhitePoint {
 /// Per frame (in the order given, which must be by ascending exposure) and
 /// channel, the white point when one below the largest code is detected and
 /// confirmed (module doc).
-pub fn detect_white_points(images: &[CodeImage]) -> Vec<[Option<WhitePoint>; 3]> {
+pub fn detect_white_points(images: &[CodeImage]) -> WhitePoints {
     let Some(first) = images.first() else {
         return Vec::new();
     };
-    let shift = u32::from(first.bits.saturating_sub(8));
-    let bin = |z: u16| usize::from(z >> shift);
-    let top = usize::from(first.max_code() >> shift);
-    let hists: Vec<[Vec<usize>; 3]> = images
-        .par_iter()
-        .map(|im| {
-            let mut h: [Vec<usize>; 3] = std::array::from_fn(|_| vec![0usize; top + 1]);
-            for px in im.data.chunks_exact(3) {
-                for c in 0..3 {
-                    h[c][bin(px[c]).min(top)] += 1;
-                }
-            }
-            h
-        })
-        .collect();
-    let mut out = vec![[None; 3]; images.len()];
-    for c in 0..3 {
-        let candidates: Vec<Option<usize>> = hists
-            .iter()
-            .zip(images)
-            .map(|(h, im)| pile_up(&h[c], im.width * im.height))
-            .collect();
-        let confirmed: Vec<bool> = (0..images.len())
-            .map(|j| {
-                let Some(z) = candidates[j] else { return false };
-                let k = if j + 1 < images.len() {
-                    j + 1
-                } else if j > 0 {
-                    j - 1
-                } else {
-                    return false;
-                };
-                let near = |v: u16| bin(v).abs_diff(z) <= 1;
-                let (mut inside, mut stayed) = (0usize, 0usize);
-                for (a, b) in images[j].data.chunks_exact(3).zip(images[k].data.chunks_exact(3)) {
-                    if near(a[c]) {
-                        inside += 1;
-                        stayed += usize::from(near(b[c]));
-                    }
-                }
-                inside > 0 && stayed as f64 >= CONFIRM_FRACTION * inside as f64
-            })
-            .collect();
-        for j in 0..images.len() {
-            let Some(z) = candidates[j] else { continue };
-            let accepted = confirmed[j]
-                || (0..images.len()).any(|k| confirmed[k] && candidates[k].is_some_and(|zk| zk.abs_diff(z) <= 1));
-            if !accepted {
-                continue;
-            }
-            let clipped_bin = z - 1;
-            let pixels = hists[j][c][clipped_bin..top].iter().sum();
-            out[j][c] = Some(WhitePoint {
-                code: (z << shift) as u16,
-                clipped_from: (clipped_bin << shift) as u16,
-                pixels,
-            });
+    let mut scan = WhitePointScan::new(images.len(), first.bits);
+    for im in images {
+        scan.push(im);
+    }
+    scan.finish()
+}
+
+/// [`detect_white_points`] one frame at a time, for brackets read from
+/// files: frames are pushed by ascending exposure, and only the previous
+/// frame's histogram bins (one byte per sample) are kept for the
+/// confirmation. A frame's pile-up is known when it is pushed, whether it
+/// is accepted only at [`WhitePointScan::finish`].
+pub struct WhitePointScan {
+    frames: usize,
+    shift: u32,
+    top: usize,
+    hists: Vec<[Vec<usize>; 3]>,
+    candidates: Vec<[Option<usize>; 3]>,
+    confirmed: Vec<[bool; 3]>,
+    /// The previous frame's bins, interleaved RGB.
+    previous: Vec<u8>,
+}
+
+impl WhitePointScan {
+    /// A scan of `frames` frames of `bits` bits per sample.
+    pub fn new(frames: usize, bits: u8) -> Self {
+        let shift = u32::from(bits.saturating_sub(8));
+        let max = (1u32 << bits.clamp(1, 16)) - 1;
+        Self {
+            frames,
+            shift,
+            top: (max >> shift) as usize,
+            hists: Vec::with_capacity(frames),
+            candidates: Vec::with_capacity(frames),
+            confirmed: Vec::with_capacity(frames),
+            previous: Vec::new(),
         }
     }
-    out
+
+    /// Takes the next frame (by ascending exposure); returns per channel the
+    /// first code its pile-up would clip (`None`: no pile-up, nothing of this
+    /// frame can become clipped at [`finish`](Self::finish)).
+    pub fn push(&mut self, im: &CodeImage) -> [Option<u16>; 3] {
+        let j = self.hists.len();
+        let (shift, top) = (self.shift, self.top);
+        let bin = move |z: u16| usize::from(z >> shift).min(top);
+        let hist = im
+            .data
+            .par_chunks(3 * 4096)
+            .fold(
+                || -> [Vec<usize>; 3] { std::array::from_fn(|_| vec![0usize; top + 1]) },
+                |mut h, chunk| {
+                    for px in chunk.chunks_exact(3) {
+                        for c in 0..3 {
+                            h[c][bin(px[c])] += 1;
+                        }
+                    }
+                    h
+                },
+            )
+            .reduce(
+                || std::array::from_fn(|_| vec![0usize; top + 1]),
+                |mut a, b| {
+                    for c in 0..3 {
+                        for (x, y) in a[c].iter_mut().zip(&b[c]) {
+                            *x += y;
+                        }
+                    }
+                    a
+                },
+            );
+        let n = im.width * im.height;
+        let cand: [Option<usize>; 3] = std::array::from_fn(|c| pile_up(&hist[c], n));
+        let here = |i: usize| bin(im.data[i]);
+        let previous = &self.previous;
+        let before = |i: usize| usize::from(previous[i]);
+        if j > 0 {
+            // The previous frame's pile-ups, against this (longer) exposure.
+            for c in 0..3 {
+                if let Some(z) = self.candidates[j - 1][c] {
+                    self.confirmed[j - 1][c] = stays(n, c, z, before, here);
+                }
+            }
+        }
+        let mut confirmed = [false; 3];
+        if j + 1 == self.frames && j > 0 {
+            // The longest frame's pile-ups, against the next shorter one.
+            for c in 0..3 {
+                if let Some(z) = cand[c] {
+                    confirmed[c] = stays(n, c, z, here, before);
+                }
+            }
+        }
+        if j + 1 < self.frames {
+            self.previous.resize(im.data.len(), 0);
+            self.previous
+                .par_iter_mut()
+                .zip(im.data.par_iter())
+                .for_each(|(b, &z)| *b = bin(z) as u8);
+        }
+        self.hists.push(hist);
+        self.candidates.push(cand);
+        self.confirmed.push(confirmed);
+        cand.map(|z| z.map(|z| ((z - 1) << self.shift) as u16))
+    }
+
+    /// The white points of the frames pushed (module doc: confirmed, or at a
+    /// code another frame confirmed for the same channel).
+    pub fn finish(self) -> WhitePoints {
+        let m = self.hists.len();
+        let mut out = vec![[None; 3]; m];
+        for (j, wp) in out.iter_mut().enumerate() {
+            for (c, slot) in wp.iter_mut().enumerate() {
+                let Some(z) = self.candidates[j][c] else { continue };
+                let accepted = self.confirmed[j][c]
+                    || (0..m).any(|k| self.confirmed[k][c] && self.candidates[k][c].is_some_and(|zk| zk.abs_diff(z) <= 1));
+                if !accepted {
+                    continue;
+                }
+                let clipped_bin = z - 1;
+                let pixels = self.hists[j][c][clipped_bin..self.top].iter().sum();
+                *slot = Some(WhitePoint {
+                    code: (z << self.shift) as u16,
+                    clipped_from: (clipped_bin << self.shift) as u16,
+                    pixels,
+                });
+            }
+        }
+        out
+    }
+}
+
+/// Whether at least [`CONFIRM_FRACTION`] of the `n` pixels whose channel-`c`
+/// bin `a` is within one of `z` stay within one of it in `b`.
+fn stays(n: usize, c: usize, z: usize, a: impl Fn(usize) -> usize + Sync, b: impl Fn(usize) -> usize + Sync) -> bool {
+    let near = |v: usize| v.abs_diff(z) <= 1;
+    let (inside, stayed) = (0..n)
+        .into_par_iter()
+        .map(|p| {
+            let i = p * 3 + c;
+            if near(a(i)) {
+                (1usize, usize::from(near(b(i))))
+            } else {
+                (0, 0)
+            }
+        })
+        .reduce(|| (0, 0), |x, y| (x.0 + y.0, x.1 + y.1));
+    inside > 0 && stayed as f64 >= CONFIRM_FRACTION * inside as f64
 }
 
 /// The pile-up bin of histogram `h` (bins `0..=top`, top excluded from the

@@ -1,0 +1,252 @@
+//! A bracket on disk, read one frame at a time.
+//!
+//! [`Bracket`](super::bracket::Bracket) holds every frame decoded (18 frames
+//! of 21 MP as `u16` codes are 2.3 GB). A [`BracketFiles`] knows its frames'
+//! exposures from the command line, a list or EXIF (no pixel is decoded to
+//! learn them), sorts them, and [`BracketFiles::scan`] decodes each frame
+//! once, in ascending exposure, hands it to a [`FrameVisitor`] (the merge's
+//! per-pixel sums, calibration's sampled pixels) and drops it. Every check
+//! of [`Bracket::new`](super::bracket::Bracket::new) is made on the way
+//! (sizes, depths, codes, times, brightness rising with time), and the
+//! white points are found by [`WhitePointScan`], which keeps one byte per
+//! sample of the previous frame.
+//!
+//! A frame's white point is decided only when the scan ends, so samples
+//! that a pile-up may clip are set aside ([`PileUpSamples`]) and settled by
+//! the visitor at [`FrameVisitor::finish`].
+
+use std::path::PathBuf;
+
+use super::HdrError;
+use super::bracket::check_image;
+use super::bracket_list::{FrameRecord, TimeSource};
+use super::exposure_metadata::{effective_times, read_exposure_metadata};
+use super::image_file::read_frame;
+use super::white_point::{WhitePoint, WhitePointScan, WhitePoints};
+use crate::camera::image::CodeImage;
+
+/// What a scan hands each frame to.
+pub trait FrameVisitor {
+    /// Frame `j` (by ascending exposure), its codes as decoded. `pile_up[c]`
+    /// is the first code (below the largest) that the frame's white point in
+    /// channel `c` may clip; whether it does is told at
+    /// [`finish`](Self::finish).
+    fn frame(&mut self, j: usize, image: &CodeImage, pile_up: [Option<u16>; 3]) -> Result<(), HdrError>;
+
+    /// The white points of every frame (`[j][c]`), once all were seen.
+    fn finish(&mut self, white_points: &[[Option<WhitePoint>; 3]]) -> Result<(), HdrError>;
+}
+
+/// The files of a bracket with their exposure times, sorted by time.
+#[derive(Debug, Clone)]
+pub struct BracketFiles {
+    records: Vec<FrameRecord>,
+}
+
+impl BracketFiles {
+    /// The files `paths` with the times given (`times_s`, one per file) or,
+    /// with `None`, their EXIF effective times (t·ISO/N², see
+    /// [`super::exposure_metadata`]). Only the EXIF is read. Times must be
+    /// finite, positive and distinct.
+    pub fn open(paths: &[PathBuf], times_s: Option<&[f64]>) -> Result<Self, HdrError> {
+        if paths.is_empty() {
+            return Err(HdrError::NoImages);
+        }
+        if let Some(t) = times_s
+            && t.len() != paths.len()
+        {
+            return Err(HdrError::TimeCountMismatch {
+                images: paths.len(),
+                times: t.len(),
+            });
+        }
+        let frames = paths
+            .iter()
+            .map(|p| Ok((p.clone(), read_exposure_metadata(p)?)))
+            .collect::<Result<Vec<_>, HdrError>>()?;
+        let (times, source) = match times_s {
+            Some(t) => (t.to_vec(), TimeSource::Given),
+            None => (effective_times(&frames)?, TimeSource::Exif),
+        };
+        let mut records: Vec<FrameRecord> = frames
+            .into_iter()
+            .zip(times)
+            .map(|((path, metadata), time_s)| FrameRecord {
+                path,
+                metadata,
+                time_s,
+                source,
+            })
+            .collect();
+        if let Some(r) = records.iter().find(|r| !(r.time_s.is_finite() && r.time_s > 0.0)) {
+            return Err(HdrError::InvalidTime {
+                image: r.path.display().to_string(),
+                time_s: r.time_s,
+            });
+        }
+        records.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+        if let Some(w) = records.windows(2).find(|w| w[0].time_s == w[1].time_s) {
+            return Err(HdrError::DuplicateTime {
+                first: w[0].path.display().to_string(),
+                second: w[1].path.display().to_string(),
+                time_s: w[0].time_s,
+            });
+        }
+        Ok(Self { records })
+    }
+
+    /// The frames, shortest exposure first.
+    pub fn records(&self) -> &[FrameRecord] {
+        &self.records
+    }
+
+    /// The exposure times, ascending.
+    pub fn times_s(&self) -> Vec<f64> {
+        self.records.iter().map(|r| r.time_s).collect()
+    }
+
+    /// Number of frames.
+    pub fn len(&self) -> usize {
+        self.records.len()
+    }
+
+    /// Whether there is no frame (never, once opened).
+    pub fn is_empty(&self) -> bool {
+        self.records.is_empty()
+    }
+
+    /// Decodes each frame once, shortest exposure first, turned upright,
+    /// checks it against the first (size, depth, codes) and the previous
+    /// (brightness must not fall as time rises, as in
+    /// [`Bracket::new`](super::bracket::Bracket::new)), and hands it to
+    /// `visitor`; `progress(k)` after the `k`-th frame. Returns the white
+    /// points (also given to the visitor).
+    pub fn scan(
+        &self,
+        visitor: &mut dyn FrameVisitor,
+        progress: &dyn Fn(usize),
+    ) -> Result<WhitePoints, HdrError> {
+        let mut first: Option<CodeImage> = None;
+        let mut previous: Option<(String, f64, f64)> = None;
+        let mut white = None;
+        for (j, r) in self.records.iter().enumerate() {
+            let (image, _) = read_frame(&r.path)?;
+            let shape = first.get_or_insert_with(|| CodeImage {
+                width: image.width,
+                height: image.height,
+                bits: image.bits,
+                data: Vec::new(),
+                label: image.label.clone(),
+            });
+            check_image(&image, shape)?;
+            let mean = image.data.iter().map(|&z| f64::from(z)).sum::<f64>() / image.data.len() as f64;
+            let tol = 0.005 * f64::from(image.max_code());
+            if let Some((label, t, m)) = &previous
+                && *m > mean + tol
+            {
+                return Err(HdrError::TimesContradictBrightness {
+                    brighter: label.clone(),
+                    brighter_time_s: *t,
+                    darker: image.label.clone(),
+                    darker_time_s: r.time_s,
+                });
+            }
+            previous = Some((image.label.clone(), r.time_s, mean));
+            let scan = white.get_or_insert_with(|| WhitePointScan::new(self.records.len(), image.bits));
+            let pile_up = scan.push(&image);
+            visitor.frame(j, &image, pile_up)?;
+            progress(j + 1);
+        }
+        let white = white.map_or_else(Vec::new, WhitePointScan::finish);
+        visitor.finish(&white)?;
+        Ok(white)
+    }
+}
+
+/// The samples of each frame and channel that a pile-up may clip: pixel
+/// index and code, set aside until the white points are known.
+#[derive(Debug, Clone, Default)]
+pub struct PileUpSamples {
+    /// `[j][c]` → (pixel, code).
+    held: Vec<[Vec<(u32, u16)>; 3]>,
+}
+
+impl PileUpSamples {
+    /// Whether code `z` of a channel whose pile-up starts at `pile_up` waits
+    /// for the white point (at or above the pile-up, below the largest code).
+    #[inline(always)]
+    pub fn waits(pile_up: Option<u16>, z: u16, max: u16) -> bool {
+        pile_up.is_some_and(|k| z >= k && z < max)
+    }
+
+    /// Sets aside frame `j`'s samples that [`waits`](Self::waits).
+    pub fn hold(&mut self, j: usize, image: &CodeImage, pile_up: [Option<u16>; 3]) {
+        if self.held.len() <= j {
+            self.held.resize_with(j + 1, Default::default);
+        }
+        let max = image.max_code();
+        for (c, held) in self.held[j].iter_mut().enumerate() {
+            if pile_up[c].is_none() {
+                continue;
+            }
+            for (p, px) in image.data.chunks_exact(3).enumerate() {
+                if Self::waits(pile_up[c], px[c], max) {
+                    held.push((p as u32, px[c]));
+                }
+            }
+        }
+    }
+
+    /// Frame `j`'s samples set aside in channel `c`.
+    pub fn of(&self, j: usize, c: usize) -> &[(u32, u16)] {
+        self.held.get(j).map_or(&[], |h| h[c].as_slice())
+    }
+}
+
+/// A bracket written to PNG files for the tests of the streamed readers.
+#[cfg(test)]
+pub(super) mod fixture {
+    use std::path::{Path, PathBuf};
+
+    use crate::camera::image::CodeImage;
+    use crate::camera::sensor::CameraModel;
+    use crate::camera::test_chart::{SEVEN_STOP_TIMES_S, hdr_chart};
+    use crate::hdr::image_file::write_png;
+
+    /// The seven-stop chart (96 × 64, 8 bits) with two pile-ups: a "moon"
+    /// whose green is clipped at 254 in every frame (confirmed), and a flat
+    /// patch at 240 in red in the shortest frame that rises with exposure
+    /// (not confirmed). Written to `dir` in reverse time order; returns the
+    /// paths, their times and the images (in time order).
+    pub fn written(dir: &Path) -> (Vec<PathBuf>, Vec<f64>, Vec<CodeImage>) {
+        let cam = CameraModel::typical(8);
+        let scene = hdr_chart(96, 64);
+        let mut images: Vec<CodeImage> = SEVEN_STOP_TIMES_S
+            .iter()
+            .enumerate()
+            .map(|(j, &t)| cam.photograph(&scene, t, j as u64))
+            .collect();
+        for (j, im) in images.iter_mut().enumerate() {
+            for p in 0..400 {
+                let (x, y) = (p % 20, p / 20);
+                let moon = (y * 96 + x) * 3;
+                im.data[moon] = im.data[moon].max(200);
+                im.data[moon + 1] = 254;
+                let patch = ((y + 30) * 96 + x + 60) * 3;
+                im.data[patch] = if j == 0 { 240 } else { 255 };
+            }
+        }
+        let mut paths = Vec::new();
+        let mut times = Vec::new();
+        for (j, im) in images.iter().enumerate().rev() {
+            let p = dir.join(format!("f{j}.png"));
+            write_png(im, &p).unwrap();
+            paths.push(p);
+            times.push(SEVEN_STOP_TIMES_S[j]);
+        }
+        for im in &mut images {
+            im.label = String::new();
+        }
+        (paths, times, images)
+    }
+}
