@@ -10,8 +10,8 @@
 #   validation/hdr/fetch_sets.sh           # the sets, outside the repository
 #   bench/hdr_real/run.sh [SET [REPEATS [THREADS]]]   # default radiantlab-eos 3 2
 #
-# Until the EXIF reader lands, --times comes from the set's times.txt and
-# Campanile's calibrate is given --allow-resampled.
+# Both tools are given the set's times.txt (the same exposures; Campanile
+# would read the same nominal times from EXIF).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
@@ -50,7 +50,7 @@ measure() { # label step cmd...
 echo "load before: $(uptime)"
 export OMP_NUM_THREADS="$threads" RAYON_NUM_THREADS="$threads"
 for r in $(seq "$repeats"); do
-  measure campanile calibrate "$bin" hdr calibrate "${files[@]}" --times "$tlist" --allow-resampled -o "$out/c.csv" --plot "$out/c.svg"
+  measure campanile calibrate "$bin" hdr calibrate "${files[@]}" --times "$tlist" -o "$out/c.csv" --plot "$out/c.svg"
   measure campanile merge "$bin" hdr merge "${files[@]}" --times "$tlist" --curve "$out/c.csv" -o "$out/c.exr"
   measure opencv calibrate "$venv/bin/python" "$here/opencv_steps.py" calibrate "$d" "$out/o.csv" "$threads"
   measure opencv merge "$venv/bin/python" "$here/opencv_steps.py" merge "$d" "$out/o.csv" "$out/o.hdr" "$threads"

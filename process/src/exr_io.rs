@@ -49,10 +49,17 @@ fn write_layer(
     channels: Vec<AnyChannel<FlatSamples>>,
     path: &Path,
 ) -> std::result::Result<(), HdrError> {
+    // PIZ (wavelet + Huffman, lossless) on scan lines: on a 21 MP float map
+    // ZIP's deflate took 40 % of a whole 18-frame merge.
+    let encoding = Encoding {
+        compression: Compression::PIZ,
+        blocks: Blocks::ScanLines,
+        line_order: LineOrder::Increasing,
+    };
     let layer = Layer::new(
         (map.width, map.height),
         attributes,
-        Encoding::SMALL_LOSSLESS,
+        encoding,
         AnyChannels::sort(SmallVec::from_vec(channels)),
     );
     Image::from_layer(layer)

@@ -51,7 +51,8 @@ pub enum HdrCommand {
     ///
     /// Writes the curve as CSV (g(z) = ln relative exposure per code and
     /// channel, with its 1σ uncertainty and support) and an SVG plot with the
-    /// ±2σ band.
+    /// ±2σ band. Frames are decoded one at a time, keeping only the pixels
+    /// the sampling can pick (about 4 bytes a pixel plus two frames).
     ///
     /// Example:
     ///   campanile hdr calibrate IMG_*.JPG -o curve.csv
@@ -73,6 +74,10 @@ pub enum HdrCommand {
     ///
     /// Pixels clipped in every exposure keep the darkest exposure's bound and
     /// are counted in the verdict (OUT's stem + .quality.json).
+    ///
+    /// Frames are decoded one at a time into per-pixel sums: memory is about
+    /// 24 bytes a pixel plus two frames (0.8 GB for 21 MP), whatever the
+    /// number of frames; --align and --deghost hold every frame.
     ///
     /// Example:
     ///   campanile hdr merge IMG_*.JPG --curve curve.csv -o scene.exr

@@ -151,10 +151,16 @@ impl Bracket {
     }
 }
 
-/// One image of a bracket whose first image is `first`: 8 to 16 bits, not
-/// empty, a buffer of `width · height · 3` codes, the size and depth of the
-/// first, every code within its depth (`first`'s codes are not read).
+/// One image of a bracket whose first image is `first`: its shape
+/// ([`check_shape`]) and every code within its depth.
 pub(super) fn check_image(img: &CodeImage, first: &CodeImage) -> Result<(), HdrError> {
+    check_shape(img, first)?;
+    check_codes(img)
+}
+
+/// 8 to 16 bits, not empty, a buffer of `width · height · 3` codes, the
+/// size and depth of `first` (whose codes are not read).
+pub(super) fn check_shape(img: &CodeImage, first: &CodeImage) -> Result<(), HdrError> {
     if !matches!(img.bits, 8..=16) {
         return Err(HdrError::BadImage {
             image: img.label.clone(),
@@ -195,6 +201,11 @@ pub(super) fn check_image(img: &CodeImage, first: &CodeImage) -> Result<(), HdrE
             first_bits: first.bits,
         });
     }
+    check_codes(img)
+}
+
+/// Every code of `img` within its depth (the first one beyond named).
+pub(super) fn check_codes(img: &CodeImage) -> Result<(), HdrError> {
     let max = img.max_code();
     if let Some(i) = img.data.iter().position(|&z| z > max) {
         let p = i / 3;

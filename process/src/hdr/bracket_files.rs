@@ -18,10 +18,12 @@
 use std::path::PathBuf;
 
 use super::HdrError;
-use super::bracket::check_image;
+use rayon::prelude::*;
+
+use super::bracket::{check_codes, check_shape};
 use super::bracket_list::{FrameRecord, TimeSource};
 use super::exposure_metadata::{effective_times, read_exposure_metadata};
-use super::image_file::read_frame;
+use super::image_file::read_frame_into;
 use super::white_point::{WhitePoint, WhitePointScan, WhitePoints};
 use crate::camera::image::CodeImage;
 
@@ -121,16 +123,20 @@ impl BracketFiles {
     /// [`Bracket::new`](super::bracket::Bracket::new)), and hands it to
     /// `visitor`; `progress(k)` after the `k`-th frame. Returns the white
     /// points (also given to the visitor).
-    pub fn scan(
-        &self,
-        visitor: &mut dyn FrameVisitor,
-        progress: &dyn Fn(usize),
-    ) -> Result<WhitePoints, HdrError> {
+    pub fn scan(&self, visitor: &mut dyn FrameVisitor, progress: &dyn Fn(usize)) -> Result<WhitePoints, HdrError> {
         let mut first: Option<CodeImage> = None;
         let mut previous: Option<(String, f64, f64)> = None;
         let mut white = None;
+        let mut bytes = Vec::new();
+        let mut image = CodeImage {
+            width: 0,
+            height: 0,
+            bits: 8,
+            data: Vec::new(),
+            label: String::new(),
+        };
         for (j, r) in self.records.iter().enumerate() {
-            let (image, _) = read_frame(&r.path)?;
+            read_frame_into(&r.path, &mut bytes, &mut image)?;
             let shape = first.get_or_insert_with(|| CodeImage {
                 width: image.width,
                 height: image.height,
@@ -138,8 +144,17 @@ impl BracketFiles {
                 data: Vec::new(),
                 label: image.label.clone(),
             });
-            check_image(&image, shape)?;
-            let mean = image.data.iter().map(|&z| f64::from(z)).sum::<f64>() / image.data.len() as f64;
+            check_shape(&image, shape)?;
+            // One parallel pass for the mean and the range of the codes.
+            let (sum, largest) = image
+                .data
+                .par_chunks(1 << 16)
+                .map(|c| c.iter().fold((0u64, 0u16), |(s, m), &z| (s + u64::from(z), m.max(z))))
+                .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1.max(b.1)));
+            if largest > image.max_code() {
+                check_codes(&image)?;
+            }
+            let mean = sum as f64 / image.data.len() as f64;
             let tol = 0.005 * f64::from(image.max_code());
             if let Some((label, t, m)) = &previous
                 && *m > mean + tol

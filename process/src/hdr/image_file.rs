@@ -3,7 +3,8 @@
 
 use std::path::Path;
 
-use image::DynamicImage;
+use image::{ColorType, DynamicImage, ImageDecoder};
+use rayon::prelude::*;
 
 use super::HdrError;
 use super::exposure_metadata::{ExposureMetadata, Orientation, read_exposure_metadata};
@@ -15,6 +16,77 @@ pub fn read_frame(path: &Path) -> Result<(CodeImage, ExposureMetadata), HdrError
     let meta = read_exposure_metadata(path)?;
     let img = read_stored_codes(path)?;
     Ok((turn_upright(img, meta.orientation), meta))
+}
+
+/// [`read_frame`] into buffers reused from frame to frame (`bytes` for the
+/// decoder's output, `out` for the codes): a bracket read one frame at a
+/// time allocates its buffers once. 8- and 16-bit RGB (the cameras' JPEG,
+/// PNG and TIFF) decode straight into them; other layouts go through
+/// [`read_frame`].
+pub fn read_frame_into(path: &Path, bytes: &mut Vec<u8>, out: &mut CodeImage) -> Result<ExposureMetadata, HdrError> {
+    let meta = read_exposure_metadata(path)?;
+    let image_error = |cause| HdrError::Image {
+        path: path.to_path_buf(),
+        cause,
+    };
+    let decoder = image::ImageReader::open(path)
+        .map_err(|e| image_error(image::ImageError::IoError(e)))?
+        .into_decoder()
+        .map_err(image_error)?;
+    let (w, h) = decoder.dimensions();
+    let bits = match decoder.color_type() {
+        ColorType::Rgb8 => 8,
+        ColorType::Rgb16 => 16,
+        _ => {
+            drop(decoder);
+            let (img, meta) = read_frame(path)?;
+            *out = img;
+            return Ok(meta);
+        }
+    };
+    let len = usize::try_from(decoder.total_bytes()).unwrap_or(usize::MAX);
+    bytes.resize(len, 0);
+    decoder.read_image(bytes).map_err(image_error)?;
+    const CHUNK: usize = 1 << 16;
+    if bits == 8 {
+        out.data.resize(bytes.len(), 0);
+        out.data
+            .par_chunks_mut(CHUNK)
+            .zip(bytes.par_chunks(CHUNK))
+            .for_each(|(d, b)| {
+                for (d, &b) in d.iter_mut().zip(b) {
+                    *d = u16::from(b);
+                }
+            });
+    } else {
+        out.data.resize(bytes.len() / 2, 0);
+        out.data
+            .par_chunks_mut(CHUNK)
+            .zip(bytes.par_chunks(2 * CHUNK))
+            .for_each(|(d, b)| {
+                for (d, b) in d.iter_mut().zip(b.chunks_exact(2)) {
+                    *d = u16::from_ne_bytes([b[0], b[1]]);
+                }
+            });
+    }
+    out.width = w as usize;
+    out.height = h as usize;
+    out.bits = bits;
+    out.label = path.display().to_string();
+    if meta.orientation != Orientation::Upright {
+        let img = std::mem::replace(
+            out,
+            CodeImage {
+                width: 0,
+                height: 0,
+                bits,
+                data: Vec::new(),
+                label: String::new(),
+            },
+        );
+        *out = turn_upright(img, meta.orientation);
+    }
+    Ok(meta)
 }
 
 /// Reads an image file as RGB codes, turned upright by its EXIF
@@ -59,12 +131,12 @@ fn read_stored_codes(path: &Path) -> Result<CodeImage, HdrError> {
         // The common cases without a copy of the decoded buffer.
         DynamicImage::ImageRgb8(buf) => (8, buf.into_raw().into_iter().map(u16::from).collect()),
         DynamicImage::ImageRgb16(buf) => (16, buf.into_raw()),
-        DynamicImage::ImageLuma8(_)
-        | DynamicImage::ImageLumaA8(_)
-        | DynamicImage::ImageRgba8(_) => (8, img.to_rgb8().into_raw().into_iter().map(u16::from).collect()),
-        DynamicImage::ImageLuma16(_)
-        | DynamicImage::ImageLumaA16(_)
-        | DynamicImage::ImageRgba16(_) => (16, img.to_rgb16().into_raw()),
+        DynamicImage::ImageLuma8(_) | DynamicImage::ImageLumaA8(_) | DynamicImage::ImageRgba8(_) => {
+            (8, img.to_rgb8().into_raw().into_iter().map(u16::from).collect())
+        }
+        DynamicImage::ImageLuma16(_) | DynamicImage::ImageLumaA16(_) | DynamicImage::ImageRgba16(_) => {
+            (16, img.to_rgb16().into_raw())
+        }
         other => {
             return Err(HdrError::BadImage {
                 image: label,

@@ -176,7 +176,8 @@ impl WhitePointScan {
             for (c, slot) in wp.iter_mut().enumerate() {
                 let Some(z) = self.candidates[j][c] else { continue };
                 let accepted = self.confirmed[j][c]
-                    || (0..m).any(|k| self.confirmed[k][c] && self.candidates[k][c].is_some_and(|zk| zk.abs_diff(z) <= 1));
+                    || (0..m)
+                        .any(|k| self.confirmed[k][c] && self.candidates[k][c].is_some_and(|zk| zk.abs_diff(z) <= 1));
                 if !accepted {
                     continue;
                 }
