@@ -1,7 +1,10 @@
 """Joins Campanile's and scipy's sky fits of the same references (bench/sky/run.sh)
 and prints one markdown row per group of skies: errors against the references
 (noise-free; and with 2% noise, Campanile's robust path against scipy's plain
-LM on its own noise draw) and time per channel, with the ratio."""
+LM on its own noise draw) and time per channel, with the ratio. With a third
+file (the example's three.csv), one more row: Campanile's plain fit of a sky's
+three channels, one after another and side by side with rayon, against three
+times scipy's median per channel (scipy fits one channel at a time)."""
 import csv, sys, statistics as st
 
 ours = {(r["id"], r["channel"]): r for r in csv.DictReader(open(sys.argv[1]))}
@@ -51,5 +54,14 @@ ev = [int(o["evaluations"]) for o in ours.values()]
 ns = [float(o["plain_ms"]) * 1e6 / max(1, int(o["samples_evaluated"])) for o in ours.values() if int(o["evaluations"]) > 0]
 nf = [int(t[0.0]["nfev"]) for t in theirs.values() if 0.0 in t and t[0.0]["nfev"]]
 print()
+if len(sys.argv) > 3:
+    three = [r for r in csv.DictReader(open(sys.argv[3])) if r["channels"] == "3"]
+    if three:
+        per_channel = st.median(allt)
+        print(f"| all, 3 channels together | {len(three)} skies | | | | "
+              f"| {st.median(float(r['serial_ms']) for r in three):.2f} ms one after another, "
+              f"{st.median(float(r['parallel_ms']) for r in three):.2f} ms with rayon | {3 * per_channel:.2f} ms (3 × median) "
+              f"| {3 * per_channel / st.median(float(r['serial_ms']) for r in three):.1f}× / "
+              f"{3 * per_channel / st.median(float(r['parallel_ms']) for r in three):.1f}× |")
 print(f"Campanile: median {st.median(ev)} Levenberg-Marquardt evaluations (residuals and Jacobian) per channel over all candidates; "
       f"{st.median(ns):.0f} ns of fit time per sample evaluated. scipy: median {st.median(nf)} function evaluations per fit (its Jacobian by differences).")

@@ -5,7 +5,10 @@
 # validation/sky/generate.sh if absent. In the same run, on the same
 # samples, from the same start (the one Campanile's fit chose):
 # Campanile's whole fit (starts, every candidate, the model choice) and
-# scipy.optimize.least_squares(method="lm") of the Perez form alone.
+# scipy.optimize.least_squares(method="lm") of the Perez form alone; and
+# Campanile's fit of each sky's three channels, one after another and with
+# rayon side by side (the machine's load and core count are printed: the
+# timings are only comparable within one run).
 # Usage: bench/sky/run.sh [REFERENCE_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -19,4 +22,5 @@ echo "load before: $(cut -d' ' -f1-3 /proc/loadavg)"
 target/release/examples/sky_references_bench "$refs" "$work"
 "$venv/bin/python" validation/sky/scipy_fit.py "$refs" --start "$work/start.csv" --noise 0.02 --seed 7 --reps 5 --out "$work/scipy.csv" > /dev/null
 echo "load after: $(cut -d' ' -f1-3 /proc/loadavg)"
-"$venv/bin/python" bench/sky/compare.py "$work/campanile.csv" "$work/scipy.csv"
+echo "cores: $(nproc)"
+"$venv/bin/python" bench/sky/compare.py "$work/campanile.csv" "$work/scipy.csv" "$work/three.csv"

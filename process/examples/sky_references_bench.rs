@@ -20,6 +20,7 @@ use campanile_process::error_figures::quantile;
 use campanile_process::sky::{SkyModel, SkySample, angle_between, direction, fit_sky, fit_sky_robust};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 
 type Error = Box<dyn std::error::Error>;
 
@@ -59,6 +60,8 @@ fn main() -> Result<(), Error> {
         "id,channel,n,kind,converged,plain_ms,robust_ms,median_err,p95_err,max_err,robust_median_err,robust_p95_err,robust_max_err,masked,noisy_median_err,noisy_p95_err,evaluations,samples_evaluated"
     )?;
     writeln!(starts, "id,channel,lz,a,b,c,d,e")?;
+    let mut three = std::fs::File::create(Path::new(out).join("three.csv"))?;
+    writeln!(three, "id,channels,n,serial_ms,parallel_ms")?;
     let mut manifest = csv::Reader::from_path(dir.join("manifest.csv"))?;
     let header = manifest.headers()?.clone();
     let mut rng = ChaCha8Rng::seed_from_u64(7);
@@ -86,6 +89,24 @@ fn main() -> Result<(), Error> {
                 v.push(x[2 + c]);
             }
         }
+        let channels: Vec<Vec<SkySample>> = values
+            .iter()
+            .map(|v| {
+                xis.iter()
+                    .zip(&gammas)
+                    .zip(v)
+                    .map(|((&xi, &gamma), &radiance)| SkySample { xi, gamma, radiance })
+                    .collect()
+            })
+            .collect();
+        let (serial_ms, _) = best_ms(5, || channels.iter().map(|s| fit_sky(s, zs)).collect::<Vec<_>>());
+        let (parallel_ms, _) = best_ms(5, || channels.par_iter().map(|s| fit_sky(s, zs)).collect::<Vec<_>>());
+        writeln!(
+            three,
+            "{id},{},{},{serial_ms:.4},{parallel_ms:.4}",
+            channels.len(),
+            xis.len()
+        )?;
         for (name, v) in names.iter().zip(&values) {
             let samples: Vec<SkySample> = xis
                 .iter()

@@ -32,6 +32,8 @@
 //! when the samples do not pay for fitting it, however far from the sun
 //! they lie.
 
+mod elementary;
+mod kernel;
 mod robust;
 mod solver;
 mod starts;
@@ -281,7 +283,7 @@ fn model_of(theta: &[f64; 7]) -> SkyModel {
 
 /// The weighted RSS of a model with its scale refitted in closed form.
 fn rescaled(prep: &Prepared, m: &SkyModel) -> (SkyModel, f64) {
-    let (sy, ss, yy) = prep.scale_sums(&[1.0, m.a, m.b, m.c, m.d, m.e, m.h], 1);
+    let (sy, ss, yy) = prep.scale_sums(&[1.0, m.a, m.b, m.c, m.d, m.e, m.h]);
     let lz = if ss > 0.0 {
         (sy / ss).max(f64::MIN_POSITIVE)
     } else {

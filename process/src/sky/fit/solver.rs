@@ -22,8 +22,8 @@
 // index loops.
 #![allow(clippy::needless_range_loop)]
 
-use super::super::seven_parameter::COS_XI_FLOOR;
-use super::SkySample;
+use super::kernel::{Evaluation, evaluate};
+pub use super::kernel::{Prepared, natural};
 
 /// Names of θ's entries, for messages.
 pub const PARAMETER_NAMES: [&str; 7] = ["Lz", "a", "b", "c", "d", "e", "h"];
@@ -106,277 +106,6 @@ impl Default for Settings {
             max_evaluations: 200,
         }
     }
-}
-
-/// `e^x` to within a few ulps of [`f64::exp`], inlined: reduced to
-/// `2^k e^r` with |r| ≤ ln 2 / 2 (Cody–Waite, ln 2 in two parts) and
-/// `e^r` by its Taylor series to r¹² (truncation < 2·10⁻¹⁶). Two of these
-/// per sample are most of an evaluation's cost, and the library call is
-/// three times slower. Outside [−708, 709] it defers to `f64::exp`
-/// (overflow to ∞, subnormals).
-#[inline(always)]
-fn exp(x: f64) -> f64 {
-    if !(-708.0..=709.0).contains(&x) {
-        return x.exp();
-    }
-    const LN2_HI: f64 = 6.931_471_803_691_238e-1;
-    const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
-    // Round to nearest by the 1.5·2⁵² trick (no libm call).
-    const SHIFT: f64 = 6_755_399_441_055_744.0;
-    let k = (x * std::f64::consts::LOG2_E + SHIFT) - SHIFT;
-    let r = (x - k * LN2_HI) - k * LN2_LO;
-    const C: [f64; 13] = [
-        1.0,
-        1.0,
-        1.0 / 2.0,
-        1.0 / 6.0,
-        1.0 / 24.0,
-        1.0 / 120.0,
-        1.0 / 720.0,
-        1.0 / 5040.0,
-        1.0 / 40320.0,
-        1.0 / 362_880.0,
-        1.0 / 3_628_800.0,
-        1.0 / 39_916_800.0,
-        1.0 / 479_001_600.0,
-    ];
-    let mut p = C[12];
-    for &c in C[..12].iter().rev() {
-        p = p * r + c;
-    }
-    f64::from_bits(((k as i64 + 1023) as u64) << 52) * p
-}
-
-/// The samples, with everything that does not depend on θ computed once.
-#[derive(Debug, Clone)]
-pub struct Prepared {
-    inv_cos: Vec<f64>,
-    gamma: Vec<f64>,
-    ln_gamma: Vec<f64>,
-    cos2: Vec<f64>,
-    inv_sigma: Vec<f64>,
-    y: Vec<f64>,
-}
-
-impl Prepared {
-    /// `sigma[i]` is sample i's weight denominator (see the module doc of
-    /// `fit`).
-    pub fn new(samples: &[SkySample], sigma: &[f64]) -> Self {
-        let n = samples.len();
-        let mut p = Prepared {
-            inv_cos: Vec::with_capacity(n),
-            gamma: Vec::with_capacity(n),
-            ln_gamma: Vec::with_capacity(n),
-            cos2: Vec::with_capacity(n),
-            inv_sigma: Vec::with_capacity(n),
-            y: Vec::with_capacity(n),
-        };
-        for (s, sg) in samples.iter().zip(sigma) {
-            let g = s.gamma.abs();
-            p.inv_cos.push(1.0 / s.xi.cos().max(COS_XI_FLOOR));
-            p.gamma.push(g);
-            p.ln_gamma.push(if g > 0.0 { g.ln() } else { 0.0 });
-            p.cos2.push(g.cos().powi(2));
-            p.inv_sigma.push(1.0 / sg);
-            p.y.push(s.radiance);
-        }
-        p
-    }
-
-    /// Number of samples.
-    pub fn len(&self) -> usize {
-        self.y.len()
-    }
-
-    /// Sample i's measured value.
-    pub fn y(&self, i: usize) -> f64 {
-        self.y[i]
-    }
-
-    /// Sample i's 1/σ.
-    pub fn inv_sigma(&self, i: usize) -> f64 {
-        self.inv_sigma[i]
-    }
-
-    /// Over every `step`-th sample, the weighted sums (Σ S y, Σ S², Σ y²)
-    /// of the shape S = the model of `t` and the samples y, each divided by
-    /// σ: the scale that fits S to y in closed form is Σ S y / Σ S², its
-    /// residual sum of squares Σ y² − (Σ S y)² / Σ S².
-    pub fn scale_sums(&self, t: &[f64; 7], step: usize) -> (f64, f64, f64) {
-        let (mut sy, mut ss, mut yy) = (0.0, 0.0, 0.0);
-        for i in (0..self.len()).step_by(step.max(1)) {
-            let w = self.inv_sigma[i];
-            let s = self.model_at(t, i) * w;
-            let y = self.y[i] * w;
-            sy += s * y;
-            ss += s * s;
-            yy += y * y;
-        }
-        (sy, ss, yy)
-    }
-
-    /// The model's value at sample i, for θ's natural parameters
-    /// `[Lz, a, b, c, d, e, h]`.
-    pub fn model_at(&self, t: &[f64; 7], i: usize) -> f64 {
-        let bg = 1.0 + t[1] * exp(t[2] * self.inv_cos[i]);
-        let gh = if t[6] == 1.0 {
-            self.gamma[i]
-        } else if self.gamma[i] > 0.0 {
-            exp(t[6] * self.ln_gamma[i])
-        } else {
-            0.0
-        };
-        let sa = 1.0 + t[3] * exp(t[4] * gh) + t[5] * self.cos2[i];
-        t[0] * bg * sa
-    }
-}
-
-/// The cost ½Σ wᵢ rᵢ², the gradient Jᵀr and JᵀJ over the free parameters
-/// (indexed 0..k in the order of `free`).
-#[derive(Debug, Clone)]
-pub struct Evaluation {
-    /// ½ Σ wᵢ rᵢ².
-    pub cost: f64,
-    /// Jᵀ W r.
-    pub grad: [f64; 7],
-    /// Jᵀ W J (upper triangle and diagonal filled, then mirrored).
-    pub jtj: [[f64; 7]; 7],
-}
-
-/// θ's natural parameters `[Lz, a, b, c, d, e, h]`.
-pub fn natural(theta: &[f64; 7]) -> [f64; 7] {
-    let mut t = *theta;
-    t[0] = theta[0].exp();
-    t
-}
-
-/// Evaluates the weighted cost, gradient and Gauss–Newton matrix, or `None`
-/// when something is not finite.
-pub fn evaluate(prep: &Prepared, theta: &[f64; 7], free: &[usize], weights: Option<&[f64]>) -> Option<Evaluation> {
-    // Monomorphized for the candidates' parameter counts, so that the
-    // accumulation of JᵀJ unrolls.
-    let ev = match *free {
-        [0, 1, 2, 5] => accumulate::<4>(prep, theta, [0, 1, 2, 5], weights),
-        [0, 1, 2, 3, 4, 5] => accumulate::<6>(prep, theta, [0, 1, 2, 3, 4, 5], weights),
-        [0, 1, 2, 3, 4, 5, 6] => accumulate::<7>(prep, theta, [0, 1, 2, 3, 4, 5, 6], weights),
-        _ => accumulate_any(prep, theta, free, weights),
-    };
-    let k = free.len();
-    let finite = ev.cost.is_finite()
-        && ev.grad[..k].iter().all(|x| x.is_finite())
-        && ev.jtj[..k].iter().all(|r| r[..k].iter().all(|x| x.is_finite()));
-    finite.then_some(ev)
-}
-
-/// Sample i's weighted residual and the seven partial derivatives of L,
-/// weighted.
-#[inline(always)]
-fn row_of(prep: &Prepared, t: &[f64; 7], i: usize, weights: Option<&[f64]>) -> (f64, [f64; 7]) {
-    let [lz, a, b, c, d, e, h] = *t;
-    let inv_cos = prep.inv_cos[i];
-    let e1 = exp(b * inv_cos);
-    let bg = 1.0 + a * e1;
-    let g = prep.gamma[i];
-    let ln_g = prep.ln_gamma[i];
-    let gh = if h == 1.0 {
-        g
-    } else if g > 0.0 {
-        exp(h * ln_g)
-    } else {
-        0.0
-    };
-    let e2 = exp(d * gh);
-    let cos2 = prep.cos2[i];
-    let sa = 1.0 + c * e2 + e * cos2;
-    let l = lz * bg * sa;
-    let scale = match weights {
-        Some(w) => prep.inv_sigma[i] * w[i].sqrt(),
-        None => prep.inv_sigma[i],
-    };
-    let r = (l - prep.y[i]) * scale;
-    let lsa = lz * sa * scale;
-    let lbg = lz * bg * scale;
-    let ce2 = c * e2;
-    (
-        r,
-        [
-            l * scale,
-            lsa * e1,
-            lsa * a * e1 * inv_cos,
-            lbg * e2,
-            lbg * ce2 * gh,
-            lbg * cos2,
-            lbg * ce2 * d * gh * ln_g,
-        ],
-    )
-}
-
-/// The accumulation for K free parameters picked by `free` (inlined into
-/// callers that pass constant patterns, so the picks fold away).
-#[inline(always)]
-fn accumulate<const K: usize>(
-    prep: &Prepared,
-    theta: &[f64; 7],
-    free: [usize; K],
-    weights: Option<&[f64]>,
-) -> Evaluation {
-    let t = natural(theta);
-    let mut cost = 0.0;
-    let mut grad = [0.0; K];
-    let mut jtj = [[0.0; K]; K];
-    if let Some(w) = weights {
-        assert_eq!(w.len(), prep.len(), "one weight per sample");
-    }
-    for i in 0..prep.len() {
-        let (r, full) = row_of(prep, &t, i, weights);
-        cost += 0.5 * r * r;
-        let row: [f64; K] = std::array::from_fn(|p| full[free[p]]);
-        for p in 0..K {
-            grad[p] += row[p] * r;
-            for q in p..K {
-                jtj[p][q] += row[p] * row[q];
-            }
-        }
-    }
-    let mut ev = Evaluation {
-        cost,
-        grad: [0.0; 7],
-        jtj: [[0.0; 7]; 7],
-    };
-    for p in 0..K {
-        ev.grad[p] = grad[p];
-        for q in p..K {
-            ev.jtj[p][q] = jtj[p][q];
-            ev.jtj[q][p] = jtj[p][q];
-        }
-    }
-    ev
-}
-
-fn accumulate_any(prep: &Prepared, theta: &[f64; 7], free: &[usize], weights: Option<&[f64]>) -> Evaluation {
-    let t = natural(theta);
-    let k = free.len();
-    let mut ev = Evaluation {
-        cost: 0.0,
-        grad: [0.0; 7],
-        jtj: [[0.0; 7]; 7],
-    };
-    for i in 0..prep.len() {
-        let (r, full) = row_of(prep, &t, i, weights);
-        ev.cost += 0.5 * r * r;
-        for p in 0..k {
-            ev.grad[p] += full[free[p]] * r;
-            for q in p..k {
-                ev.jtj[p][q] += full[free[p]] * full[free[q]];
-            }
-        }
-    }
-    for p in 0..k {
-        for q in 0..p {
-            ev.jtj[p][q] = ev.jtj[q][p];
-        }
-    }
-    ev
 }
 
 /// The bounds of θ's entry `j` (θ₀ = ln Lz is unbounded).
@@ -503,7 +232,8 @@ pub fn minimize(
         let (lo, hi) = bounds(j);
         theta[j] = theta[j].clamp(lo, hi);
     }
-    let mut ev = evaluate(prep, &theta, free, weights)?;
+    let scale = prep.residual_scale(weights);
+    let mut ev = evaluate(prep, &theta, free, &scale)?;
     let mut evaluations = 1;
     let mut iterations = 0;
     let mut lambda = 1e-3;
@@ -585,7 +315,7 @@ pub fn minimize(
         }
         let step_norm = step[..k].iter().map(|s| s * s).sum::<f64>().sqrt();
         let theta_norm = free.iter().map(|&j| theta[j] * theta[j]).sum::<f64>().sqrt();
-        let next = evaluate(prep, &trial, free, weights);
+        let next = evaluate(prep, &trial, free, &scale);
         evaluations += 1;
         // MINPACK's test, on accepted and refused steps alike: the cost
         // neither falls nor is predicted to fall by more than ftol.
@@ -642,6 +372,7 @@ pub fn minimize(
 
 #[cfg(test)]
 mod tests {
+    use super::super::SkySample;
     use super::*;
 
     fn samples() -> Vec<SkySample> {
@@ -659,28 +390,14 @@ mod tests {
     }
 
     #[test]
-    fn the_inlined_exp_is_within_4_ulps_of_the_librarys() {
-        let mut worst = 0.0_f64;
-        for i in -200_000..=200_000 {
-            let x = f64::from(i) * 3.5e-3 + 1e-7;
-            let (a, b) = (exp(x), x.exp());
-            worst = worst.max((a / b - 1.0).abs());
-        }
-        assert!(worst < 4.0 * f64::EPSILON, "{worst:e}");
-        assert_eq!(exp(800.0), f64::INFINITY);
-        assert_eq!(exp(-800.0), 0.0);
-        assert_eq!(exp(0.0), 1.0);
-        assert!(exp(f64::NAN).is_nan());
-    }
-
-    #[test]
     fn the_analytic_jacobian_matches_finite_differences() {
         let s = samples();
         let sigma: Vec<f64> = (0..s.len()).map(|i| 0.5 + 0.01 * i as f64).collect();
         let prep = Prepared::new(&s, &sigma);
         let theta = [0.3, -0.9, -0.4, 9.0, -2.7, 0.5, 0.9];
         let free: Vec<usize> = (0..7).collect();
-        let ev = evaluate(&prep, &theta, &free, None).expect("finite");
+        let scale = prep.residual_scale(None);
+        let ev = evaluate(&prep, &theta, &free, &scale).expect("finite");
         // The gradient of ½Σr² by central differences.
         for j in 0..7 {
             let h = 1e-6;
@@ -688,8 +405,8 @@ mod tests {
             p[j] += h;
             let mut m = theta;
             m[j] -= h;
-            let cp = evaluate(&prep, &p, &free, None).expect("finite").cost;
-            let cm = evaluate(&prep, &m, &free, None).expect("finite").cost;
+            let cp = evaluate(&prep, &p, &free, &scale).expect("finite").cost;
+            let cm = evaluate(&prep, &m, &free, &scale).expect("finite").cost;
             let fd = (cp - cm) / (2.0 * h);
             assert!(
                 (fd - ev.grad[j]).abs() < 1e-6 * (1.0 + fd.abs()),

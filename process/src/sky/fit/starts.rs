@@ -99,11 +99,11 @@ fn params(m: &SkyModel) -> [f64; 7] {
 /// `Lz = Σ S y / σ² / Σ S² / σ²`, and the weighted residual sum of squares.
 /// Sorted best first.
 pub fn scored_least_squares(prep: &Prepared, sun_zenith: f64) -> Vec<Start> {
-    let step = stride(prep.len());
+    let subset = prep.strided(stride(prep.len()));
     let mut out: Vec<Start> = shapes(sun_zenith)
         .into_iter()
         .filter_map(|(shape, origin)| {
-            let (sy, ss, yy) = prep.scale_sums(&params(&shape), step);
+            let (sy, ss, yy) = subset.scale_sums(&params(&shape));
             if !(ss > 0.0 && sy > 0.0 && ss.is_finite() && sy.is_finite()) {
                 return None;
             }
