@@ -54,6 +54,10 @@ pub struct CapturedFrame {
     pub filter_transmittance: [f64; 3],
     /// The raw codes.
     pub codes: CodeImage,
+    /// The codes are a RAW frame's logarithmic codes
+    /// ([`crate::hdr::linear_codes`]), whose response is known, not a
+    /// camera's processed output.
+    pub linear: bool,
 }
 
 /// The frames of one target of one step: a bracket, or the sun's frames.

@@ -104,6 +104,20 @@ pub enum PipelineError {
         "no bracket of two or more exposures without a filter in the session: the response needs one (take a view or a sky scan with brackets)"
     )]
     NoBracket,
+    /// Some frames are RAW and some are not.
+    #[error(
+        "{linear} of the session's {total} frames are RAW (e.g. {raw_example:?}) and the others are not (e.g. {other_example:?}): one response cannot serve both; process them as separate sessions"
+    )]
+    MixedFrames {
+        /// RAW frames.
+        linear: usize,
+        /// All frames.
+        total: usize,
+        /// A RAW frame's key.
+        raw_example: String,
+        /// Another frame's key.
+        other_example: String,
+    },
     /// A group could not be merged.
     #[error("merging {group}: {source}")]
     Merge {

@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow, bail};
+use campanile_capture::device::FrameFormat;
 use campanile_capture::store::{FrameEntry, JournalEntry, SessionReader, ShotKind};
 use campanile_config::plan::Step;
 use campanile_config::source::SourceFile;
@@ -114,7 +115,12 @@ impl SessionInputs {
             .par_iter()
             .zip(described)
             .map(|(e, (purpose, position_m))| {
-                let codes = self.reader.read_frame(e).map_err(|err| anyhow!("{err}"))?;
+                // A frame file that is missing, damaged or undecodable is
+                // bad input (exit 2), named by the store's error.
+                let codes = self
+                    .reader
+                    .read_frame(e)
+                    .map_err(|err| crate::cli::exit::bad_input(err.to_string()))?;
                 bar.inc(1);
                 let pose = e.meta.pose_reached.or(e.meta.pose_requested).ok_or_else(|| {
                     anyhow!(
@@ -154,6 +160,7 @@ impl SessionInputs {
                     exposure_s: e.meta.exposure_actual_s,
                     filter_transmittance,
                     codes,
+                    linear: e.format == FrameFormat::Dng,
                 })
             })
             .collect();
