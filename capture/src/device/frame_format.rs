@@ -68,6 +68,29 @@ impl FrameFormat {
             )
         })
     }
+
+    /// Why `bytes` cannot be a whole file of this format, judged by its
+    /// end, if they cannot: a JPEG must end with its end-of-image marker
+    /// (ff d9, trailing zero padding allowed). JPEG decoders fill a file cut
+    /// short with grey instead of failing, so a truncated frame would
+    /// otherwise be merged as data.
+    pub fn end_problem(self, bytes: &[u8]) -> Option<String> {
+        if self != FrameFormat::Jpeg {
+            return None;
+        }
+        let end = bytes.iter().rposition(|&b| b != 0).map_or(0, |i| i + 1);
+        (!bytes[..end].ends_with(&[0xFF, 0xD9])).then(|| {
+            let tail: Vec<String> = bytes[end.saturating_sub(4)..end]
+                .iter()
+                .map(|b| format!("{b:02x}"))
+                .collect();
+            format!(
+                "{} bytes ending [{}], expected the JPEG end of image ff d9: the file is cut short",
+                bytes.len(),
+                tail.join(" ")
+            )
+        })
+    }
 }
 
 /// A frame as the camera's file delivered it.

@@ -161,7 +161,7 @@ pub fn decode_frame(path: &Path, bytes: &[u8], format: FrameFormat, bits: u8) ->
         path: path.to_path_buf(),
         reason: format!("not a readable {} frame: {e}", format.name()),
     };
-    if let Some(reason) = format.signature_problem(bytes) {
+    if let Some(reason) = format.signature_problem(bytes).or_else(|| format.end_problem(bytes)) {
         return Err(StoreError::BadFrameFile {
             path: path.to_path_buf(),
             reason,

@@ -27,7 +27,7 @@ mod radiance;
 mod response;
 pub mod room_views;
 
-pub use frames::{CapturedFrame, FrameGroup, Purpose, group_frames, mean_time};
+pub use frames::{CapturedFrame, FrameGroup, LOSSY_CLIP_MARGIN, Purpose, clip_lossy_top, group_frames, mean_time};
 pub use illumination::{
     OccurrenceLight, SUN_MARGIN_RAD, SunMeasurement, TRIPLET_AGREEMENT, fisheye_average, illumination, sky_fisheye,
 };
