@@ -212,6 +212,7 @@ impl Camera for FlatCamera {
             sequence: self.sequence - 1,
             timestamp,
             temperature_c: None,
+            file: None,
         })
     }
 }

@@ -106,6 +106,26 @@ pub struct GainLimits {
     pub max_db: f64,
 }
 
+/// The file the camera delivers each frame as (the simulated camera; real
+/// drivers deliver what their device gives).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(test, derive(proptest_derive::Arbitrary))]
+pub enum FrameFileFormat {
+    /// Decoded codes, stored by the session as a lossless 16-bit PNG.
+    #[default]
+    Png,
+    /// A JPEG at quality 95 with EXIF ExposureTime (8-bit codes).
+    Jpeg,
+    /// A DNG of the sensor's Bayer mosaic (linear, black and white levels).
+    Dng,
+}
+
+impl FrameFileFormat {
+    fn is_png(&self) -> bool {
+        *self == FrameFileFormat::Png
+    }
+}
+
 /// The camera as the station drives it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(test, derive(proptest_derive::Arbitrary))]
@@ -131,6 +151,12 @@ pub struct Camera {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[cfg_attr(test, proptest(strategy = "crate::arbitrary::opt_path()"))]
     pub response_curve: Option<PathBuf>,
+    /// The file each frame arrives as (`Png` when absent): `Jpeg` or `Dng`
+    /// makes the simulated camera deliver what a DSLR would, kept byte for
+    /// byte by the session and decoded by `campanile process`. Only the
+    /// `Sim` driver takes it.
+    #[serde(default, skip_serializing_if = "FrameFileFormat::is_png")]
+    pub file_format: FrameFileFormat,
 }
 
 impl Validate for Camera {
@@ -218,6 +244,13 @@ impl Validate for Camera {
                 "a gain in dB (at least min_db)",
             );
         });
+        if self.driver != CameraDriver::Sim && self.file_format != FrameFileFormat::Png {
+            v.invalid(
+                "file_format",
+                format!("{:?}", self.file_format),
+                "Png (the default) for a real camera driver: only the simulated camera delivers JPEG or DNG files",
+            );
+        }
         if let Some(p) = &self.response_curve {
             v.existing_file("response_curve", p, "a response curve CSV");
         }

@@ -27,6 +27,14 @@
 //!    per-channel gain is multiplied by `g` and its full well divided by
 //!    `g`, leaving the read noise in electrons.
 //!
+//! 5. **File.** With the config's `file_format: Jpeg`, the frame also
+//!    arrives as a JPEG of those codes (8-bit, quality [`JPEG_QUALITY`],
+//!    EXIF ExposureTime); with `Dng`, as a DNG of the same sensor radiance
+//!    photographed by a Bayer sensor of the same full well, read noise and
+//!    gains ([`bayer_sensor`]) with the same noise seed. The frame's codes
+//!    stay the model's in every format, so metering chooses the same
+//!    brackets whatever the file.
+//!
 //! What each frame was made from is kept as a [`FrameTruth`]
 //! ([`SimCamera::last_truth`], [`SimCamera::truth_log`]).
 //!
@@ -42,9 +50,13 @@ use crate::seed::{Purpose, derive};
 use campanile_capture::device::{
     Camera, CameraInfo, CaptureSettings, DeviceError, ExposureRange, ExposureTime, Frame, Gain, GainRange,
 };
-use campanile_config::camera::Camera as CameraConfig;
-use campanile_process::camera::image::RadianceImage;
+use campanile_capture::device::{FrameFile, FrameFormat};
+use campanile_config::camera::{Camera as CameraConfig, FrameFileFormat};
+use campanile_process::camera::bayer::{BayerSensor, CfaPattern, Exposure};
+use campanile_process::camera::image::{CodeImage, RadianceImage};
 use campanile_process::camera::sensor::CameraModel;
+use campanile_process::hdr::dng_file::{DngLayout, DngMetadata, dng_bytes};
+use campanile_process::hdr::image_file::jpeg_bytes;
 use campanile_process::hdr::lens::{RadialPolynomial, normalized_r2};
 use campanile_process::pose::HeadPose;
 use std::sync::{Arc, Mutex, PoisonError};
@@ -171,6 +183,8 @@ pub struct SimCamera<S> {
     /// The last view rendered and its radiance: frames of the same view
     /// within [`SAME_SCENE_S`] reuse it (see [`SimCamera::capture`]).
     render_cache: Option<(View, Arc<RadianceImage>)>,
+    /// The file each frame is delivered as.
+    file_format: FrameFileFormat,
 }
 
 /// Frames of one view taken within this many seconds of its render see the
@@ -226,6 +240,7 @@ impl<S: FrameSource> SimCamera<S> {
             options,
             log: Arc::default(),
             render_cache: None,
+            file_format: config.file_format,
         }
     }
 
@@ -308,6 +323,77 @@ impl<S: FrameSource> SimCamera<S> {
     }
 }
 
+impl<S: FrameSource> SimCamera<S> {
+    /// The file the config's `file_format` asks for (module doc, step 5):
+    /// none for PNG (the store encodes the codes), the codes as a JPEG, or
+    /// the sensor radiance photographed by a Bayer sensor as a DNG.
+    fn frame_file(
+        &self,
+        codes: &CodeImage,
+        sensor: &RadianceImage,
+        model: &CameraModel,
+        exposure_s: f64,
+        noise_seed: u64,
+    ) -> Result<Option<FrameFile>, String> {
+        match self.file_format {
+            FrameFileFormat::Png => Ok(None),
+            FrameFileFormat::Jpeg => jpeg_bytes(codes, JPEG_QUALITY, Some(exposure_s))
+                .map(|bytes| {
+                    Some(FrameFile {
+                        format: FrameFormat::Jpeg,
+                        bytes,
+                    })
+                })
+                .map_err(|e| format!("simulated JPEG not written: {e}")),
+            FrameFileFormat::Dng => {
+                let bayer = bayer_sensor(model);
+                let exposure = Exposure {
+                    time_s: exposure_s,
+                    f_number: bayer.reference_f_number,
+                    iso: bayer.base_iso,
+                };
+                let mosaic = bayer.photograph(sensor, &exposure, noise_seed);
+                let meta = DngMetadata {
+                    make: "Campanile".into(),
+                    model: self.info.model.clone(),
+                    exposure,
+                    xyz_to_camera: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+                    as_shot_neutral: bayer.neutral(),
+                    calibration_illuminant: 21,
+                };
+                Ok(Some(FrameFile {
+                    format: FrameFormat::Dng,
+                    bytes: dng_bytes(&mosaic, &meta, DngLayout::SingleIfd),
+                }))
+            }
+        }
+    }
+}
+
+/// JPEG quality of the simulated camera's JPEG files.
+pub const JPEG_QUALITY: u8 = 95;
+
+/// The Bayer sensor of a DNG-delivering simulated camera: the same full
+/// well, read noise and per-channel gain as `model` (so a RAW frame's
+/// linear value is the model's normalized exposure `x`, the full-well gauge
+/// of `campanile process`), RGGB, at the model's bit depth with a black
+/// level of 1/64 of its range and the white level at its top code.
+pub fn bayer_sensor(model: &CameraModel) -> BayerSensor {
+    let bits = model.sensor.bits.clamp(8, 16);
+    let white = (u32::from(u16::MAX) >> (16 - bits)) as u16;
+    BayerSensor {
+        full_well_electrons: model.sensor.full_well_electrons,
+        read_noise_electrons: model.sensor.read_noise_electrons,
+        gain: model.sensor.gain,
+        bits,
+        black_levels: [(white / 64).max(1); 4],
+        white_level: white,
+        pattern: CfaPattern::Rggb,
+        base_iso: 100.0,
+        reference_f_number: 4.0,
+    }
+}
+
 impl<S: FrameSource> Camera for SimCamera<S> {
     fn info(&self) -> CameraInfo {
         self.info.clone()
@@ -384,6 +470,9 @@ impl<S: FrameSource> Camera for SimCamera<S> {
         }
         let noise_seed = derive(self.seed, Purpose::SensorNoise, sequence);
         let codes = model.photograph(&sensor, exposure.seconds(), noise_seed);
+        let file = self
+            .frame_file(&codes, &sensor, &model, exposure.seconds(), noise_seed)
+            .map_err(DeviceError::Camera)?;
         let truth = FrameTruth {
             sequence,
             view,
@@ -410,6 +499,7 @@ impl<S: FrameSource> Camera for SimCamera<S> {
             sequence,
             timestamp,
             temperature_c: self.options.temperature_c,
+            file,
         })
     }
 }

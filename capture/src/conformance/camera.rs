@@ -141,6 +141,7 @@ mod tests {
                 sequence: 0,
                 timestamp: chrono::DateTime::default(),
                 temperature_c: None,
+                file: None,
             })
         }
     }

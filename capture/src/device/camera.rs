@@ -5,7 +5,7 @@
 //! a sensor in line times), so a [`Frame`] records both the exposure asked
 //! for and the one the camera applied, as the session journal needs.
 
-use super::{DeviceError, ExposureTime, Gain};
+use super::{DeviceError, ExposureTime, FrameFile, Gain};
 use campanile_process::camera::image::CodeImage;
 use chrono::{DateTime, Utc};
 use std::future::Future;
@@ -129,6 +129,11 @@ pub struct Frame {
     pub timestamp: DateTime<Utc>,
     /// Sensor temperature in °C, if the camera reports one.
     pub temperature_c: Option<f64>,
+    /// The file the camera delivered the frame as (JPEG, RAW), if it
+    /// delivered one: the session store keeps it byte for byte and
+    /// processing decodes it, while `data` serves the controller's metering
+    /// and centering. `None`: the store encodes `data` as a 16-bit PNG.
+    pub file: Option<FrameFile>,
 }
 
 impl Frame {

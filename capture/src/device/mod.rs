@@ -23,6 +23,7 @@
 pub mod camera;
 pub mod error;
 pub mod filter_wheel;
+pub mod frame_format;
 pub mod lights;
 pub mod pan_tilt;
 pub mod units;
@@ -30,6 +31,7 @@ pub mod units;
 pub use camera::{Camera, CameraInfo, CaptureSettings, ExposureRange, Frame, GainRange};
 pub use error::DeviceError;
 pub use filter_wheel::FilterWheel;
+pub use frame_format::{FrameFile, FrameFormat};
 pub use lights::{LightChannel, Lights};
 pub use pan_tilt::{AxisRange, HeadStatus, PanTilt, PanTiltLimits};
 pub use units::{Angle, AngularSpeed, ExposureTime, Gain, Level, Pose};

@@ -137,6 +137,7 @@ mod tests {
                 sequence: n,
                 timestamp: chrono::DateTime::default(),
                 temperature_c: None,
+                file: None,
             })
         }
     }

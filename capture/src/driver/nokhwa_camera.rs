@@ -229,6 +229,7 @@ impl BlockingCamera for NokhwaCamera {
             sequence,
             timestamp,
             temperature_c: None,
+            file: None,
         })
     }
 }

@@ -304,6 +304,7 @@ impl BlockingCamera for V4l2Camera {
             sequence,
             timestamp,
             temperature_c: None,
+            file: None,
         })
     }
 }

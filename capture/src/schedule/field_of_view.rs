@@ -101,6 +101,7 @@ pub(crate) mod tests {
                 max_db: 24.0,
             },
             response_curve: None,
+            file_format: Default::default(),
         }
     }
 

@@ -1,4 +1,6 @@
-//! Frame files: raw sensor codes stored losslessly as 16-bit RGB PNG.
+//! Frame files: raw sensor codes stored losslessly as 16-bit RGB PNG, or
+//! the file a camera delivered (JPEG, DNG) kept byte for byte; decoded by
+//! format ([`decode_frame`]).
 //!
 //! The codes are written unscaled (a 12-bit code of 4095 is stored as
 //! 4095, not 65535); the journal records the bit depth so readers know the
@@ -7,8 +9,9 @@
 //! and the same checksum.
 
 use super::error::StoreError;
-use crate::device::Frame;
+use crate::device::{Frame, FrameFormat};
 use campanile_process::camera::image::CodeImage;
+use campanile_process::hdr::{HdrError, image_file, linear_codes, raw_file};
 use image::codecs::png::{CompressionType, FilterType, PngDecoder, PngEncoder};
 use image::{ColorType, DynamicImage, ImageBuffer, ImageDecoder, Rgb};
 use std::io::Cursor;
@@ -142,15 +145,51 @@ pub(crate) fn read_checked_bytes<S: Storage + ?Sized>(
     Ok(bytes)
 }
 
-/// The codes of a journaled frame, exactly as recorded (unscaled,
-/// `entry.bits` significant bits), after checking its checksum and size.
+/// Decode a frame file of `format` through the HDR readers of
+/// `campanile-process` (the ones `campanile hdr calibrate/merge` use):
+/// - PNG ([`decode_png`]): the codes unscaled, `bits` (from the journal)
+///   significant bits;
+/// - JPEG ([`image_file::read_frame_bytes`]): 8-bit codes, turned upright
+///   by the EXIF orientation;
+/// - DNG ([`raw_file::read_raw_bytes`]): the linear frame (black level
+///   removed, white level 1, clipped samples flagged) as the logarithmic
+///   16-bit codes of [`linear_codes`], whose response is known.
+///
+/// A file that does not decode is [`StoreError::BadFrameFile`] naming it.
+pub fn decode_frame(path: &Path, bytes: &[u8], format: FrameFormat, bits: u8) -> Result<CodeImage, StoreError> {
+    let bad = |e: HdrError| StoreError::BadFrameFile {
+        path: path.to_path_buf(),
+        reason: format!("not a readable {} frame: {e}", format.name()),
+    };
+    if let Some(reason) = format.signature_problem(bytes).or_else(|| format.end_problem(bytes)) {
+        return Err(StoreError::BadFrameFile {
+            path: path.to_path_buf(),
+            reason,
+        });
+    }
+    match format {
+        FrameFormat::Png => decode_png(path, bytes, bits),
+        FrameFormat::Jpeg => image_file::read_frame_bytes(path, bytes)
+            .map(|(image, _)| image)
+            .map_err(bad),
+        FrameFormat::Dng => raw_file::read_raw_bytes(path, bytes.to_vec())
+            .map(|frame| linear_codes::log_codes(&frame))
+            .map_err(bad),
+    }
+}
+
+/// The codes of a journaled frame, decoded by its format ([`decode_frame`]:
+/// a PNG's codes exactly as recorded, unscaled with `entry.bits`
+/// significant bits; a JPEG's 8-bit codes; a DNG's logarithmic codes),
+/// after checking its checksum and size, and that its (upright) size is
+/// the journaled one.
 pub(crate) fn read_checked_frame<S: Storage + ?Sized>(
     storage: &S,
     path: &Path,
     entry: &FrameEntry,
 ) -> Result<CodeImage, StoreError> {
     let bytes = read_checked_bytes(storage, path, entry)?;
-    let mut image = decode_png(path, &bytes, entry.bits)?;
+    let mut image = decode_frame(path, &bytes, entry.format, entry.bits)?;
     if (image.width, image.height) != (entry.width as usize, entry.height as usize) {
         return Err(StoreError::BadFrameFile {
             path: path.to_path_buf(),

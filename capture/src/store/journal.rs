@@ -19,6 +19,7 @@
 //! line without its `\n`, which [`parse_journal`] sets apart.
 
 use super::error::StoreError;
+use crate::device::FrameFormat;
 use chrono::{DateTime, Utc};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -154,8 +155,11 @@ pub struct FrameEntry {
     /// The scheduler's key for the shot.
     pub key: String,
     /// The frame file, relative to the session directory
-    /// (`frames/….png`).
+    /// (`frames/….png`, `….jpg`, `….dng`).
     pub file: String,
+    /// The file's format. Journals from before the field read as PNG.
+    #[serde(default)]
+    pub format: FrameFormat,
     /// CRC-32C of the file's bytes.
     pub crc32c: u32,
     /// Size of the file, bytes.
@@ -165,7 +169,9 @@ pub struct FrameEntry {
     /// Height, pixels.
     pub height: u32,
     /// Significant bits per sample: the stored codes lie in
-    /// `0..=2^bits − 1` (unscaled).
+    /// `0..=2^bits − 1` (unscaled). For a camera's file, the bits of the
+    /// codes the camera reported with it (the file's own depth is the
+    /// file's).
     pub bits: u8,
     /// The camera's frame counter.
     pub sequence: u64,

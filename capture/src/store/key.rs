@@ -12,6 +12,7 @@
 
 use super::checksum::crc32c;
 use super::error::StoreError;
+use crate::device::FrameFormat;
 
 /// Longest key accepted, in bytes.
 pub const MAX_KEY_BYTES: usize = 200;
@@ -46,8 +47,13 @@ pub fn check_key(key: &str) -> Result<(), StoreError> {
     Ok(())
 }
 
-/// The frame file name for `key` (call [`check_key`] first).
+/// The PNG frame file name for `key` (call [`check_key`] first).
 pub fn frame_file_name(key: &str) -> String {
+    frame_file_name_as(key, FrameFormat::Png)
+}
+
+/// The frame file name for `key` in `format` (`….jpg`, `….dng`).
+pub fn frame_file_name_as(key: &str, format: FrameFormat) -> String {
     let mut stem: String = key
         .chars()
         .take(MAX_STEM_CHARS)
@@ -63,7 +69,7 @@ pub fn frame_file_name(key: &str) -> String {
     if stem.starts_with('.') {
         stem.replace_range(0..1, "_");
     }
-    format!("{stem}-{:08x}.png", crc32c(key.as_bytes()))
+    format!("{stem}-{:08x}.{}", crc32c(key.as_bytes()), format.extension())
 }
 
 #[cfg(test)]

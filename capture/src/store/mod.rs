@@ -74,12 +74,12 @@ mod storage;
 
 pub use checksum::crc32c;
 pub use error::{DiskFull, StoreError, is_disk_full};
-pub use frame_file::{check_frame, decode_png, encode_png};
+pub use frame_file::{check_frame, decode_frame, decode_png, encode_png};
 pub use journal::{
     FrameEntry, FrameMeta, JournalEntry, LightLevel, MissedEntry, OutageEntry, ParsedJournal, PoseDeg, PrunedEntry,
     ShotKind, parse_journal,
 };
-pub use key::{MAX_KEY_BYTES, check_key, frame_file_name};
+pub use key::{MAX_KEY_BYTES, check_key, frame_file_name, frame_file_name_as};
 pub use products::{PROCESSED_DIR, PRODUCTS_FILE, ProcessedProducts, ProductsError, products_path};
 pub use reader::SessionReader;
 pub use report::{ResumeReport, TornLine, VerifyReport};

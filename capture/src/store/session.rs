@@ -5,11 +5,11 @@ use super::checksum::crc32c;
 use super::error::{DiskFull, StoreError, is_disk_full};
 use super::frame_file::{check_frame, encode_png, read_checked_bytes, read_checked_frame};
 use super::journal::{FrameEntry, FrameMeta, JournalEntry, MissedEntry, OutageEntry, PrunedEntry, parse_journal};
-use super::key::{check_key, frame_file_name};
+use super::key::{check_key, frame_file_name_as};
 use super::report::{ResumeReport, TornLine, VerifyReport};
 use super::snapshot::{PLAN_FILE, PROVENANCE_FILE, SCENE_FILE, STATION_FILE, Snapshot};
 use super::storage::{AtomicWriteError, FsStorage, Storage, is_temp_name, write_atomic};
-use crate::device::Frame;
+use crate::device::{Frame, FrameFormat};
 use campanile_process::camera::image::CodeImage;
 use chrono::{DateTime, Utc};
 use std::collections::{HashMap, HashSet};
@@ -234,7 +234,10 @@ impl<S: Storage> SessionStore<S> {
                 continue;
             }
             let p = frames.join(&name);
-            if name.ends_with(".png") {
+            if FrameFormat::ALL
+                .iter()
+                .any(|f| name.ends_with(&format!(".{}", f.extension())))
+            {
                 s.remove(&p).map_err(io_err("removing unjournaled frame", &p))?;
                 report.orphan_frames_removed.push(p);
                 removed = true;
@@ -386,8 +389,10 @@ impl<S: Storage> SessionStore<S> {
     }
 
     /// Record a frame: checks the key (not completed, not missed in this
-    /// run), the frame and the metadata; writes the codes as a 16-bit RGB
-    /// PNG via a temporary file, fsync, rename and directory fsync; then
+    /// run), the frame and the metadata; writes the camera's file as
+    /// delivered (`frame.file`: JPEG, DNG; its first bytes checked against
+    /// its format), or else the codes as a 16-bit RGB PNG, via a temporary
+    /// file, fsync, rename and directory fsync; then
     /// appends one journal line (`late` if `meta.late_by_s` is set, else
     /// `done`) and fsyncs the journal. Returns the entry journaled.
     ///
@@ -406,7 +411,16 @@ impl<S: Storage> SessionStore<S> {
             });
         }
         check_frame(key, frame)?;
-        let name = frame_file_name(key);
+        let format = frame.file.as_ref().map_or(FrameFormat::Png, |f| f.format);
+        if let Some(file) = &frame.file
+            && let Some(reason) = file.format.signature_problem(&file.bytes)
+        {
+            return Err(StoreError::BadFrame {
+                key: key.to_string(),
+                reason: format!("the camera's file: {reason}"),
+            });
+        }
+        let name = frame_file_name_as(key, format);
         if let Some(other) = self.files.get(&name) {
             return Err(StoreError::FileNameClash {
                 key: key.to_string(),
@@ -414,10 +428,18 @@ impl<S: Storage> SessionStore<S> {
                 file: name,
             });
         }
-        let png = encode_png(key, frame)?;
+        // A camera's file is kept as delivered; decoded codes become a PNG.
+        let encoded;
+        let bytes: &[u8] = match &frame.file {
+            Some(file) => &file.bytes,
+            None => {
+                encoded = encode_png(key, frame)?;
+                &encoded
+            }
+        };
         let frames = self.dir.join(FRAMES_DIR);
         let target = frames.join(&name);
-        if let Err(e) = write_atomic(&self.storage, &frames, &name, &png) {
+        if let Err(e) = write_atomic(&self.storage, &frames, &name, bytes) {
             return Err(if is_disk_full(&e.source) {
                 self.disk_full("frame", key, target, e.source)
             } else {
@@ -427,8 +449,9 @@ impl<S: Storage> SessionStore<S> {
         let entry = FrameEntry {
             key: key.to_string(),
             file: format!("{FRAMES_DIR}/{name}"),
-            crc32c: crc32c(&png),
-            bytes: png.len() as u64,
+            format,
+            crc32c: crc32c(bytes),
+            bytes: bytes.len() as u64,
             // check_frame has bounded both by u32.
             width: u32::try_from(frame.width).unwrap_or(u32::MAX),
             height: u32::try_from(frame.height).unwrap_or(u32::MAX),
@@ -566,7 +589,8 @@ impl<S: Storage> SessionStore<S> {
     }
 
     /// Re-read every journaled frame: its size, CRC-32C, and that it
-    /// decodes as a 16-bit RGB PNG of the journaled size. Damaged or
+    /// decodes by its format (a 16-bit RGB PNG, a JPEG, a DNG) to the
+    /// journaled size. Damaged or
     /// missing frames are listed in the report; only a failure to read
     /// (other than a missing file) is an error.
     pub fn verify(&self) -> Result<VerifyReport, StoreError> {
@@ -586,8 +610,9 @@ impl<S: Storage> SessionStore<S> {
         Ok(report)
     }
 
-    /// The codes of a journaled frame, exactly as recorded (unscaled,
-    /// `entry.bits` significant bits), after checking its checksum.
+    /// The codes of a journaled frame, decoded by its format (see
+    /// [`decode_frame`](super::decode_frame)), after checking
+    /// its checksum.
     pub fn read_frame(&self, entry: &FrameEntry) -> Result<CodeImage, StoreError> {
         read_checked_frame(&self.storage, &self.frame_path(entry), entry)
     }
@@ -687,6 +712,10 @@ impl<S: Storage> SessionStore<S> {
 #[cfg(test)]
 #[path = "session_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "camera_file_tests.rs"]
+mod camera_file_tests;
 
 fn io_error(action: &'static str, path: &Path) -> impl FnOnce(io::Error) -> StoreError {
     let path = path.to_path_buf();

@@ -4,6 +4,7 @@
 use super::*;
 use crate::device::{ExposureTime, Gain};
 use crate::store::fault::{CrashingStorage, Operation, QuotaStorage};
+use crate::store::frame_file_name;
 use crate::store::{CalibrationRef, LightLevel, PoseDeg, Provenance, SessionReader, ShotKind, SourcePaths};
 use chrono::TimeZone;
 use std::collections::BTreeSet;
@@ -74,6 +75,7 @@ fn synth_frame(seed: u64, bits: u8) -> Frame {
         sequence: seed + 1000,
         timestamp: Utc.with_ymd_and_hms(2026, 8, 28, 6, 0, 0).unwrap() + chrono::Duration::seconds(seed as i64 * 7),
         temperature_c: Some(31.7),
+        file: None,
     }
 }
 

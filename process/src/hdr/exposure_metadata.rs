@@ -16,7 +16,7 @@
 //! error, not a guess.
 
 use std::fs::File;
-use std::io::BufReader;
+use std::io::{BufRead, BufReader, Cursor, Seek};
 use std::path::{Path, PathBuf};
 
 use exif::{In, Reader, Tag, Value};
@@ -110,7 +110,17 @@ pub fn read_exposure_metadata(path: &Path) -> Result<ExposureMetadata, HdrError>
         path: path.to_path_buf(),
         cause,
     })?;
-    let exif = match Reader::new().read_from_container(&mut BufReader::new(file)) {
+    exposure_metadata_from(path, &mut BufReader::new(file))
+}
+
+/// [`read_exposure_metadata`] on a file's bytes already in memory (a frame
+/// a camera delivered); `path` names it in errors.
+pub fn read_exposure_metadata_bytes(path: &Path, bytes: &[u8]) -> Result<ExposureMetadata, HdrError> {
+    exposure_metadata_from(path, &mut Cursor::new(bytes))
+}
+
+fn exposure_metadata_from<R: BufRead + Seek>(path: &Path, reader: &mut R) -> Result<ExposureMetadata, HdrError> {
+    let exif = match Reader::new().read_from_container(reader) {
         Ok(e) => e,
         Err(exif::Error::NotFound(_)) => return Ok(ExposureMetadata::default()),
         Err(exif::Error::Io(cause)) => {

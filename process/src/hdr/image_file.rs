@@ -7,14 +7,25 @@ use image::{ColorType, DynamicImage, ImageDecoder};
 use rayon::prelude::*;
 
 use super::HdrError;
-use super::exposure_metadata::{ExposureMetadata, Orientation, read_exposure_metadata};
+use super::exposure_metadata::{ExposureMetadata, Orientation, read_exposure_metadata_bytes};
 use crate::camera::image::CodeImage;
 
 /// Reads an image file as upright RGB codes with its EXIF exposure metadata
 /// (see [`read_code_image`] and [`read_exposure_metadata`]).
 pub fn read_frame(path: &Path) -> Result<(CodeImage, ExposureMetadata), HdrError> {
-    let meta = read_exposure_metadata(path)?;
-    let img = read_stored_codes(path)?;
+    let bytes = std::fs::read(path).map_err(|cause| HdrError::Io {
+        path: path.to_path_buf(),
+        cause,
+    })?;
+    read_frame_bytes(path, &bytes)
+}
+
+/// [`read_frame`] on a file's bytes already in memory (a frame a camera
+/// delivered, as a session stores it); `path` names it in errors and labels
+/// the image. The format is found from the bytes, not the name.
+pub fn read_frame_bytes(path: &Path, bytes: &[u8]) -> Result<(CodeImage, ExposureMetadata), HdrError> {
+    let meta = read_exposure_metadata_bytes(path, bytes)?;
+    let img = read_stored_codes(path, bytes)?;
     Ok((turn_upright(img, meta.orientation), meta))
 }
 
@@ -120,11 +131,16 @@ pub fn turn_upright(img: CodeImage, o: Orientation) -> CodeImage {
 }
 
 /// The codes as stored in the file, before any EXIF orientation.
-fn read_stored_codes(path: &Path) -> Result<CodeImage, HdrError> {
-    let img = image::open(path).map_err(|cause| HdrError::Image {
+fn read_stored_codes(path: &Path, bytes: &[u8]) -> Result<CodeImage, HdrError> {
+    let image_err = |cause| HdrError::Image {
         path: path.to_path_buf(),
         cause,
-    })?;
+    };
+    // The name's extension first (as `image::open` does), else the bytes.
+    let format = image::ImageFormat::from_path(path)
+        .or_else(|_| image::guess_format(bytes))
+        .map_err(image_err)?;
+    let img = image::load_from_memory_with_format(bytes, format).map_err(image_err)?;
     let label = path.display().to_string();
     let (width, height) = (img.width() as usize, img.height() as usize);
     let (bits, data) = match img {
@@ -182,6 +198,74 @@ pub fn write_png(img: &CodeImage, path: &Path) -> Result<(), HdrError> {
     }
 }
 
+/// The bytes of a baseline JPEG of `img`'s codes scaled to 8 bits
+/// (`round(z · 255 / z_max)`) at `quality` (1–100), with an EXIF block
+/// holding ExposureTime when `exposure_time_s` is given (as a camera writes
+/// it; [`read_frame_bytes`] reads it back).
+pub fn jpeg_bytes(img: &CodeImage, quality: u8, exposure_time_s: Option<f64>) -> Result<Vec<u8>, HdrError> {
+    use image::ImageEncoder;
+    let expected = img.width * img.height * 3;
+    let (Ok(w), Ok(h)) = (u32::try_from(img.width), u32::try_from(img.height)) else {
+        return Err(HdrError::BadImage {
+            image: img.label.clone(),
+            what: format!("size {}×{}: too large for a JPEG", img.width, img.height),
+        });
+    };
+    if img.data.len() != expected {
+        return Err(HdrError::BufferLength {
+            image: img.label.clone(),
+            len: img.data.len(),
+            width: img.width,
+            height: img.height,
+            expected,
+        });
+    }
+    let scale = 255.0 / f64::from(crate::camera::image::max_code(img.bits));
+    let buf: Vec<u8> = img
+        .data
+        .iter()
+        .map(|&z| (f64::from(z) * scale).round().min(255.0) as u8)
+        .collect();
+    let encode_err = |cause: image::ImageError| HdrError::BadImage {
+        image: img.label.clone(),
+        what: format!("JPEG encoding failed: {cause}"),
+    };
+    let mut out = Vec::new();
+    let mut encoder = image::codecs::jpeg::JpegEncoder::new_with_quality(&mut out, quality.clamp(1, 100));
+    if let Some(t) = exposure_time_s.filter(|t| t.is_finite() && *t > 0.0) {
+        // A rational as cameras write it: 1/N below a second, else N/1000.
+        let r = if t < 1.0 {
+            exif::Rational {
+                num: 1,
+                denom: (1.0 / t).round().clamp(1.0, f64::from(u32::MAX)) as u32,
+            }
+        } else {
+            exif::Rational {
+                num: (t * 1000.0).round().min(f64::from(u32::MAX)) as u32,
+                denom: 1000,
+            }
+        };
+        let field = exif::Field {
+            tag: exif::Tag::ExposureTime,
+            ifd_num: exif::In::PRIMARY,
+            value: exif::Value::Rational(vec![r]),
+        };
+        let mut writer = exif::experimental::Writer::new();
+        writer.push_field(&field);
+        let mut block = std::io::Cursor::new(Vec::new());
+        writer.write(&mut block, false).map_err(|e| HdrError::BadImage {
+            image: img.label.clone(),
+            what: format!("EXIF block not written: {e}"),
+        })?;
+        // The JPEG encoder accepts EXIF; the error type says "unsupported" only for formats without it.
+        let _ = encoder.set_exif_metadata(block.into_inner());
+    }
+    encoder
+        .write_image(&buf, w, h, image::ExtendedColorType::Rgb8)
+        .map_err(encode_err)?;
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -205,6 +289,36 @@ mod tests {
             assert_eq!(back.bits, bits);
             assert_eq!(back.data, img.data);
         }
+    }
+
+    #[test]
+    fn jpeg_bytes_read_back_as_8_bit_codes_with_the_exposure_time() {
+        // A 12-bit ramp, smooth enough for JPEG at quality 95.
+        let (w, h) = (32usize, 16usize);
+        let data: Vec<u16> = (0..w * h)
+            .flat_map(|i| [((i % w) * 4095 / (w - 1)) as u16; 3])
+            .collect();
+        let img = CodeImage {
+            width: w,
+            height: h,
+            bits: 12,
+            data,
+            label: "ramp".into(),
+        };
+        let bytes = jpeg_bytes(&img, 95, Some(1.0 / 250.0)).unwrap();
+        let (back, meta) = read_frame_bytes(Path::new("frames/ramp.jpg"), &bytes).unwrap();
+        assert_eq!((back.width, back.height, back.bits), (w, h, 8));
+        assert_eq!(meta.exposure_time_s, Some(0.004));
+        let worst = back
+            .data
+            .iter()
+            .zip(&img.data)
+            .map(|(&a, &z)| (f64::from(a) - f64::from(z) * 255.0 / 4095.0).abs())
+            .fold(0.0, f64::max);
+        assert!(worst <= 3.0, "worst code error {worst}");
+        // A damaged JPEG names the file.
+        let e = read_frame_bytes(Path::new("frames/ramp.jpg"), &bytes[..bytes.len() / 3]).unwrap_err();
+        assert!(e.to_string().contains("frames/ramp.jpg"), "{e}");
     }
 
     #[test]

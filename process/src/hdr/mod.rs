@@ -21,6 +21,7 @@
 //! - [`exposure_metadata`]: EXIF exposure time, f-number, ISO, orientation; effective times.
 //! - [`white_point`]: each frame's effective white point per channel (clipping below the largest code).
 //! - [`raw_file`]: reading camera RAW files (rawler) into [`linear_frame`]s.
+//! - [`linear_codes`]: linear frames as logarithmic codes for the session pipeline, and their exact curve.
 //! - [`linear_merge`]: merging linear frames without a response curve.
 //! - [`dng_file`]: writing DNG files (for the simulated RAW path).
 //! - [`tiff_structure`]: the IFD structure of a TIFF/DNG, without its pixels.
@@ -40,6 +41,7 @@ pub mod exposure_codes;
 pub mod exposure_metadata;
 pub mod image_file;
 pub mod lens;
+pub mod linear_codes;
 pub mod linear_frame;
 pub mod linear_merge;
 pub mod merge;

@@ -152,6 +152,17 @@ pub fn read_raw_mosaic(path: &Path) -> Result<RawMosaic, HdrError> {
         path: path.to_path_buf(),
         cause,
     })?;
+    read_raw_mosaic_bytes(path, bytes)
+}
+
+/// [`read_raw`] on a file's bytes already in memory (a frame a camera
+/// delivered, as a session stores it); `path` names it in errors.
+pub fn read_raw_bytes(path: &Path, bytes: Vec<u8>) -> Result<LinearFrame, HdrError> {
+    Ok(demosaic(&read_raw_mosaic_bytes(path, bytes)?))
+}
+
+/// [`read_raw_mosaic`] on a file's bytes already in memory.
+pub fn read_raw_mosaic_bytes(path: &Path, bytes: Vec<u8>) -> Result<RawMosaic, HdrError> {
     if let Some(s) = tiff_structure::parse(&bytes)
         && s.is_dng()
     {

@@ -54,6 +54,35 @@ pub struct CapturedFrame {
     pub filter_transmittance: [f64; 3],
     /// The raw codes.
     pub codes: CodeImage,
+    /// The codes are a RAW frame's logarithmic codes
+    /// ([`crate::hdr::linear_codes`]), whose response is known, not a
+    /// camera's processed output.
+    pub linear: bool,
+}
+
+/// How far below the largest code a lossy (JPEG) frame's codes are taken
+/// as clipped, in 8-bit codes. A channel clipped at 255 decodes from a JPEG
+/// at 250–255 (the compression's error near saturation, chroma above all);
+/// read as valid, those codes bend the top of the recovered curve, which
+/// sets each channel's full-well gauge (`g(255) = 0`), and shift the whole
+/// channel (−0.16 in ln for blue on the simulated sky day at quality 95).
+/// As clipped, they get no weight in the recovery or the merge, and the
+/// curve's top is its smooth continuation.
+pub const LOSSY_CLIP_MARGIN: u16 = 5;
+
+/// Marks the codes of a lossy (JPEG) frame within [`LOSSY_CLIP_MARGIN`]
+/// (scaled to its depth) of the largest code as clipped (the largest
+/// code); returns how many were moved.
+pub fn clip_lossy_top(codes: &mut CodeImage) -> usize {
+    let top = codes.max_code();
+    let margin = (u32::from(LOSSY_CLIP_MARGIN) * u32::from(top) / 255) as u16;
+    let from = top.saturating_sub(margin);
+    let mut moved = 0;
+    for z in codes.data.iter_mut().filter(|z| (from..top).contains(*z)) {
+        *z = top;
+        moved += 1;
+    }
+    moved
 }
 
 /// The frames of one target of one step: a bracket, or the sun's frames.

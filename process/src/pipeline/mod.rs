@@ -27,7 +27,7 @@ mod radiance;
 mod response;
 pub mod room_views;
 
-pub use frames::{CapturedFrame, FrameGroup, Purpose, group_frames, mean_time};
+pub use frames::{CapturedFrame, FrameGroup, LOSSY_CLIP_MARGIN, Purpose, clip_lossy_top, group_frames, mean_time};
 pub use illumination::{
     OccurrenceLight, SUN_MARGIN_RAD, SunMeasurement, TRIPLET_AGREEMENT, fisheye_average, illumination, sky_fisheye,
 };
@@ -104,6 +104,20 @@ pub enum PipelineError {
         "no bracket of two or more exposures without a filter in the session: the response needs one (take a view or a sky scan with brackets)"
     )]
     NoBracket,
+    /// Some frames are RAW and some are not.
+    #[error(
+        "{linear} of the session's {total} frames are RAW (e.g. {raw_example:?}) and the others are not (e.g. {other_example:?}): one response cannot serve both; process them as separate sessions"
+    )]
+    MixedFrames {
+        /// RAW frames.
+        linear: usize,
+        /// All frames.
+        total: usize,
+        /// A RAW frame's key.
+        raw_example: String,
+        /// Another frame's key.
+        other_example: String,
+    },
     /// A group could not be merged.
     #[error("merging {group}: {source}")]
     Merge {

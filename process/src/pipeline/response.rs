@@ -2,7 +2,9 @@
 
 use super::{FrameGroup, PipelineError, Purpose};
 use crate::hdr::bracket::Bracket;
-use crate::hdr::debevec::{Calibration, DebevecOptions, calibrate_debevec};
+use crate::hdr::debevec::{Calibration, ChannelDiagnostics, DebevecOptions, calibrate_debevec};
+use crate::hdr::linear_codes;
+use crate::hdr::noise_bias::NoiseBiasReport;
 
 /// Most brackets stacked into one calibration.
 pub const MAX_STACKED: usize = 12;
@@ -24,10 +26,39 @@ pub struct ResponseChoice {
 /// the widest span of times) among the unfiltered views and tiles, and
 /// fixes its gauge so that the top code is full well (`g(z_max) = 0`, see
 /// the module's units).
+///
+/// A session of RAW frames ([`CapturedFrame::linear`](super::CapturedFrame)
+/// on every frame) is not recovered: its codes are the logarithmic codes of
+/// a linear sensor, whose curve is known exactly
+/// ([`linear_codes::log_code_curve`], already in the full-well gauge: the
+/// white level is exposure 1). A recovery could only add its smoothing and
+/// sampling error to that line, and would need a bracket. A session mixing
+/// RAW and processed frames is refused ([`PipelineError::MixedFrames`]):
+/// one curve cannot serve both.
 pub fn calibrate_response(
     groups: &[FrameGroup],
     opts: &DebevecOptions,
 ) -> Result<(Calibration, ResponseChoice), PipelineError> {
+    let frames = || groups.iter().flat_map(|g| &g.frames);
+    let linear = frames().filter(|f| f.linear).count();
+    if linear > 0 {
+        let total = frames().count();
+        if linear < total {
+            let example = |want: bool| {
+                frames()
+                    .find(|f| f.linear == want)
+                    .map(|f| f.key.clone())
+                    .unwrap_or_default()
+            };
+            return Err(PipelineError::MixedFrames {
+                linear,
+                total,
+                raw_example: example(true),
+                other_example: example(false),
+            });
+        }
+        return Ok(linear_response(linear));
+    }
     let unfiltered = |g: &FrameGroup| {
         g.frames
             .iter()
@@ -123,4 +154,34 @@ pub fn calibrate_response(
         ),
     };
     Ok((calibration, choice))
+}
+
+/// The known response of `frames` RAW frames (see [`calibrate_response`]).
+fn linear_response(frames: usize) -> (Calibration, ResponseChoice) {
+    let calibration = Calibration {
+        curve: linear_codes::log_code_curve(),
+        // Nothing was solved: no samples, no residual, no adjustment.
+        channels: std::array::from_fn(|_| ChannelDiagnostics {
+            samples: 0,
+            observations: 0,
+            residual_rms: 0.0,
+            monotone_adjustments: 0,
+            noise_bias: NoiseBiasReport::default(),
+            condition_estimate: 1.0,
+        }),
+        times_s: Vec::new(),
+        method: format!(
+            "linear (RAW: black level removed, white level = exposure 1, {}-stop logarithmic codes)",
+            linear_codes::LOG_RANGE_STOPS
+        ),
+    };
+    let choice = ResponseChoice {
+        group: "RAW frames".into(),
+        exposures: 0,
+        exposure_ratio: 1.0,
+        reason: format!(
+            "all {frames} frames are RAW: the sensor is linear up to its white level, so the response is known, not recovered"
+        ),
+    };
+    (calibration, choice)
 }

@@ -474,10 +474,15 @@ fn run_sky_series(args: &ProcessArgs, out: PathBuf, debevec: DebevecOptions, q: 
         for (occ, why) in &run.failed {
             eprintln!("  failed {occ}: {why}");
         }
-        anyhow::bail!(
+        let message = format!(
             "{} scans failed (listed above); they were not marked processed",
             run.failed.len()
         );
+        // Every failure a damaged or unreadable input: bad input (exit 2).
+        if run.failed_on_input == run.failed.len() {
+            return Err(crate::cli::exit::bad_input(message));
+        }
+        anyhow::bail!(message);
     }
     verdicts::finish(&quality, &out.join("quality.json"))
 }

@@ -4,11 +4,12 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow, bail};
+use campanile_capture::device::FrameFormat;
 use campanile_capture::store::{FrameEntry, JournalEntry, SessionReader, ShotKind};
 use campanile_config::plan::Step;
 use campanile_config::source::SourceFile;
 use campanile_config::{Plan, Scene, Station};
-use campanile_process::pipeline::{CapturedFrame, Purpose};
+use campanile_process::pipeline::{CapturedFrame, Purpose, clip_lossy_top};
 use campanile_process::pose::HeadPose;
 use indicatif::ProgressBar;
 use rayon::prelude::*;
@@ -114,7 +115,15 @@ impl SessionInputs {
             .par_iter()
             .zip(described)
             .map(|(e, (purpose, position_m))| {
-                let codes = self.reader.read_frame(e).map_err(|err| anyhow!("{err}"))?;
+                // A frame file that is missing, damaged or undecodable is
+                // bad input (exit 2), named by the store's error.
+                let mut codes = self
+                    .reader
+                    .read_frame(e)
+                    .map_err(|err| crate::cli::exit::bad_input(err.to_string()))?;
+                if e.format == FrameFormat::Jpeg {
+                    clip_lossy_top(&mut codes);
+                }
                 bar.inc(1);
                 let pose = e.meta.pose_reached.or(e.meta.pose_requested).ok_or_else(|| {
                     anyhow!(
@@ -154,6 +163,7 @@ impl SessionInputs {
                     exposure_s: e.meta.exposure_actual_s,
                     filter_transmittance,
                     codes,
+                    linear: e.format == FrameFormat::Dng,
                 })
             })
             .collect();

@@ -76,6 +76,8 @@ pub struct ScanRun {
     pub incomplete: Vec<String>,
     /// Occurrences that failed, and why.
     pub failed: Vec<(String, String)>,
+    /// How many of them failed on bad input (a damaged frame file: exit 2).
+    pub failed_on_input: usize,
     /// Where the response came from.
     pub response: String,
     /// Seconds spent on the scans (reading, merging, fitting, writing).
@@ -323,10 +325,14 @@ pub fn process_new_scans(session: &Path, opts: &SkySeriesOptions) -> Result<Scan
     let scan_seconds = t.elapsed().as_secs_f64();
     let mut processed = Vec::new();
     let mut failed = Vec::new();
+    let mut failed_on_input = 0;
     for (occ, r) in outcomes {
         match r {
             Ok(()) => processed.push(occ),
-            Err(e) => failed.push((occ, format!("{e:#}"))),
+            Err(e) => {
+                failed_on_input += usize::from(crate::cli::exit::code_of(&e) == 2);
+                failed.push((occ, format!("{e:#}")));
+            }
         }
     }
     let series = recompute_day(&opts.out)?;
@@ -336,6 +342,7 @@ pub fn process_new_scans(session: &Path, opts: &SkySeriesOptions) -> Result<Scan
         other_shards,
         incomplete,
         failed,
+        failed_on_input,
         response: response_source,
         scan_seconds,
         series,
