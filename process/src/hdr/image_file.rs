@@ -7,7 +7,7 @@ use image::{ColorType, DynamicImage, ImageDecoder};
 use rayon::prelude::*;
 
 use super::HdrError;
-use super::exposure_metadata::{ExposureMetadata, Orientation, read_exposure_metadata_bytes};
+use super::exposure_metadata::{ExposureMetadata, Orientation, read_exposure_metadata, read_exposure_metadata_bytes};
 use crate::camera::image::CodeImage;
 
 /// Reads an image file as upright RGB codes with its EXIF exposure metadata
@@ -40,10 +40,13 @@ pub fn read_frame_into(path: &Path, bytes: &mut Vec<u8>, out: &mut CodeImage) ->
         path: path.to_path_buf(),
         cause,
     };
-    let decoder = image::ImageReader::open(path)
-        .map_err(|e| image_error(image::ImageError::IoError(e)))?
-        .into_decoder()
-        .map_err(image_error)?;
+    let io_error = |e| image_error(image::ImageError::IoError(e));
+    // The name's extension first (as `read_frame`), else the bytes.
+    let mut reader = image::ImageReader::open(path).map_err(io_error)?;
+    if reader.format().is_none() {
+        reader = reader.with_guessed_format().map_err(io_error)?;
+    }
+    let decoder = reader.into_decoder().map_err(image_error)?;
     let (w, h) = decoder.dimensions();
     let bits = match decoder.color_type() {
         ColorType::Rgb8 => 8,
