@@ -7,11 +7,11 @@ use image::{ColorType, DynamicImage, ImageDecoder};
 use rayon::prelude::*;
 
 use super::HdrError;
-use super::exposure_metadata::{ExposureMetadata, Orientation, read_exposure_metadata, read_exposure_metadata_bytes};
+use super::exposure_metadata::{ExposureMetadata, Orientation, read_exposure_metadata_bytes};
 use crate::camera::image::CodeImage;
 
 /// Reads an image file as upright RGB codes with its EXIF exposure metadata
-/// (see [`read_code_image`] and [`read_exposure_metadata`]).
+/// (see [`read_code_image`] and [`read_exposure_metadata`](super::exposure_metadata::read_exposure_metadata)).
 pub fn read_frame(path: &Path) -> Result<(CodeImage, ExposureMetadata), HdrError> {
     let bytes = std::fs::read(path).map_err(|cause| HdrError::Io {
         path: path.to_path_buf(),
@@ -35,18 +35,20 @@ pub fn read_frame_bytes(path: &Path, bytes: &[u8]) -> Result<(CodeImage, Exposur
 /// PNG and TIFF) decode straight into them; other layouts go through
 /// [`read_frame`].
 pub fn read_frame_into(path: &Path, bytes: &mut Vec<u8>, out: &mut CodeImage) -> Result<ExposureMetadata, HdrError> {
-    let meta = read_exposure_metadata(path)?;
+    let file = std::fs::read(path).map_err(|cause| HdrError::Io {
+        path: path.to_path_buf(),
+        cause,
+    })?;
+    let meta = read_exposure_metadata_bytes(path, &file)?;
+    check_not_cut_short(path, &file)?;
     let image_error = |cause| HdrError::Image {
         path: path.to_path_buf(),
         cause,
     };
-    let io_error = |e| image_error(image::ImageError::IoError(e));
-    // The name's extension first (as `read_frame`), else the bytes.
-    let mut reader = image::ImageReader::open(path).map_err(io_error)?;
-    if reader.format().is_none() {
-        reader = reader.with_guessed_format().map_err(io_error)?;
-    }
-    let decoder = reader.into_decoder().map_err(image_error)?;
+    let format = file_format(path, &file).map_err(image_error)?;
+    let decoder = image::ImageReader::with_format(std::io::Cursor::new(&file), format)
+        .into_decoder()
+        .map_err(image_error)?;
     let (w, h) = decoder.dimensions();
     let bits = match decoder.color_type() {
         ColorType::Rgb8 => 8,
@@ -133,16 +135,61 @@ pub fn turn_upright(img: CodeImage, o: Orientation) -> CodeImage {
     }
 }
 
+/// A file's image format: by the name's extension first (as `image::open`
+/// does), else by its bytes.
+fn file_format(path: &Path, bytes: &[u8]) -> image::ImageResult<image::ImageFormat> {
+    image::ImageFormat::from_path(path).or_else(|_| image::guess_format(bytes))
+}
+
+/// Refuses a JPEG whose image data stops before its end-of-image marker: a
+/// file cut short (a copy interrupted, a card pulled), which the decoder
+/// would fill with grey and merge as data. The marker segments are walked
+/// to the first start of scan; from there the entropy-coded data stuffs
+/// every `FF` as `FF 00`, so the first `FF D9` is the end of the image (data
+/// a phone appends after it is allowed). Not a JPEG, or headers the decoder
+/// will refuse anyway: nothing to say here.
+fn check_not_cut_short(path: &Path, bytes: &[u8]) -> Result<(), HdrError> {
+    if !bytes.starts_with(&[0xFF, 0xD8]) {
+        return Ok(());
+    }
+    let cut = |what: String| HdrError::BadImage {
+        image: path.display().to_string(),
+        what,
+    };
+    let mut i = 2;
+    loop {
+        if i + 4 > bytes.len() {
+            return Err(cut(format!(
+                "JPEG of {} bytes ends inside its headers, before the image data: the file is cut short",
+                bytes.len()
+            )));
+        }
+        match (bytes[i], bytes[i + 1]) {
+            (0xFF, 0xFF) => i += 1,
+            (0xFF, 0xDA) => break,
+            (0xFF, 0xD9) | (0xFF, 0xD0..=0xD7) => return Ok(()),
+            (0xFF, _) => i += 2 + usize::from(u16::from_be_bytes([bytes[i + 2], bytes[i + 3]])),
+            _ => return Ok(()),
+        }
+    }
+    if bytes[i..].windows(2).any(|w| w == [0xFF, 0xD9]) {
+        Ok(())
+    } else {
+        Err(cut(format!(
+            "JPEG of {} bytes has no end-of-image marker (FF D9) after its image data: the file is cut short",
+            bytes.len()
+        )))
+    }
+}
+
 /// The codes as stored in the file, before any EXIF orientation.
 fn read_stored_codes(path: &Path, bytes: &[u8]) -> Result<CodeImage, HdrError> {
     let image_err = |cause| HdrError::Image {
         path: path.to_path_buf(),
         cause,
     };
-    // The name's extension first (as `image::open` does), else the bytes.
-    let format = image::ImageFormat::from_path(path)
-        .or_else(|_| image::guess_format(bytes))
-        .map_err(image_err)?;
+    check_not_cut_short(path, bytes)?;
+    let format = file_format(path, bytes).map_err(image_err)?;
     let img = image::load_from_memory_with_format(bytes, format).map_err(image_err)?;
     let label = path.display().to_string();
     let (width, height) = (img.width() as usize, img.height() as usize);
@@ -291,6 +338,43 @@ mod tests {
             let back = read_code_image(&p).unwrap();
             assert_eq!(back.bits, bits);
             assert_eq!(back.data, img.data);
+        }
+    }
+
+    #[test]
+    fn a_cut_short_jpeg_is_refused_and_a_trailer_after_its_end_is_not() {
+        let (w, h) = (64usize, 48usize);
+        let img = CodeImage {
+            width: w,
+            height: h,
+            bits: 8,
+            data: (0..w * h * 3).map(|i| ((i * 7) % 251) as u16).collect(),
+            label: "noise".into(),
+        };
+        let full = jpeg_bytes(&img, 95, Some(0.01)).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("f.jpg");
+        let (mut bytes, mut out) = (Vec::new(), img.clone());
+        // Whole, and with data appended after the end (as phones do): read.
+        let mut trailer = full.clone();
+        trailer.extend_from_slice(b"motion photo trailer");
+        for ok in [&full, &trailer] {
+            std::fs::write(&path, ok).unwrap();
+            read_frame_into(&path, &mut bytes, &mut out).unwrap();
+            assert_eq!((out.width, out.height), (w, h));
+            read_frame(&path).unwrap();
+        }
+        // Cut at 90 %: the decoder would fill the rest; refused by both readers.
+        std::fs::write(&path, &full[..full.len() * 9 / 10]).unwrap();
+        for e in [
+            read_frame_into(&path, &mut bytes, &mut out).unwrap_err(),
+            read_frame(&path).unwrap_err(),
+        ] {
+            let e = e.to_string();
+            assert!(
+                e.contains("f.jpg") && e.contains("no end-of-image marker (FF D9)"),
+                "{e}"
+            );
         }
     }
 
