@@ -33,7 +33,7 @@ pub fn read_frame_bytes(path: &Path, bytes: &[u8]) -> Result<(CodeImage, Exposur
 /// decoder's output, `out` for the codes): a bracket read one frame at a
 /// time allocates its buffers once. 8- and 16-bit RGB (the cameras' JPEG,
 /// PNG and TIFF) decode straight into them; other layouts go through
-/// [`read_frame`].
+/// [`read_frame_bytes`] on the bytes already read.
 pub fn read_frame_into(path: &Path, bytes: &mut Vec<u8>, out: &mut CodeImage) -> Result<ExposureMetadata, HdrError> {
     let file = std::fs::read(path).map_err(|cause| HdrError::Io {
         path: path.to_path_buf(),
@@ -55,8 +55,7 @@ pub fn read_frame_into(path: &Path, bytes: &mut Vec<u8>, out: &mut CodeImage) ->
         ColorType::Rgb16 => 16,
         _ => {
             drop(decoder);
-            let (img, meta) = read_frame(path)?;
-            *out = img;
+            *out = read_frame_bytes(path, &file)?.0;
             return Ok(meta);
         }
     };
