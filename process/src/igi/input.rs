@@ -79,6 +79,13 @@ pub struct IgiOptions {
     pub allow_anisotropic: bool,
     /// Seed of every random choice.
     pub seed: u64,
+    /// Whether the images hold interreflected light (§4.3–4.5: indirect
+    /// irradiance and the indirect specular term ΔS are estimated and
+    /// subtracted). `false` for images of direct light only (a renderer's
+    /// single-bounce images, or a scene whose other surfaces are black):
+    /// the indirect terms are then zero, and
+    /// [`super::interreflection_check`] says whether the images agree.
+    pub interreflection: bool,
 }
 
 impl Default for IgiOptions {
@@ -94,6 +101,7 @@ impl Default for IgiOptions {
             max_view_angle_rad: 84f64.to_radians(),
             allow_anisotropic: true,
             seed: 1,
+            interreflection: true,
         }
     }
 }

@@ -30,8 +30,10 @@ mod error;
 mod geometry;
 pub mod highlight;
 pub mod input;
+pub mod interreflection_check;
 pub mod lamp_paths;
 pub mod light_triangulation;
+pub mod material_record;
 mod observation;
 mod radiosity;
 mod recover;
@@ -41,6 +43,8 @@ pub mod scene_file;
 mod specular_albedo;
 mod stratified;
 pub mod table;
+pub mod uncertainty;
+pub mod variant_choice;
 mod ward_fit;
 
 pub use camera::ViewCamera;
@@ -48,6 +52,7 @@ pub use error::IgiError;
 pub use input::{IgiInput, IgiLight, IgiOptions, View};
 pub use observation::DroppedPixels;
 pub use recover::{
-    IgiResult, IterationReport, SpecularKind, SurfaceModel, SurfaceResult, canonical_lobe, recover, specular_kind,
+    IgiProgress, IgiResult, IterationReport, SpecularKind, SurfaceModel, SurfaceResult, canonical_lobe, recover,
+    recover_with_progress, specular_kind,
 };
 pub use table::format_table;

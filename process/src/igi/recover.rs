@@ -17,9 +17,11 @@ use super::error::IgiError;
 use super::geometry::Geometry;
 use super::highlight::{DetectorSample, HighlightReport, detect};
 use super::input::{IgiInput, IgiOptions};
+use super::interreflection_check::{self, InterreflectionCheck};
 use super::observation::{DroppedPixels, Observation, observations};
 use super::radiosity::RadiosityField;
 use super::specular_albedo::SpecularAlbedo;
+use super::uncertainty::{MaterialSigma, bootstrap};
 use super::ward_fit::{FitSample, Shape, anisotropic, isotropic, linear_fit};
 use crate::brdf::{WardKernel, WardLobe, WardMaterial, WardVariant};
 use crate::model_choice::bic;
@@ -59,7 +61,8 @@ pub struct SurfaceResult {
     /// Why that model, in words (BIC values, highlights seen).
     pub reason: String,
     /// The recovered BRDF (`None` when unobserved). Anisotropic lobes are
-    /// given with γ in [0°, 90°) (the representation (αx, αy, γ) ≡ (αy, αx, γ + 90°) ≡ (αx, αy, γ + 180°)).
+    /// given in [`canonical_lobe`]'s form: αx ≥ αy, γ in (−90°, 90°]
+    /// (the representation (αx, αy, γ) ≡ (αy, αx, γ + 90°) ≡ (αx, αy, γ + 180°)).
     pub material: Option<WardMaterial>,
     /// Plastic or metal.
     pub kind: SpecularKind,
@@ -78,6 +81,9 @@ pub struct SurfaceResult {
     pub directional_albedo: [f64; 2],
     /// Whether the energy bound holds (ρd + ρs ≤ 1 and both albedos ≤ 1).
     pub energy_ok: bool,
+    /// One standard deviation of each parameter, by bootstrapping views
+    /// ([`super::uncertainty`]); `None` when it could not be measured.
+    pub sigma: Option<MaterialSigma>,
 }
 
 /// One ΔS iteration's convergence.
@@ -109,6 +115,8 @@ pub struct IgiResult {
     pub pixels: Vec<(String, DroppedPixels)>,
     /// The Ward normalization fitted.
     pub variant: WardVariant,
+    /// Whether the images agree with [`IgiOptions::interreflection`].
+    pub interreflection: InterreflectionCheck,
     /// Total wall time, seconds.
     pub seconds: f64,
 }
@@ -141,13 +149,20 @@ const ANISOTROPY_BIC_MARGIN: f64 = 10.0;
 /// Smallest αmax/αmin of an anisotropic fit that counts as anisotropic.
 const ANISOTROPY_MIN_RATIO: f64 = 1.05;
 
-/// The (αx, αy, γ) representation with γ in [0, π/2).
+/// The canonical representation of a lobe: αx ≥ αy and γ in (−π/2, π/2]
+/// (the same lobe as (αy, αx, γ + π/2) and (αx, αy, γ + π)). γ is the
+/// angle of the αx axis from the surface's tangent toward its bitangent
+/// (normal × tangent, the normal on the side the cameras see).
 pub fn canonical_lobe(mut lobe: WardLobe) -> WardLobe {
-    let half = std::f64::consts::FRAC_PI_2;
-    let mut g = lobe.gamma_rad.rem_euclid(std::f64::consts::PI);
-    if g >= half {
-        g -= half;
+    let (half, pi) = (std::f64::consts::FRAC_PI_2, std::f64::consts::PI);
+    let mut g = lobe.gamma_rad;
+    if lobe.alpha_x < lobe.alpha_y {
         std::mem::swap(&mut lobe.alpha_x, &mut lobe.alpha_y);
+        g += half;
+    }
+    g = g.rem_euclid(pi);
+    if g > half {
+        g -= pi;
     }
     lobe.gamma_rad = g;
     lobe
@@ -158,6 +173,28 @@ pub fn canonical_lobe(mut lobe: WardLobe) -> WardLobe {
 /// Errors: the input's and options' validation errors ([`IgiError`]).
 /// Surfaces that no pixel sees come back as [`SurfaceModel::Unobserved`].
 pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiError> {
+    recover_with_progress(input, options, &mut |_| {})
+}
+
+/// Where [`recover_with_progress`] is: ΔS pass `pass` (from 1) of
+/// `passes`, about to run `step`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct IgiProgress {
+    /// The pass, from 1.
+    pub pass: u32,
+    /// Passes in all.
+    pub passes: u32,
+    /// The step about to run: "indirect light", "ΔS", "fitting",
+    /// "interreflection check".
+    pub step: &'static str,
+}
+
+/// [`recover`], calling `progress` before each step of each pass.
+pub fn recover_with_progress(
+    input: &IgiInput,
+    options: &IgiOptions,
+    progress: &mut dyn FnMut(IgiProgress),
+) -> Result<IgiResult, IgiError> {
     let start = Instant::now();
     options.validate()?;
     input.validate()?;
@@ -198,8 +235,16 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
     let mut fits: Vec<SurfaceFit> = Vec::new();
     let mut iterations = Vec::new();
 
-    for it in 0..options.iterations.max(1) {
+    let passes = options.iterations.max(1);
+    for it in 0..passes {
         let t0 = Instant::now();
+        let mut report = |step| {
+            progress(IgiProgress {
+                pass: it + 1,
+                passes,
+                step,
+            })
+        };
         let seed = options.seed.wrapping_add(u64::from(it) * 0x9e37_79b9);
         // (1) Diffuse radiance per cell: measured minus the specular estimate.
         estimate_diffuse(&mut field, &geometry, &obs, &materials, &kind_ind);
@@ -207,25 +252,32 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
             .par_iter()
             .map(|m| m.and_then(|m| m.lobe).map(|l| SpecularAlbedo::new(&l)))
             .collect();
-        // (2) Indirect irradiance per cell.
+        // (2) Indirect irradiance per cell (none in direct-only images).
         let tt = Instant::now();
-        field.gather(&geometry, input, &materials, &albedos, options.gather_rays, seed);
+        if options.interreflection {
+            report("indirect light");
+            field.gather(&geometry, input, &materials, &albedos, options.gather_rays, seed);
+        }
         let gather_seconds = tt.elapsed().as_secs_f64();
         let tt = Instant::now();
         // (3) ΔS at every sample.
-        kind_ind = indirect_specular(
-            &geometry,
-            input,
-            &field,
-            &materials,
-            &albedos,
-            &obs,
-            &shapes,
-            options.lobe_rays,
-            seed ^ 0x5555,
-        );
+        if options.interreflection {
+            report("ΔS");
+            kind_ind = indirect_specular(
+                &geometry,
+                input,
+                &field,
+                &materials,
+                &albedos,
+                &obs,
+                &shapes,
+                options.lobe_rays,
+                seed ^ 0x5555,
+            );
+        }
         let delta_s_seconds = tt.elapsed().as_secs_f64();
         let tt = Instant::now();
+        report("fitting");
         if it == 0 {
             for s in 0..n_surf {
                 let samples: Vec<DetectorSample> = by_surface[s]
@@ -249,12 +301,7 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
         fits = (0..n_surf)
             .into_par_iter()
             .map(|s| {
-                let mean = by_surface[s]
-                    .iter()
-                    .map(|&i| obs[i].radiance.iter().sum::<f64>() / 3.0)
-                    .sum::<f64>()
-                    / by_surface[s].len().max(1) as f64;
-                let floor = (WEIGHT_FLOOR * mean).max(1e-30);
+                let floor = weight_floor(&by_surface[s], &obs);
                 let samples: Vec<FitSample> = by_surface[s]
                     .iter()
                     .map(|&i| fit_sample(&obs[i], &field, kind_ind[i], materials[s].as_ref(), floor))
@@ -284,6 +331,88 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
             materials: materials.clone(),
         });
     }
+
+    // Do the images agree with the interreflection assumed?
+    progress(IgiProgress {
+        pass: passes,
+        passes,
+        step: "interreflection check",
+    });
+    if !options.interreflection {
+        let albedos: Vec<Option<SpecularAlbedo>> = materials
+            .par_iter()
+            .map(|m| m.and_then(|m| m.lobe).map(|l| SpecularAlbedo::new(&l)))
+            .collect();
+        let seed = options.seed.wrapping_add(u64::from(passes) * 0x9e37_79b9);
+        field.gather(&geometry, input, &materials, &albedos, options.gather_rays, seed);
+    }
+    let mut check_samples: Vec<interreflection_check::SurfaceSamples> = vec![Vec::new(); n_surf];
+    for (i, o) in obs.iter().enumerate() {
+        let specular = specular_radiance(o, materials[o.surface].as_ref(), kind_ind[i]);
+        if let Some(x) = interreflection_check::sample(o, field.e_indirect[o.cell], specular) {
+            check_samples[o.surface].push(x);
+        }
+    }
+    let interreflection = interreflection_check::check(&check_samples, options.interreflection);
+
+    // Each parameter's uncertainty: the final fit over bootstrapped views.
+    progress(IgiProgress {
+        pass: passes,
+        passes,
+        step: "uncertainties",
+    });
+    let sigmas: Vec<Option<MaterialSigma>> = (0..n_surf)
+        .into_par_iter()
+        .map(|s| {
+            let f = fits.get(s)?;
+            let reference = f.material?;
+            let floor = weight_floor(&by_surface[s], &obs);
+            let model = f.model;
+            let shape = reference.lobe.map(|l| Shape {
+                alpha_x: l.alpha_x,
+                alpha_y: l.alpha_y,
+                gamma_rad: l.gamma_rad,
+            });
+            let refit = |draw: &[usize]| -> Option<WardMaterial> {
+                let dense: Vec<FitSample> = draw
+                    .iter()
+                    .map(|&i| fit_sample(&obs[i], &field, kind_ind[i], Some(&reference), floor))
+                    .collect();
+                let lobe = match (model, shape) {
+                    (SurfaceModel::Isotropic, Some(_)) => {
+                        let sparse = sparse_set(draw, &obs, &dense, options.sparse_samples);
+                        let (a, _, _) = isotropic(&sparse, options.variant, 25);
+                        Some(
+                            Shape {
+                                alpha_x: a,
+                                alpha_y: a,
+                                gamma_rad: 0.0,
+                            }
+                            .lobe(options.variant),
+                        )
+                    }
+                    (SurfaceModel::Anisotropic, Some(shape)) => {
+                        let sparse = sparse_set(draw, &obs, &dense, options.sparse_samples);
+                        let (sh, _, _) = anisotropic(&sparse, options.variant, &[shape], 0.1);
+                        Some(sh.lobe(options.variant))
+                    }
+                    _ => None,
+                };
+                let fit = linear_fit(&dense, lobe.as_ref());
+                Some(WardMaterial {
+                    rho_d: fit.rho_d,
+                    lobe: lobe.map(|l| WardLobe { rho_s: fit.rho_s, ..l }),
+                })
+            };
+            bootstrap(
+                &by_surface[s],
+                &|i| obs[i].view,
+                &refit,
+                &reference,
+                options.seed ^ (s as u64).wrapping_mul(0x2545_f491),
+            )
+        })
+        .collect();
 
     let surfaces = (0..n_surf)
         .map(|s| {
@@ -315,6 +444,7 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
                 rms_relative: f.rms,
                 directional_albedo,
                 energy_ok,
+                sigma: sigmas[s],
             }
         })
         .collect();
@@ -323,6 +453,7 @@ pub fn recover(input: &IgiInput, options: &IgiOptions) -> Result<IgiResult, IgiE
         iterations,
         pixels: input.views.iter().map(|v| v.name.clone()).zip(dropped).collect(),
         variant: options.variant,
+        interreflection,
         seconds: start.elapsed().as_secs_f64(),
     })
 }
@@ -353,6 +484,17 @@ impl Default for SurfaceFit {
             anisotropic: None,
         }
     }
+}
+
+/// The floor of a surface's weights' predicted radiance ([`WEIGHT_FLOOR`]
+/// of its mean measured radiance).
+fn weight_floor(indices: &[usize], obs: &[Observation]) -> f64 {
+    let mean = indices
+        .iter()
+        .map(|&i| obs[i].radiance.iter().sum::<f64>() / 3.0)
+        .sum::<f64>()
+        / indices.len().max(1) as f64;
+    (WEIGHT_FLOOR * mean).max(1e-30)
 }
 
 /// Direct plus indirect irradiance at an observation.
@@ -722,13 +864,22 @@ mod tests {
 
     #[test]
     fn the_canonical_representation_is_the_same_lobe_with_gamma_below_90_degrees() {
-        let lobe = WardLobe::new([0.1; 3], 0.3, 0.05, 100f64.to_radians(), WardVariant::Ward1992).unwrap();
+        let lobe = WardLobe::new([0.1; 3], 0.05, 0.3, 100f64.to_radians(), WardVariant::Ward1992).unwrap();
         let c = canonical_lobe(lobe);
+        // αx ≥ αy: swapped, γ + 90° = 190° ≡ 10°.
         assert!(
-            (c.alpha_x - 0.05).abs() < 1e-15 && (c.alpha_y - 0.3).abs() < 1e-15,
+            (c.alpha_x - 0.3).abs() < 1e-15 && (c.alpha_y - 0.05).abs() < 1e-15,
             "{c:?}"
         );
         assert!((c.gamma_rad.to_degrees() - 10.0).abs() < 1e-9, "{c:?}");
+        // Already αx ≥ αy: γ = 120° ≡ −60°, 90° stays 90°.
+        let d = canonical_lobe(WardLobe::new([0.1; 3], 0.3, 0.05, 120f64.to_radians(), WardVariant::Ward1992).unwrap());
+        assert!(
+            (d.gamma_rad.to_degrees() + 60.0).abs() < 1e-9 && d.alpha_x == 0.3,
+            "{d:?}"
+        );
+        let e = canonical_lobe(WardLobe::new([0.1; 3], 0.3, 0.05, 90f64.to_radians(), WardVariant::Ward1992).unwrap());
+        assert!((e.gamma_rad.to_degrees() - 90.0).abs() < 1e-9, "{e:?}");
         let pairs: [(Vector3<f64>, Vector3<f64>); 3] = [
             (Vector3::new(0.3, 0.2, 0.0), Vector3::new(-0.25, -0.1, 0.0)),
             (Vector3::new(-0.5, 0.1, 0.0), Vector3::new(0.4, 0.05, 0.0)),

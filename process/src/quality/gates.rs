@@ -10,6 +10,7 @@ use crate::hdr::curve::ResponseCurve;
 use crate::hdr::debevec::Calibration;
 use crate::hdr::merge::{MASK_SATURATED, MASK_UNDEREXPOSED, RadianceMap};
 use crate::igi::SurfaceResult;
+use crate::igi::interreflection_check::InterreflectionCheck;
 use crate::sky::ChannelSky;
 use crate::sky_series::ScanProducts;
 
@@ -270,6 +271,32 @@ pub fn brdf(surface: &SurfaceResult, q: &Quality) -> ProductQuality {
         ],
     )
     .with_note(format!("{:?}: {}", surface.model, surface.reason))
+}
+
+/// The images against the interreflection the solver assumed
+/// ([`crate::igi::interreflection_check`]): how much worse the assumption
+/// fits the diffuse pixels than the other (the pooled weighted residual's
+/// ratio less one; ≤ 0 when the assumption fits at least as well). Images
+/// that cannot tell (too little indirect light, or a tie) give 0 and a note.
+pub fn interreflection(check: &InterreflectionCheck, q: &Quality) -> ProductQuality {
+    let excess = match check.consistent {
+        None => 0.0,
+        Some(_) => check.excess_residual.max(0.0),
+    };
+    ProductQuality::new(
+        "igi interreflection",
+        vec![Check::new(
+            if check.assumed {
+                "residual excess of interreflection (as modelled) over direct light only"
+            } else {
+                "residual excess of direct light only (--direct-only) over interreflection"
+            },
+            excess,
+            q.igi.interreflection,
+            Better::Lower,
+        )],
+    )
+    .with_note(check.message.clone())
 }
 
 #[cfg(test)]

@@ -175,7 +175,6 @@ fn run_room(args: &ProcessArgs, out: &Path, debevec: &DebevecOptions) -> Result<
         quick: args.quick,
     };
     let products = room::room_stage(&processed, out, &opts)?;
-    super::igi::write_products(&products.recovered, &out.join("room").join("igi"))?;
     let mut sections = stage_sections(&processed, None)?;
     let mut speed = sections.pop().unwrap_or_default();
     sections.truncate(1); // the response; indoors there is no sun, sky or environment
@@ -185,6 +184,7 @@ fn run_room(args: &ProcessArgs, out: &Path, debevec: &DebevecOptions) -> Result<
     }
     sections.push(speed);
     let quality = QualityReport::new(room::room_quality(&processed, &products), &processed.thresholds);
+    super::igi::write_products(&products.recovered, &out.join("room").join("igi"), &quality)?;
     let report = Report {
         title: format!("Campanile: {}", args.session.display()),
         intro: vec![format!(

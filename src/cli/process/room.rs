@@ -366,6 +366,8 @@ pub fn room_stage(p: &Processed, out: &Path, opts: &RoomOptions) -> Result<RoomP
         cameras,
         lights,
         images: entries,
+        ward_variant: None,
+        interreflection: None,
     };
     let scene_file = dir.join("scene.ron");
     let text = ron::ser::to_string_pretty(&file, ron::ser::PrettyConfig::default())?;
