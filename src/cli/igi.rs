@@ -368,15 +368,12 @@ pub fn write_products(r: &Recovered, out: &Path, quality: &QualityReport) -> Res
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let table = format_table(&r.result, &[], None);
     out!("{table}")?;
-    outln!(
-        "Ward normalization: {}{}",
-        r.result.variant,
-        if r.variants.len() > 1 {
-            format!(" ({})", describe(&r.variants.iter().collect::<Vec<_>>()))
-        } else {
-            String::new()
-        }
-    )?;
+    if r.variants.len() > 1 {
+        outln!(
+            "Ward normalization chosen: {}",
+            describe(&r.variants.iter().collect::<Vec<_>>())
+        )?;
+    }
     outln!("{}", r.result.interreflection.message)?;
     for (n, t) in &r.loaded.triangulated {
         outln!(

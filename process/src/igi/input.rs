@@ -72,6 +72,8 @@ pub struct IgiOptions {
     /// §4.7.1 cube the first pass (no ΔS correction) leaves 15 % in ρs,
     /// the second 1.2 %, and from the third on the parameters move only by
     /// the solver's own Monte Carlo noise (BENCHMARKS.md, the IGI sweep).
+    /// Without [`Self::interreflection`] at most two passes run (nothing
+    /// is gathered; the second only re-weights the fit).
     pub iterations: u32,
     /// Views more grazing than this (angle from the normal) are dropped, radians.
     pub max_view_angle_rad: f64,

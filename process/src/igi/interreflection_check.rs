@@ -244,7 +244,7 @@ mod tests {
                 (d, i + noise, 0.5 * (d + i))
             })
             .collect();
-        let c = check(&[s.clone()], true);
+        let c = check(std::slice::from_ref(&s), true);
         assert!(c.indirect_scale < 0.7, "attenuated: {c:?}");
         assert_eq!(c.consistent, Some(true), "{}", c.message);
         assert!(c.excess_residual < 0.0, "{c:?}");

@@ -235,7 +235,13 @@ pub fn recover_with_progress(
     let mut fits: Vec<SurfaceFit> = Vec::new();
     let mut iterations = Vec::new();
 
-    let passes = options.iterations.max(1);
+    // Without interreflection nothing is gathered, and a pass only
+    // re-weights the fit by the previous estimate: two passes do it.
+    let passes = if options.interreflection {
+        options.iterations.max(1)
+    } else {
+        options.iterations.clamp(1, 2)
+    };
     for it in 0..passes {
         let t0 = Instant::now();
         let mut report = |step| {
