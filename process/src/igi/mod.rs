@@ -33,6 +33,7 @@ pub mod input;
 pub mod lamp_paths;
 pub mod light_triangulation;
 mod observation;
+pub mod radiance_view;
 mod radiosity;
 mod recover;
 pub mod relight;
