@@ -150,21 +150,50 @@ pub fn read_radiance_exr(path: &Path) -> std::result::Result<RadianceMap, HdrErr
 }
 
 /// Reads the `R`, `G`, `B` channels of the first layer of any OpenEXR file
-/// (e.g. a flat-field radiance map for `hdr lens`).
+/// (e.g. a flat-field radiance map for `hdr lens`), or, where there is no
+/// `R`, the one `PREFIX.R`, `PREFIX.G`, `PREFIX.B` set (a renderer's layer,
+/// e.g. Blender's `ViewLayer.Combined.R`).
 pub fn read_rgb_exr(path: &Path) -> std::result::Result<RadianceImage, HdrError> {
     let layer = first_layer(path, "an RGB layer")?;
     let (w, h) = (layer.size.width(), layer.size.height());
+    let names: Vec<String> = layer.channel_data.list.iter().map(|ch| ch.name.to_string()).collect();
+    let prefix = if names.iter().any(|n| n == "R") {
+        String::new()
+    } else {
+        let sets: Vec<&str> = names
+            .iter()
+            .filter_map(|n| n.strip_suffix(".R"))
+            .filter(|p| names.contains(&format!("{p}.G")) && names.contains(&format!("{p}.B")))
+            .collect();
+        match sets.as_slice() {
+            [p] => format!("{p}."),
+            _ => String::new(),
+        }
+    };
     let mut data = vec![0.0f32; w * h * 3];
     for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        let name = format!("{prefix}{name}");
         let ch = layer
             .channel_data
             .list
             .iter()
-            .find(|ch| ch.name.to_string() == *name)
+            .find(|ch| ch.name.to_string() == name)
             .ok_or_else(|| HdrError::BadImage {
                 image: path.display().to_string(),
-                what: format!("no channel '{name}': expected R, G and B"),
+                what: format!(
+                    "no channel '{name}': expected R, G and B, or one LAYER.R, LAYER.G, LAYER.B set (it has: {})",
+                    names.join(", ")
+                ),
             })?;
+        if ch.sample_data.len() != w * h {
+            return Err(HdrError::BadImage {
+                image: path.display().to_string(),
+                what: format!(
+                    "channel '{name}' has {} samples: expected one per pixel ({w}x{h}, not subsampled)",
+                    ch.sample_data.len()
+                ),
+            });
+        }
         for (p, v) in ch.sample_data.values_as_f32().enumerate() {
             data[p * 3 + c] = v;
         }
@@ -245,5 +274,28 @@ mod tests {
         assert_eq!(back, map, "lossless round trip");
         let rgb = read_rgb_exr(&path).unwrap();
         assert_eq!(rgb.data, map.rgb);
+    }
+
+    #[test]
+    fn rgb_of_a_renderer_layer_is_read_by_its_prefix() {
+        let (w, h) = (3, 2);
+        let plane = |c: usize| FlatSamples::F32((0..w * h).map(|p| (p * 3 + c) as f32).collect());
+        let channels: Vec<AnyChannel<FlatSamples>> = ["R", "G", "B"]
+            .iter()
+            .enumerate()
+            .map(|(c, n)| AnyChannel::new(format!("ViewLayer.Combined.{n}").as_str(), plane(c)))
+            .chain(std::iter::once(AnyChannel::new("ViewLayer.Depth.Z", plane(0))))
+            .collect();
+        let layer = Layer::new(
+            (w, h),
+            LayerAttributes::default(),
+            Encoding::FAST_LOSSLESS,
+            AnyChannels::sort(SmallVec::from_vec(channels)),
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("blender.exr");
+        Image::from_layer(layer).write().to_file(&path).unwrap();
+        let img = read_rgb_exr(&path).unwrap();
+        assert_eq!(img.data, (0..w * h * 3).map(|i| i as f32).collect::<Vec<_>>());
     }
 }

@@ -7,6 +7,7 @@
 //!   assembly, lens falloff, and the checks on the input images.
 //! - [`exr_io`]: OpenEXR output and input of radiance maps.
 //! - [`rgbe_file`]: Radiance RGBE (`.hdr`) output of radiance maps.
+//! - [`radiance_file`]: reading an HDR radiance image (OpenEXR, RGBE, PFM).
 
 pub mod brdf;
 pub mod camera;
@@ -23,6 +24,7 @@ pub mod outdoor;
 pub mod pipeline;
 pub mod pose;
 pub mod quality;
+pub mod radiance_file;
 pub mod render;
 pub mod report;
 pub mod rgbe_file;

@@ -23,9 +23,10 @@ use clap::Args;
 /// Recover every surface's Ward BRDF and albedo map from a scene file.
 ///
 /// SCENE.ron lists OBJ geometry (groups gathered into surfaces that share
-/// specular parameters), calibrated cameras, lights (known, or HDR images
-/// of their bulbs to triangulate) and EXR radiance images with optional
-/// masks; the README documents the format. Writes to --out:
+/// specular parameters), calibrated cameras (or RADIANCE views), lights
+/// (known, RADIANCE light spheres, or HDR images of their bulbs to
+/// triangulate) and radiance images (OpenEXR, RADIANCE RGBE .hdr/.pic or
+/// PFM) with optional masks; the README documents the format. Writes to --out:
 /// materials.txt (Table 4.1's layout, with each surface's model and why),
 /// materials.rad (RADIANCE plastic/plastic2/metal/metal2) and materials.xml
 /// (Mitsuba 3; see the README for the conversions),

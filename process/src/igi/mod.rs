@@ -35,6 +35,7 @@ pub mod lamp_paths;
 pub mod light_triangulation;
 pub mod material_record;
 mod observation;
+pub mod radiance_view;
 mod radiosity;
 mod recover;
 pub mod relight;

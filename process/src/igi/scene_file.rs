@@ -1,22 +1,38 @@
 //! The scene file of `campanile igi SCENE.ron` (README: "Indoor scene
 //! file"): OBJ geometry whose groups are gathered into surfaces that share
-//! specular parameters; calibrated cameras; lights given directly or as HDR
-//! images of their bulbs to triangulate; EXR radiance images with optional
-//! masks. Paths are relative to the scene file.
+//! specular parameters; calibrated cameras (position, look, up and a
+//! vertical or horizontal field of view, or a RADIANCE view string); lights
+//! given directly (W/sr, or a RADIANCE `light` sphere's radiance and radius)
+//! or as HDR images of their bulbs to triangulate; HDR radiance images
+//! (OpenEXR, RADIANCE RGBE, PFM) with optional PNG masks. Paths are
+//! relative to the scene file.
+//!
+//! OBJ normals may face either way: the solver shades each triangle on the
+//! side its cameras see (the side most of its observations come from), so
+//! the winding order of the faces does not matter.
 //!
 //! ```ron
 //! IgiScene(
 //!     geometry: "room.obj",
 //!     surfaces: [(name: "wood", groups: ["floor", "table-top"])],
-//!     cameras: [(name: "wide", position_m: (0.5, 0.5, 1.6), look: (1.0, 1.0, -0.3),
-//!                up: (0.0, 0.0, 1.0), vfov_deg: 46.8, width: 256, height: 192)],
+//!     cameras: [
+//!         (name: "wide", position_m: (0.5, 0.5, 1.6), look: (1.0, 1.0, -0.3),
+//!          up: (0.0, 0.0, 1.0), vfov_deg: 46.8, width: 256, height: 192),
+//!         (name: "pano", position_m: (2.0, 0.5, 1.2), look: (0.0, 1.0, 0.0),
+//!          up: (0.0, 0.0, 1.0), hfov_deg: 90.0, width: 320, height: 120),
+//!         (name: "rad", radiance_view: "-vtv -vp 1 0.2 1.5 -vd 0 1 -0.2 -vu 0 0 1 -vh 60 -vv 46.83",
+//!          width: 96, height: 72),
+//!     ],
 //!     lights: [
 //!         Known(name: "lamp-1", position_m: (1.0, 1.0, 2.6), radius_m: 0.05,
 //!               intensity_w_sr: (3.0, 2.8, 2.4)),
+//!         RadianceLight(name: "lamp-3", position_m: (2.0, 1.0, 2.6), radius_m: 0.05,
+//!                       radiance: (380.0, 360.0, 300.0)),
 //!         Bulb(name: "lamp-2", images: [(camera: "bulb-a", image: "lamp-2-a.exr"),
-//!                                       (camera: "bulb-b", image: "lamp-2-b.exr")]),
+//!                                       (camera: "bulb-b", image: "lamp-2-b.hdr")]),
 //!     ],
-//!     images: [(camera: "wide", image: "wide.exr", mask: Some("wide-mask.png"))],
+//!     images: [(camera: "wide", image: "wide.exr", mask: Some("wide-mask.png")),
+//!              (camera: "rad", image: "rad.hdr")],
 //! )
 //! ```
 
@@ -28,9 +44,10 @@ use serde::{Deserialize, Serialize};
 use super::camera::ViewCamera;
 use super::input::{IgiInput, IgiLight, View};
 use super::light_triangulation::{BulbImage, TriangulatedLight, triangulate};
+use super::radiance_view::RadianceView;
 use crate::brdf::WardVariant;
 use crate::camera::image::RadianceImage;
-use crate::exr_io::read_rgb_exr;
+use crate::radiance_file::read_radiance_image;
 use crate::render::Triangle;
 
 /// A surface: OBJ groups sharing one BRDF's specular parameters.
@@ -42,19 +59,41 @@ pub struct SurfaceGroup {
     pub groups: Vec<String>,
 }
 
-/// A calibrated pinhole camera (rectified images).
+/// A calibrated pinhole camera (rectified images, square pixels), given by
+/// position, look, up hint and one field of view, or by a RADIANCE view
+/// string.
+///
+/// Conventions ([`ViewCamera`]): right = look × up, `up` only a hint (made
+/// orthogonal to `look`); pixel (0, 0) at the top left, rows downward,
+/// pixel centres at `(x + 0.5, y + 0.5)`; `vfov_deg` spans the height,
+/// `hfov_deg` the width, with `tan(v/2) = tan(h/2) · height / width`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CameraEntry {
     /// Name, referred to by images.
     pub name: String,
-    /// Centre of projection, metres.
-    pub position_m: (f64, f64, f64),
-    /// Viewing direction.
-    pub look: (f64, f64, f64),
-    /// Up direction.
-    pub up: (f64, f64, f64),
-    /// Vertical field of view, degrees.
-    pub vfov_deg: f64,
+    /// Centre of projection, metres (absent with `radiance_view`).
+    #[serde(default)]
+    pub position_m: Option<(f64, f64, f64)>,
+    /// Viewing direction, any length (absent with `radiance_view`).
+    #[serde(default)]
+    pub look: Option<(f64, f64, f64)>,
+    /// Up hint (absent with `radiance_view`).
+    #[serde(default)]
+    pub up: Option<(f64, f64, f64)>,
+    /// Vertical field of view, degrees (or `hfov_deg`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vfov_deg: Option<f64>,
+    /// Horizontal field of view, degrees (or `vfov_deg`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hfov_deg: Option<f64>,
+    /// A RADIANCE view, `"-vtv -vp x y z -vd dx dy dz -vu ux uy uz -vh H
+    /// -vv V"` as rpict or a picture's `VIEW=` line give it (a leading
+    /// `rvu`, `rpict` or `VIEW=` is skipped; RADIANCE's defaults), or
+    /// `"from-image"`: the `VIEW=` line of the first RGBE image of this
+    /// camera. Replaces position, look, up and the fields of view
+    /// ([`super::radiance_view`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radiance_view: Option<String>,
     /// Width, pixels.
     pub width: usize,
     /// Height, pixels.
@@ -66,7 +105,7 @@ pub struct CameraEntry {
 pub struct BulbImageEntry {
     /// The camera that took it.
     pub camera: String,
-    /// The EXR radiance image.
+    /// The HDR radiance image (OpenEXR, RGBE or PFM).
     pub image: PathBuf,
 }
 
@@ -84,6 +123,18 @@ pub enum LightEntry {
         /// Radiant intensity per channel, W/sr.
         intensity_w_sr: (f64, f64, f64),
     },
+    /// A RADIANCE `light` material on a `sphere`: its radiant intensity is
+    /// `I = L · π r²` per channel.
+    RadianceLight {
+        /// Name.
+        name: String,
+        /// Centre, metres.
+        position_m: (f64, f64, f64),
+        /// Sphere radius, metres (> 0).
+        radius_m: f64,
+        /// The `light` material's radiance `r g b`, W·m⁻²·sr⁻¹.
+        radiance: (f64, f64, f64),
+    },
     /// A light triangulated from HDR images of its bulb (≥ 2 views).
     Bulb {
         /// Name.
@@ -98,7 +149,9 @@ pub enum LightEntry {
 pub struct ImageEntry {
     /// The camera that took it.
     pub camera: String,
-    /// The EXR radiance image (R, G, B in W·m⁻²·sr⁻¹).
+    /// The HDR radiance image (R, G, B in W·m⁻²·sr⁻¹): OpenEXR, RADIANCE
+    /// RGBE (`.hdr`, `.pic`, divided by its `EXPOSURE=`) or PFM, told apart
+    /// by their first bytes ([`crate::radiance_file`]).
     pub image: PathBuf,
     /// An 8-bit PNG mask: non-zero pixels are used.
     #[serde(default)]
@@ -204,9 +257,201 @@ fn v3(t: (f64, f64, f64)) -> Vector3<f64> {
     Vector3::new(t.0, t.1, t.2)
 }
 
+/// A light given by its numbers (`Known` or `RadianceLight`); the error is
+/// (field, value, expected).
+fn given_light(entry: &LightEntry) -> Result<IgiLight, (&'static str, String, &'static str)> {
+    let (position_m, radius_m, intensity) = match entry {
+        LightEntry::Known {
+            position_m,
+            radius_m,
+            intensity_w_sr,
+            ..
+        } => {
+            let i = [intensity_w_sr.0, intensity_w_sr.1, intensity_w_sr.2];
+            if !i.iter().all(|v| v.is_finite() && *v >= 0.0) {
+                return Err((
+                    "intensity_w_sr",
+                    format!("{intensity_w_sr:?}"),
+                    "finite intensities >= 0 W/sr",
+                ));
+            }
+            (position_m, radius_m, i)
+        }
+        LightEntry::RadianceLight {
+            position_m,
+            radius_m,
+            radiance,
+            ..
+        } => {
+            let l = [radiance.0, radiance.1, radiance.2];
+            if !l.iter().all(|v| v.is_finite() && *v >= 0.0) {
+                return Err(("radiance", format!("{radiance:?}"), "finite radiances >= 0 W/m²/sr"));
+            }
+            if !(radius_m.is_finite() && *radius_m > 0.0) {
+                return Err((
+                    "radius_m",
+                    radius_m.to_string(),
+                    "a finite sphere radius > 0 m (a RADIANCE light's intensity is L · π r²)",
+                ));
+            }
+            let area = std::f64::consts::PI * radius_m * radius_m;
+            (position_m, radius_m, l.map(|v| v * area))
+        }
+        LightEntry::Bulb { .. } => return Err(("", "Bulb(...)".into(), "a light given by its numbers")),
+    };
+    if ![position_m.0, position_m.1, position_m.2].iter().all(|c| c.is_finite()) {
+        return Err(("position_m", format!("{position_m:?}"), "finite coordinates"));
+    }
+    if !(radius_m.is_finite() && *radius_m >= 0.0) {
+        return Err(("radius_m", radius_m.to_string(), "a finite radius >= 0 m"));
+    }
+    Ok(IgiLight {
+        position: v3(*position_m),
+        radius: *radius_m,
+        intensity,
+    })
+}
+
+/// What was wrong with a camera entry.
+enum CameraFault {
+    /// A field (relative to the camera) with a bad value.
+    Field {
+        name: &'static str,
+        value: String,
+        expected: String,
+    },
+    /// An image could not be read.
+    File(SceneFileError),
+}
+
+fn camera_fault(name: &'static str, value: String, expected: impl Into<String>) -> CameraFault {
+    CameraFault::Field {
+        name,
+        value,
+        expected: expected.into(),
+    }
+}
+
+/// The camera of an entry; `None` for `radiance_view: "from-image"`, which
+/// needs an image ([`camera_from_image`]).
+fn camera_of_entry(c: &CameraEntry) -> Result<Option<ViewCamera>, CameraFault> {
+    if let Some(text) = &c.radiance_view {
+        for (name, present) in [
+            ("position_m", c.position_m.is_some()),
+            ("look", c.look.is_some()),
+            ("up", c.up.is_some()),
+            ("vfov_deg", c.vfov_deg.is_some()),
+            ("hfov_deg", c.hfov_deg.is_some()),
+        ] {
+            if present {
+                return Err(camera_fault(
+                    name,
+                    "given".into(),
+                    "absent when radiance_view is given (the view string sets it)",
+                ));
+            }
+        }
+        if text.trim() == "from-image" {
+            return Ok(None);
+        }
+        return radiance_camera(text, c.width, c.height).map(Some);
+    }
+    let need = |name: &'static str, v: Option<(f64, f64, f64)>, what: &str| {
+        v.map(v3)
+            .ok_or_else(|| camera_fault(name, "absent".into(), format!("{what}, or a radiance_view")))
+    };
+    let position = need("position_m", c.position_m, "a centre of projection (x, y, z) in metres")?;
+    let look = need("look", c.look, "a viewing direction (x, y, z)")?;
+    let up = need("up", c.up, "an up hint (x, y, z)")?;
+    let angle = |name: &'static str, deg: f64| {
+        if deg > 0.0 && deg < 180.0 {
+            Ok(deg.to_radians())
+        } else {
+            Err(camera_fault(name, deg.to_string(), "an angle in (0, 180) degrees"))
+        }
+    };
+    let vfov_rad = match (c.vfov_deg, c.hfov_deg) {
+        (Some(v), None) => angle("vfov_deg", v)?,
+        (None, Some(h)) => {
+            let h = angle("hfov_deg", h)?;
+            if c.width == 0 || c.height == 0 {
+                return Err(camera_fault(
+                    "width",
+                    format!("{}x{}", c.width, c.height),
+                    "at least 1x1 pixels",
+                ));
+            }
+            // Square pixels: tan(v/2) = tan(h/2) · height / width.
+            2.0 * ((0.5 * h).tan() * c.height as f64 / c.width as f64).atan()
+        }
+        (Some(v), Some(h)) => {
+            return Err(camera_fault(
+                "hfov_deg",
+                format!("{h} with vfov_deg {v}"),
+                "exactly one of vfov_deg and hfov_deg (the other follows from width and height)",
+            ));
+        }
+        (None, None) => {
+            return Err(camera_fault(
+                "vfov_deg",
+                "absent".into(),
+                "vfov_deg or hfov_deg (degrees), or a radiance_view",
+            ));
+        }
+    };
+    Ok(Some(ViewCamera {
+        position,
+        look,
+        up,
+        vfov_rad,
+        width: c.width,
+        height: c.height,
+    }))
+}
+
+/// The camera of a RADIANCE view string for a `width` × `height` picture.
+fn radiance_camera(text: &str, width: usize, height: usize) -> Result<ViewCamera, CameraFault> {
+    RadianceView::parse(text)
+        .and_then(|v| v.camera(width, height))
+        .map_err(|e| camera_fault("radiance_view", format!("{text:?}"), e))
+}
+
+/// The camera of `radiance_view: "from-image"`: the `VIEW=` line of the
+/// RGBE picture `file`.
+fn camera_from_image(c: &CameraEntry, file: &Path) -> Result<ViewCamera, CameraFault> {
+    let f = read_radiance_image(file).map_err(|e| {
+        CameraFault::File(SceneFileError::File {
+            path: e.path,
+            message: e.message,
+        })
+    })?;
+    let Some(view) = f.view else {
+        return Err(camera_fault(
+            "radiance_view",
+            "\"from-image\"".into(),
+            format!(
+                "a VIEW= line in the header of {} (none: give the view string)",
+                file.display()
+            ),
+        ));
+    };
+    if (f.pixel_aspect - 1.0).abs() > 1e-3 {
+        return Err(camera_fault(
+            "radiance_view",
+            "\"from-image\"".into(),
+            format!(
+                "square pixels ({} has PIXASPECT={}; render with rpict -pa 1)",
+                file.display(),
+                f.pixel_aspect
+            ),
+        ));
+    }
+    radiance_camera(&view, c.width, c.height)
+}
+
 /// Parses the text of a scene file (`path` names it in errors).
 pub fn parse(path: &Path, text: &str) -> Result<IgiScene, SceneFileError> {
-    ron::Options::default()
+    campanile_config::source::ron_options()
         .from_str::<IgiScene>(text)
         .map_err(|e| SceneFileError::File {
             path: path.to_path_buf(),
@@ -311,19 +556,44 @@ pub fn load(path: &Path) -> Result<LoadedIgiScene, SceneFileError> {
                 "a name no other camera has",
             ));
         }
-        let cam = ViewCamera {
-            position: v3(c.position_m),
-            look: v3(c.look),
-            up: v3(c.up),
-            vfov_rad: c.vfov_deg.to_radians(),
-            width: c.width,
-            height: c.height,
+        let cam = camera_of_entry(c).map_err(|e| match e {
+            CameraFault::Field { name, value, expected } => field(format!("cameras[{i}].{name}"), value, &expected),
+            CameraFault::File(e) => e,
+        })?;
+        let cam = match cam {
+            Some(cam) => cam,
+            None => {
+                // "from-image": the view of the first image of this camera.
+                let file = scene
+                    .images
+                    .iter()
+                    .map(|e| (&e.camera, &e.image))
+                    .chain(scene.lights.iter().flat_map(|l| match l {
+                        LightEntry::Bulb { images, .. } => images.iter().map(|b| (&b.camera, &b.image)).collect(),
+                        _ => Vec::new(),
+                    }))
+                    .find(|(n, _)| **n == c.name)
+                    .map(|(_, f)| f.clone())
+                    .ok_or_else(|| {
+                        field(
+                            format!("cameras[{i}].radiance_view"),
+                            "\"from-image\"".into(),
+                            "an image of this camera to take the view from (no image names it)",
+                        )
+                    })?;
+                camera_from_image(c, &base.join(&file)).map_err(|e| match e {
+                    CameraFault::Field { name, value, expected } => {
+                        field(format!("cameras[{i}].{name}"), value, &expected)
+                    }
+                    CameraFault::File(e) => e,
+                })?
+            }
         };
         cam.validate(&c.name).map_err(|e| {
             field(
                 format!("cameras[{i}]"),
                 format!("{:?}", c.name),
-                &format!("a valid camera ({e}; vfov_deg in (0, 180), width and height >= 1)"),
+                &format!("a valid camera ({e}; fields of view in (0, 180), width and height >= 1)"),
             )
         })?;
         cameras.push((c.name.clone(), cam));
@@ -342,10 +612,12 @@ pub fn load(path: &Path) -> Result<LoadedIgiScene, SceneFileError> {
     };
     let read_image = |what: String, file: &Path, cam: &ViewCamera| -> Result<RadianceImage, SceneFileError> {
         let full = base.join(file);
-        let img = read_rgb_exr(&full).map_err(|e| SceneFileError::File {
-            path: full.clone(),
-            message: format!("{e} (expected an OpenEXR radiance image with R, G, B)"),
-        })?;
+        let img = read_radiance_image(&full)
+            .map_err(|e| SceneFileError::File {
+                path: full.clone(),
+                message: e.message,
+            })?
+            .image;
         if img.width != cam.width || img.height != cam.height {
             return Err(field(
                 what,
@@ -362,38 +634,9 @@ pub fn load(path: &Path) -> Result<LoadedIgiScene, SceneFileError> {
     let mut triangulated = Vec::new();
     for (i, l) in scene.lights.iter().enumerate() {
         match l {
-            LightEntry::Known {
-                name,
-                position_m,
-                radius_m,
-                intensity_w_sr,
-            } => {
-                let light = IgiLight {
-                    position: v3(*position_m),
-                    radius: *radius_m,
-                    intensity: [intensity_w_sr.0, intensity_w_sr.1, intensity_w_sr.2],
-                };
-                if !light.position.iter().all(|c| c.is_finite()) {
-                    return Err(field(
-                        format!("lights[{i}].position_m"),
-                        format!("{position_m:?}"),
-                        "finite coordinates",
-                    ));
-                }
-                if !(radius_m.is_finite() && *radius_m >= 0.0) {
-                    return Err(field(
-                        format!("lights[{i}].radius_m"),
-                        radius_m.to_string(),
-                        "a finite radius >= 0 m",
-                    ));
-                }
-                if !light.intensity.iter().all(|v| v.is_finite() && *v >= 0.0) {
-                    return Err(field(
-                        format!("lights[{i}].intensity_w_sr"),
-                        format!("{intensity_w_sr:?}"),
-                        "finite intensities >= 0 W/sr",
-                    ));
-                }
+            LightEntry::Known { name, .. } | LightEntry::RadianceLight { name, .. } => {
+                let light = given_light(l)
+                    .map_err(|(f, value, expected)| field(format!("lights[{i}].{f}"), value, expected))?;
                 lights.push(light);
                 light_names.push(name.clone());
             }
@@ -484,12 +727,12 @@ pub fn load_lights(path: &Path) -> Result<Vec<(String, IgiLight)>, SceneFileErro
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
-    let entries: Vec<LightEntry> = ron::Options::default()
+    let entries: Vec<LightEntry> = campanile_config::source::ron_options()
         .from_str(&text)
         .map_err(|e| SceneFileError::File {
             path: path.to_path_buf(),
             message: format!(
-                "line {}, column {}: {} (expected a list of Known(name, position_m, radius_m, intensity_w_sr))",
+                "line {}, column {}: {} (expected a list of Known(name, position_m, radius_m, intensity_w_sr) or RadianceLight(name, position_m, radius_m, radiance))",
                 e.span.start.line, e.span.start.col, e.code
             ),
         })?;
@@ -502,34 +745,16 @@ pub fn load_lights(path: &Path) -> Result<Vec<(String, IgiLight)>, SceneFileErro
             expected: expected.to_string(),
         };
         match e {
-            LightEntry::Known {
-                name,
-                position_m,
-                radius_m,
-                intensity_w_sr,
-            } => {
-                let l = IgiLight {
-                    position: v3(position_m),
-                    radius: radius_m,
-                    intensity: [intensity_w_sr.0, intensity_w_sr.1, intensity_w_sr.2],
-                };
-                if !l.position.iter().all(|c| c.is_finite()) {
-                    return Err(field("position_m", format!("{position_m:?}"), "finite coordinates"));
-                }
-                if !(radius_m.is_finite() && radius_m >= 0.0) {
-                    return Err(field("radius_m", radius_m.to_string(), "a finite radius >= 0 m"));
-                }
-                if !l.intensity.iter().all(|v| v.is_finite() && *v >= 0.0) {
-                    return Err(field(
-                        "intensity_w_sr",
-                        format!("{intensity_w_sr:?}"),
-                        "finite values >= 0 W/sr",
-                    ));
-                }
-                out.push((name, l));
+            LightEntry::Known { ref name, .. } | LightEntry::RadianceLight { ref name, .. } => {
+                let l = given_light(&e).map_err(|(f, value, expected)| field(f, value, expected))?;
+                out.push((name.clone(), l));
             }
             LightEntry::Bulb { name, .. } => {
-                return Err(field("", format!("Bulb({name:?})"), "Known(...) lights only"));
+                return Err(field(
+                    "",
+                    format!("Bulb({name:?})"),
+                    "Known(...) or RadianceLight(...) lights only",
+                ));
             }
         }
     }
@@ -586,5 +811,42 @@ mod tests {
             r#"IgiScene(geometry: "q.obj", cameras: [], lights: [Known(name: "l", position_m: (0.0, 0.0, 1.0), radius_m: -1.0, intensity_w_sr: (1.0, 1.0, 1.0))], images: [])"#,
         );
         assert!(e.contains("lights[0].radius_m = -1"), "{e}");
+    }
+
+    #[test]
+    fn a_scene_written_by_ron_reads_back_with_optional_camera_fields() {
+        // `campanile process` writes its scene file with ron's serializer:
+        // the optional fields come out as Some(...), and absent ones not at all.
+        let scene = IgiScene {
+            geometry: "room.obj".into(),
+            surfaces: Vec::new(),
+            cameras: vec![CameraEntry {
+                name: "c".into(),
+                position_m: Some((0.5, 0.5, 1.6)),
+                look: Some((1.0, 0.0, 0.0)),
+                up: Some((0.0, 0.0, 1.0)),
+                vfov_deg: Some(46.8),
+                hfov_deg: None,
+                radiance_view: None,
+                width: 64,
+                height: 48,
+            }],
+            lights: vec![LightEntry::RadianceLight {
+                name: "l".into(),
+                position_m: (1.0, 1.0, 2.0),
+                radius_m: 0.05,
+                radiance: (10.0, 9.0, 8.0),
+            }],
+            images: Vec::new(),
+        };
+        let text = ron::ser::to_string_pretty(&scene, ron::ser::PrettyConfig::default()).unwrap();
+        assert!(!text.contains("hfov_deg") && !text.contains("radiance_view"), "{text}");
+        assert_eq!(parse(Path::new("s.ron"), &text).unwrap(), scene);
+        // And the hand-written form without Some.
+        let hand = text
+            .replace("Some((0.5, 0.5, 1.6))", "(0.5, 0.5, 1.6)")
+            .replace("Some(46.8)", "46.8");
+        assert_ne!(hand, text);
+        assert_eq!(parse(Path::new("s.ron"), &hand).unwrap(), scene);
     }
 }

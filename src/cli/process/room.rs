@@ -158,10 +158,12 @@ fn camera_entry(name: &str, c: &campanile_process::igi::ViewCamera) -> CameraEnt
     let t3 = |v: &Vector3<f64>| (v.x, v.y, v.z);
     CameraEntry {
         name: name.to_owned(),
-        position_m: t3(&c.position),
-        look: t3(&c.look),
-        up: t3(&c.up),
-        vfov_deg: c.vfov_rad.to_degrees(),
+        position_m: Some(t3(&c.position)),
+        look: Some(t3(&c.look)),
+        up: Some(t3(&c.up)),
+        vfov_deg: Some(c.vfov_rad.to_degrees()),
+        hfov_deg: None,
+        radiance_view: None,
         width: c.width,
         height: c.height,
     }
