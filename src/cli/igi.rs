@@ -88,6 +88,9 @@ pub struct Recovered {
 /// Loads `scene` and recovers its materials and albedo maps.
 pub fn recover_scene(scene: &Path, quick: bool) -> Result<Recovered> {
     let loaded = load(scene)?;
+    for w in &loaded.warnings {
+        eprintln!("warning: {w}");
+    }
     let (opts, map_opts, _) = settings(quick);
     let result = recover(&loaded.input, &opts).map_err(|e| anyhow!("inverse global illumination: {e}"))?;
     let map = AlbedoMap::build(&loaded.input, &result, &map_opts).map_err(|e| anyhow!("albedo maps: {e}"))?;
