@@ -152,6 +152,9 @@ pub fn recover_scene(scene: &Path, quick: bool) -> Result<Recovered> {
 /// [`recover_scene`] with the command line's `choice` over the scene file's.
 pub fn recover_scene_with(scene: &Path, quick: bool, choice: ModelChoice) -> Result<Recovered> {
     let loaded = load(scene)?;
+    for w in &loaded.warnings {
+        eprintln!("warning: {w}");
+    }
     let entry = choice
         .variant
         .or(loaded.ward_variant)

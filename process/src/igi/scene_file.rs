@@ -48,7 +48,7 @@ use super::radiance_view::RadianceView;
 use crate::brdf::WardVariant;
 use crate::camera::image::RadianceImage;
 use crate::radiance_file::read_radiance_image;
-use crate::render::Triangle;
+use crate::render::{Material, Ray, Scene, Triangle};
 
 /// A surface: OBJ groups sharing one BRDF's specular parameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -251,6 +251,9 @@ pub struct LoadedIgiScene {
     pub ward_variant: Option<WardVariantEntry>,
     /// The scene file's `interreflection`.
     pub interreflection: Option<bool>,
+    /// What the scene loads with but the user should know (e.g. OBJ groups
+    /// whose normals face away from every camera).
+    pub warnings: Vec<String>,
 }
 
 fn v3(t: (f64, f64, f64)) -> Vector3<f64> {
@@ -703,6 +706,17 @@ pub fn load(path: &Path) -> Result<LoadedIgiScene, SceneFileError> {
     if views.is_empty() {
         return Err(field("images".into(), "[]".into(), "at least one radiance image"));
     }
+    let warnings = back_facing_groups(&triangles, &triangle_group, &groups, &cameras)
+        .into_iter()
+        .map(|g| {
+            format!(
+                "{}: OBJ group {g:?}: the cameras see it only from behind (its normals face away from them); \
+                 it is shaded on the side the cameras see, but albedo/{g}.exr is then mirrored left to right (reverse the faces' \
+                 winding so that the normals face the cameras)",
+                obj.display()
+            )
+        })
+        .collect();
     Ok(LoadedIgiScene {
         input: IgiInput {
             triangles,
@@ -717,7 +731,51 @@ pub fn load(path: &Path) -> Result<LoadedIgiScene, SceneFileError> {
         triangulated,
         ward_variant: scene.ward_variant,
         interreflection: scene.interreflection,
+        warnings,
     })
+}
+
+/// The OBJ groups the cameras see only from behind (the side opposite
+/// their OBJ normal), by casting a 32 × 24 grid of each camera's rays. The
+/// solver shades each triangle on the side its cameras see, so such a group
+/// is solved the same, but its albedo map's texture axes follow the OBJ
+/// normal and the map comes out mirrored.
+fn back_facing_groups(
+    triangles: &[Triangle],
+    triangle_group: &[usize],
+    groups: &[String],
+    cameras: &[(String, ViewCamera)],
+) -> Vec<String> {
+    let tris: Vec<Triangle> = triangles.iter().map(|t| Triangle { material: 0, ..*t }).collect();
+    let Ok(scene) = Scene::new(tris, vec![Material::diffuse("any", [0.0; 3])], groups.to_vec()) else {
+        return Vec::new();
+    };
+    // Per group: rays that met its front, its back.
+    let mut seen = vec![[0usize; 2]; groups.len()];
+    for (_, cam) in cameras {
+        for j in 0..24 {
+            for i in 0..32 {
+                let direction = cam.direction(
+                    (i as f64 + 0.5) * cam.width as f64 / 32.0,
+                    (j as f64 + 0.5) * cam.height as f64 / 24.0,
+                );
+                let ray = Ray {
+                    origin: cam.position,
+                    direction,
+                };
+                if let Some(hit) = scene.intersect(&ray, f64::INFINITY) {
+                    let front = triangles[hit.triangle].normal.dot(&direction) < 0.0;
+                    seen[triangle_group[hit.triangle]][usize::from(!front)] += 1;
+                }
+            }
+        }
+    }
+    groups
+        .iter()
+        .zip(&seen)
+        .filter(|(_, [front, back])| *front == 0 && *back > 0)
+        .map(|(g, _)| g.clone())
+        .collect()
 }
 
 /// Reads a lights file: a RON list of `Known(...)` lights (as in the scene
@@ -848,5 +906,33 @@ mod tests {
             .replace("Some(46.8)", "46.8");
         assert_ne!(hand, text);
         assert_eq!(parse(Path::new("s.ron"), &hand).unwrap(), scene);
+    }
+
+    #[test]
+    fn a_group_the_cameras_see_only_from_behind_is_named() {
+        let dir = tempfile::tempdir().unwrap();
+        // Two walls at y = 3: "toward" wound so its normal is -y (toward the
+        // camera at y = 0), "away" the other way.
+        std::fs::write(
+            dir.path().join("w.obj"),
+            "v 0 3 0\nv 1 3 0\nv 1 3 1\nv 0 3 1\nv 2 3 0\nv 3 3 0\nv 3 3 1\nv 2 3 1\n\
+             g toward\nf 1 2 3 4\ng away\nf 5 8 7 6\n",
+        )
+        .unwrap();
+        let pfm: Vec<u8> = b"Pf\n2 2\n-1.0\n".iter().copied().chain([0u8; 16]).collect();
+        std::fs::write(dir.path().join("i.pfm"), pfm).unwrap();
+        let p = dir.path().join("s.ron");
+        std::fs::write(
+            &p,
+            r#"IgiScene(geometry: "w.obj", cameras: [(name: "c", position_m: (1.5, 0.0, 0.5), look: (0.0, 1.0, 0.0), up: (0.0, 0.0, 1.0), vfov_deg: 60.0, width: 2, height: 2)], lights: [], images: [(camera: "c", image: "i.pfm")])"#,
+        )
+        .unwrap();
+        let s = load(&p).unwrap();
+        assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+        assert!(
+            s.warnings[0].contains("OBJ group \"away\": the cameras see it only from behind"),
+            "{}",
+            s.warnings[0]
+        );
     }
 }
