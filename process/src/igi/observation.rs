@@ -66,6 +66,15 @@ pub struct DroppedPixels {
     pub used: usize,
 }
 
+/// Pixels whose footprint comes within this many pixels of a bulb's disc
+/// are dropped with those whose centre ray meets it: a pixel is an area,
+/// and one that covers part of a bulb (a real camera's, a supersampled
+/// render's, or one whose centre ray the renderer's slightly different
+/// projection sends onto the bulb) holds the bulb's radiance, hundreds of
+/// times the wall's. On a RADIANCE room at 64×64 four such pixels in 16 000
+/// took a wall's lobe away and put its ρd 16 % high.
+pub const BULB_MARGIN_PX: f64 = 1.5;
+
 /// The direct light terms at `point` (frame `frame`), shadow-tested.
 pub(crate) fn light_terms(
     geometry: &Geometry,
@@ -120,6 +129,7 @@ pub(crate) fn observations(
             .collect::<Vec<_>>()
             .par_iter()
             .map(|&y| {
+                let pixel_rad = cam.vfov_rad / cam.height as f64;
                 let mut obs = Vec::new();
                 let mut d = DroppedPixels::default();
                 for x in (0..cam.width).step_by(stride) {
@@ -137,8 +147,10 @@ pub(crate) fn observations(
                     let bulb = input.lights.iter().any(|l| {
                         l.radius > 0.0 && {
                             let oc = cam.position - l.position;
+                            // The bulb widened by BULB_MARGIN_PX pixels at its distance.
+                            let r = l.radius + BULB_MARGIN_PX * pixel_rad * oc.norm();
                             let b = oc.dot(&direction);
-                            let c = oc.norm_squared() - l.radius * l.radius;
+                            let c = oc.norm_squared() - r * r;
                             let disc = b * b - c;
                             disc >= 0.0 && (-b + disc.sqrt()) > 0.0 && (-b - disc.sqrt()) < limit
                         }
