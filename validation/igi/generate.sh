@@ -7,7 +7,8 @@
 #   validation/igi/generate.sh --fixtures  # rewrites validation/igi/fixtures/ (64x64, committed)
 #
 # Environment: IGI_AD (rpict -ad, default 1024), IGI_SPP (Mitsuba spp, default
-# 2048), IGI_ROOMS / IGI_MODES (default all). Creates (or reuses) the peer venv
+# 2048), IGI_ROOMS / IGI_MODES (default all), IGI_MITSUBA=0 to skip the Mitsuba
+# room (bench set only). Creates (or reuses) the peer venv
 # outside the repository with bench/venv.sh, generates, then runs the
 # generator's own tests on the output.
 set -euo pipefail
@@ -45,6 +46,8 @@ else
     esac
     mkdir -p "$out"
     "$venv/bin/python" "$here/generate.py" "$out" --size 128 --rooms "$rooms" --modes "${IGI_MODES:-direct,interreflection}" --ad "$ad"
-    "$venv/bin/python" "$here/mitsuba_room.py" "$out" --size 128 --spp "$spp"
+    if [ "${IGI_MITSUBA:-1}" != 0 ]; then
+        "$venv/bin/python" "$here/mitsuba_room.py" "$out" --size 128 --spp "$spp"
+    fi
 fi
 "$venv/bin/python" "$here/test_room.py" "$out"

@@ -20,6 +20,7 @@ if [ "$#" -gt 0 ] && [ "$1" != "--" ]; then bin="$1"; shift; fi
 [ "${1:-}" = "--" ] && shift
 venv="$("$repo/bench/venv.sh" numpy OpenEXR)"
 outs="${TMPDIR:-/tmp}/campanile-validation/igi-out"
+mkdir -p "$outs"
 scene_name="scene.ron"
 [ "${IGI_LEGACY:-0}" = 1 ] && scene_name="scene-exr.ron"
 status=0
