@@ -34,9 +34,9 @@ if [ "$fixtures" = 1 ]; then
     fi
     out="$here/fixtures"
     mkdir -p "$out"
-    # The committed set: both rooms direct only, the studio with interreflection.
+    # The committed set: both rooms direct only and with interreflection.
     "$venv/bin/python" "$here/generate.py" --fixtures "$out" --rooms "$rooms" --modes direct --ad "$ad"
-    "$venv/bin/python" "$here/generate.py" --fixtures "$out" --rooms studio --modes interreflection --ad "$ad"
+    "$venv/bin/python" "$here/generate.py" --fixtures "$out" --rooms "$rooms" --modes interreflection --ad "$ad"
     "$venv/bin/python" "$here/mitsuba_room.py" "$out" --size 64 --spp "$spp"
 else
     out="${1:-${TMPDIR:-/tmp}/campanile-validation/igi}"
