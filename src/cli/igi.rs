@@ -108,7 +108,12 @@ pub struct ModelChoice {
 /// The solver's and the albedo map's settings: `quick` for the tests and `demo --quick`.
 pub fn settings(quick: bool) -> (IgiOptions, AlbedoMapOptions, RelightSettings) {
     let igi = IgiOptions {
-        cells_per_edge: if quick { 4 } else { 6 },
+        // 12 cells per triangle edge: on the RADIANCE studio with
+        // interreflection (validation/igi) 6 left ρs 4–17 % and α 5–12 %
+        // high (cell-constant indirect light over 0.7 m cells), 12 brings
+        // most within 2–5 % (examples/igi_knobs; BENCHMARKS.md), 24 is no
+        // better at 64² views with 1.7 % noise.
+        cells_per_edge: if quick { 4 } else { 12 },
         gather_rays: if quick { 32 } else { 64 },
         iterations: if quick { 3 } else { 4 },
         ..IgiOptions::default()
@@ -298,6 +303,12 @@ fn summary(r: &Recovered, albedo: &[String]) -> serde_json::Value {
         "ward_normalization": r.result.variant.to_string(),
         "seconds": r.result.seconds,
         "iterations": r.result.iterations.iter().map(|i| i.max_relative_change).collect::<Vec<_>>(),
+        "iteration_seconds": r.result.iterations.iter().map(|i| serde_json::json!({
+            "total": i.seconds,
+            "gather": i.gather_seconds,
+            "delta_s": i.delta_s_seconds,
+            "fit": i.fit_seconds,
+        })).collect::<Vec<_>>(),
         "surfaces": surfaces,
         "lights": lights,
         "albedo_maps": albedo.iter().map(|g| format!("albedo/{g}.exr")).collect::<Vec<_>>(),

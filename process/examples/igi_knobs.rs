@@ -1,0 +1,58 @@
+//! Runs the IGI solver on a scene file with the knobs given on the command
+//! line, writing `OUT/materials.json` as `campanile igi` does (the records
+//! only), for error-against-knob studies on the validation rooms
+//! (`validation/igi`).
+//!
+//! `cargo run --release -p campanile-process --example igi_knobs -- SCENE OUT
+//! [cells_per_edge gather_rays lobe_rays iterations]`
+
+use campanile_process::brdf::WardVariant;
+use campanile_process::igi::material_record::{records, variant_name};
+use campanile_process::igi::scene_file::load;
+use campanile_process::igi::{IgiOptions, recover};
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if args.len() < 3 {
+        eprintln!("usage: igi_knobs SCENE OUT [cells gather lobe iterations]");
+        std::process::exit(2);
+    }
+    let knob = |i: usize, d: u64| args.get(i).and_then(|a| a.parse().ok()).unwrap_or(d);
+    let loaded = match load(std::path::Path::new(&args[1])) {
+        Ok(l) => l,
+        Err(e) => {
+            eprintln!("{e}");
+            std::process::exit(2);
+        }
+    };
+    let options = IgiOptions {
+        variant: loaded
+            .ward_variant
+            .and_then(|v| v.variant())
+            .unwrap_or(WardVariant::Ward1992),
+        interreflection: loaded.interreflection.unwrap_or(true),
+        cells_per_edge: knob(3, 6) as usize,
+        gather_rays: knob(4, 64) as u32,
+        lobe_rays: knob(5, 16) as u32,
+        iterations: knob(6, 4) as u32,
+        ..IgiOptions::default()
+    };
+    let r = match recover(&loaded.input, &options) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("{e}");
+            std::process::exit(1);
+        }
+    };
+    let cams = &loaded.cameras;
+    let inside = cams.iter().map(|(_, c)| c.position).sum::<nalgebra::Vector3<f64>>() / cams.len().max(1) as f64;
+    let json = serde_json::json!({
+        "variant": variant_name(r.variant),
+        "surfaces": records(&loaded.input, &r, &inside),
+        "seconds": r.seconds,
+    });
+    let out = std::path::Path::new(&args[2]);
+    std::fs::create_dir_all(out).expect("output directory");
+    std::fs::write(out.join("materials.json"), serde_json::to_string_pretty(&json).unwrap()).expect("write");
+    println!("{:.2} s; {}", r.seconds, r.interreflection.message);
+}
