@@ -109,6 +109,17 @@ impl Default for IgiOptions {
 }
 
 impl IgiOptions {
+    /// The ΔS passes that run: [`Self::iterations`] (at least one), at
+    /// most two without [`Self::interreflection`] (nothing is gathered; the
+    /// second pass only re-weights the fit by the first's estimate).
+    pub fn passes(&self) -> u32 {
+        if self.interreflection {
+            self.iterations.max(1)
+        } else {
+            self.iterations.clamp(1, 2)
+        }
+    }
+
     /// Checks every option.
     pub fn validate(&self) -> Result<(), IgiError> {
         let err = |name, value: String, expected| Err(IgiError::Option { name, value, expected });

@@ -235,13 +235,7 @@ pub fn recover_with_progress(
     let mut fits: Vec<SurfaceFit> = Vec::new();
     let mut iterations = Vec::new();
 
-    // Without interreflection nothing is gathered, and a pass only
-    // re-weights the fit by the previous estimate: two passes do it.
-    let passes = if options.interreflection {
-        options.iterations.max(1)
-    } else {
-        options.iterations.clamp(1, 2)
-    };
+    let passes = options.passes();
     for it in 0..passes {
         let t0 = Instant::now();
         let mut report = |step| {
@@ -254,20 +248,16 @@ pub fn recover_with_progress(
         let seed = options.seed.wrapping_add(u64::from(it) * 0x9e37_79b9);
         // (1) Diffuse radiance per cell: measured minus the specular estimate.
         estimate_diffuse(&mut field, &geometry, &obs, &materials, &kind_ind);
-        let albedos: Vec<Option<SpecularAlbedo>> = materials
-            .par_iter()
-            .map(|m| m.and_then(|m| m.lobe).map(|l| SpecularAlbedo::new(&l)))
-            .collect();
-        // (2) Indirect irradiance per cell (none in direct-only images).
-        let tt = Instant::now();
+        // (2) Indirect irradiance per cell and (3) ΔS at every sample, both
+        // none in direct-only images.
+        let (mut gather_seconds, mut delta_s_seconds) = (0.0, 0.0);
         if options.interreflection {
+            let tt = Instant::now();
             report("indirect light");
+            let albedos = specular_albedos(&materials);
             field.gather(&geometry, input, &materials, &albedos, options.gather_rays, seed);
-        }
-        let gather_seconds = tt.elapsed().as_secs_f64();
-        let tt = Instant::now();
-        // (3) ΔS at every sample.
-        if options.interreflection {
+            gather_seconds = tt.elapsed().as_secs_f64();
+            let tt = Instant::now();
             report("ΔS");
             kind_ind = indirect_specular(
                 &geometry,
@@ -280,8 +270,8 @@ pub fn recover_with_progress(
                 options.lobe_rays,
                 seed ^ 0x5555,
             );
+            delta_s_seconds = tt.elapsed().as_secs_f64();
         }
-        let delta_s_seconds = tt.elapsed().as_secs_f64();
         let tt = Instant::now();
         report("fitting");
         if it == 0 {
@@ -345,10 +335,7 @@ pub fn recover_with_progress(
         step: "interreflection check",
     });
     if !options.interreflection {
-        let albedos: Vec<Option<SpecularAlbedo>> = materials
-            .par_iter()
-            .map(|m| m.and_then(|m| m.lobe).map(|l| SpecularAlbedo::new(&l)))
-            .collect();
+        let albedos = specular_albedos(&materials);
         let seed = options.seed.wrapping_add(u64::from(passes) * 0x9e37_79b9);
         field.gather(&geometry, input, &materials, &albedos, options.gather_rays, seed);
     }
@@ -490,6 +477,15 @@ impl Default for SurfaceFit {
             anisotropic: None,
         }
     }
+}
+
+/// Each material's lobe's directional albedo (for the lobe's share of
+/// the light it sends on, [`RadiosityField::radiance_toward`]).
+fn specular_albedos(materials: &[Option<WardMaterial>]) -> Vec<Option<SpecularAlbedo>> {
+    materials
+        .par_iter()
+        .map(|m| m.and_then(|m| m.lobe).map(|l| SpecularAlbedo::new(&l)))
+        .collect()
 }
 
 /// The floor of a surface's weights' predicted radiance ([`WEIGHT_FLOOR`]

@@ -131,9 +131,7 @@ pub(crate) fn bootstrap(
 fn canonical(m: &WardMaterial) -> WardMaterial {
     WardMaterial {
         rho_d: m.rho_d,
-        lobe: m
-            .lobe
-            .map(|l| if l.alpha_x != l.alpha_y { canonical_lobe(l) } else { l }),
+        lobe: m.lobe.map(canonical_lobe),
     }
 }
 
