@@ -26,3 +26,7 @@ pub fn date() -> impl Strategy<Value = NaiveDate> {
 pub fn small_vec<T: Arbitrary>() -> impl Strategy<Value = Vec<T>> {
     proptest::collection::vec(any::<T>(), 0..4)
 }
+
+pub fn albedo() -> impl Strategy<Value = Option<(f64, f64, f64)>> {
+    proptest::option::of((0.0..=1.0f64, 0.0..=1.0f64, 0.0..=1.0f64))
+}

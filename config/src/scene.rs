@@ -34,6 +34,14 @@ pub struct MaterialGroup {
     /// Model to fit.
     #[serde(default)]
     pub model: MaterialModel,
+    /// The known diffuse albedo per channel (r, g, b), each in [0, 1], of a
+    /// material that is not recovered: the environment (ground, a
+    /// neighbouring building) that lights the recovered surfaces by one
+    /// bounce (thesis §5.4). `campanile outdoor recover` needs it on every
+    /// material that is not `PseudoBrdf`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(test, proptest(strategy = "crate::arbitrary::albedo()"))]
+    pub albedo: Option<(f64, f64, f64)>,
 }
 
 /// A named surface: one or more OBJ groups, e.g. a wall of the tower.
@@ -135,7 +143,16 @@ impl Validate for Scene {
         v.unique_names("materials", self.materials.iter().map(|m| m.name.as_str()));
         v.at("materials", |v| {
             for (i, m) in self.materials.iter().enumerate() {
-                v.at(i, |v| v.non_empty("name", &m.name));
+                v.at(i, |v| {
+                    v.non_empty("name", &m.name);
+                    if let Some((r, g, b)) = m.albedo {
+                        v.at("albedo", |v| {
+                            for (k, c) in [r, g, b].into_iter().enumerate() {
+                                v.range(k, c, 0.0, 1.0, "a diffuse albedo in [0, 1]");
+                            }
+                        });
+                    }
+                });
             }
         });
         v.unique_names("surfaces", self.surfaces.iter().map(|s| s.name.as_str()));

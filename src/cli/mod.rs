@@ -11,6 +11,7 @@ pub mod exit;
 mod hdr;
 mod igi;
 mod logging;
+mod outdoor;
 mod partial_file;
 mod plan;
 mod process;
@@ -83,6 +84,11 @@ pub enum Command {
     },
     /// Inverse global illumination indoors: Ward BRDFs and albedo maps from a scene file (SCENE.ron).
     Igi(igi::IgiArgs),
+    /// Outdoor reflectance on plain files: pseudo-albedos from posed HDR photos, views at new times.
+    Outdoor {
+        #[command(subcommand)]
+        action: outdoor::OutdoorCommand,
+    },
     /// Run a plan on a station into a session directory, or resume one.
     Capture(capture::CaptureArgs),
     /// The unattended station: run a plan day after day (`station run`), read its heartbeat (`station status`).
@@ -147,6 +153,7 @@ pub fn run() -> ExitCode {
         Command::Devices(args) => finish(devices::run(args)),
         Command::Render(args) => report(render::run(args)),
         Command::Igi(args) => report(igi::run(args)),
+        Command::Outdoor { action } => report(outdoor::run(action)),
     };
     ExitCode::from(code)
 }

@@ -452,6 +452,54 @@ fn camera_from_image(c: &CameraEntry, file: &Path) -> Result<ViewCamera, CameraF
     radiance_camera(&view, c.width, c.height)
 }
 
+/// The camera of `entry`, at `field` (e.g. `cameras[2]`) of the file
+/// `path`; `first_image` is the first image this camera took, for
+/// `radiance_view: "from-image"` (its `VIEW=` line). Checked whole
+/// ([`ViewCamera::validate`]). Shared by every plain-file command that
+/// takes cameras (`campanile igi`, `campanile outdoor`).
+pub fn view_camera(
+    path: &Path,
+    field: &str,
+    entry: &CameraEntry,
+    first_image: Option<&Path>,
+) -> Result<ViewCamera, SceneFileError> {
+    let bad = |name: &str, value: String, expected: &str| SceneFileError::Field {
+        path: path.to_path_buf(),
+        field: if name.is_empty() {
+            field.to_string()
+        } else {
+            format!("{field}.{name}")
+        },
+        value,
+        expected: expected.to_string(),
+    };
+    let fault = |e: CameraFault| match e {
+        CameraFault::Field { name, value, expected } => bad(name, value, &expected),
+        CameraFault::File(e) => e,
+    };
+    let cam = match camera_of_entry(entry).map_err(fault)? {
+        Some(cam) => cam,
+        None => {
+            let file = first_image.ok_or_else(|| {
+                bad(
+                    "radiance_view",
+                    "\"from-image\"".into(),
+                    "an image of this camera to take the view from (no image names it)",
+                )
+            })?;
+            camera_from_image(entry, file).map_err(fault)?
+        }
+    };
+    cam.validate(&entry.name).map_err(|e| {
+        bad(
+            "",
+            format!("{:?}", entry.name),
+            &format!("a valid camera ({e}; fields of view in (0, 180), width and height >= 1)"),
+        )
+    })?;
+    Ok(cam)
+}
+
 /// Parses the text of a scene file (`path` names it in errors).
 pub fn parse(path: &Path, text: &str) -> Result<IgiScene, SceneFileError> {
     campanile_config::source::ron_options()
@@ -559,46 +607,18 @@ pub fn load(path: &Path) -> Result<LoadedIgiScene, SceneFileError> {
                 "a name no other camera has",
             ));
         }
-        let cam = camera_of_entry(c).map_err(|e| match e {
-            CameraFault::Field { name, value, expected } => field(format!("cameras[{i}].{name}"), value, &expected),
-            CameraFault::File(e) => e,
-        })?;
-        let cam = match cam {
-            Some(cam) => cam,
-            None => {
-                // "from-image": the view of the first image of this camera.
-                let file = scene
-                    .images
-                    .iter()
-                    .map(|e| (&e.camera, &e.image))
-                    .chain(scene.lights.iter().flat_map(|l| match l {
-                        LightEntry::Bulb { images, .. } => images.iter().map(|b| (&b.camera, &b.image)).collect(),
-                        _ => Vec::new(),
-                    }))
-                    .find(|(n, _)| **n == c.name)
-                    .map(|(_, f)| f.clone())
-                    .ok_or_else(|| {
-                        field(
-                            format!("cameras[{i}].radiance_view"),
-                            "\"from-image\"".into(),
-                            "an image of this camera to take the view from (no image names it)",
-                        )
-                    })?;
-                camera_from_image(c, &base.join(&file)).map_err(|e| match e {
-                    CameraFault::Field { name, value, expected } => {
-                        field(format!("cameras[{i}].{name}"), value, &expected)
-                    }
-                    CameraFault::File(e) => e,
-                })?
-            }
-        };
-        cam.validate(&c.name).map_err(|e| {
-            field(
-                format!("cameras[{i}]"),
-                format!("{:?}", c.name),
-                &format!("a valid camera ({e}; fields of view in (0, 180), width and height >= 1)"),
-            )
-        })?;
+        // "from-image": the view of the first image of this camera.
+        let first_image = scene
+            .images
+            .iter()
+            .map(|e| (&e.camera, &e.image))
+            .chain(scene.lights.iter().flat_map(|l| match l {
+                LightEntry::Bulb { images, .. } => images.iter().map(|b| (&b.camera, &b.image)).collect(),
+                _ => Vec::new(),
+            }))
+            .find(|(n, _)| **n == c.name)
+            .map(|(_, f)| base.join(f));
+        let cam = view_camera(path, &format!("cameras[{i}]"), c, first_image.as_deref())?;
         cameras.push((c.name.clone(), cam));
     }
     let camera = |what: String, name: &str| -> Result<ViewCamera, SceneFileError> {

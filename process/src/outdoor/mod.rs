@@ -12,6 +12,10 @@
 //! - [`rerender`]: radiance images at any time and sky (§5.5, §5.6).
 //! - [`atlas`]: pseudo-albedo texture atlases (EXR) and the materials file.
 //! - [`photograph`]: renders through a response curve at a chosen shutter.
+//! - [`scene_file`], [`photo_file`], [`light_file`]: the plain files of
+//!   `campanile outdoor recover|render` (scene with known environment
+//!   albedos, posed HDR photos, sun and sky per time), with [`sky_image`]
+//!   fitting a sky from a fisheye picture of it.
 //! - [`mod@zoom_albedo`]: pseudo-albedos at pixel resolution from a zoom
 //!   photograph (§5.6.4, eq. 5.16) and the zoom view re-rendered with them.
 //!
@@ -33,10 +37,15 @@ pub mod atlas;
 pub mod cell_irradiance;
 pub mod estimate;
 pub mod grid;
+pub mod light_file;
+pub mod novel_view;
 pub mod observation;
 pub mod photo;
+pub mod photo_file;
 pub mod photograph;
 pub mod rerender;
+pub mod scene_file;
+pub mod sky_image;
 pub mod texture_transfer;
 pub mod zoom_albedo;
 

@@ -299,6 +299,70 @@ pub fn interreflection(check: &InterreflectionCheck, q: &Quality) -> ProductQual
     .with_note(check.message.clone())
 }
 
+/// The outdoor pseudo-albedos (thesis §5.4) from their fit's diagnostics:
+/// the median over solved cells of each cell's RMS relative residual, with
+/// counts of how the cells were obtained and the photos left out as notes.
+/// The light they were divided by is judged on its own (its sky's
+/// verdicts); the caller inherits those.
+pub fn pseudo_albedos(refl: &crate::outdoor::Reflectance, q: &Quality) -> ProductQuality {
+    use crate::outdoor::CellStatus;
+    let mut residuals: Vec<f64> = refl
+        .cells
+        .iter()
+        .filter(|c| c.status == CellStatus::Solved)
+        .map(|c| c.rms_relative)
+        .collect();
+    residuals.sort_by(f64::total_cmp);
+    let median = if residuals.is_empty() {
+        f64::NAN
+    } else {
+        residuals[residuals.len() / 2]
+    };
+    let mut p = ProductQuality::new(
+        "pseudo-albedos",
+        vec![Check::new(
+            format!(
+                "median RMS relative residual of eqs. 5.11-5.12 ({} solved cells)",
+                residuals.len()
+            ),
+            median,
+            q.outdoor.residual,
+            Better::Lower,
+        )],
+    );
+    let count = |s: CellStatus| refl.count(s);
+    p = p.with_note(format!(
+        "{} cells: {} solved, {} never sunlit (rho_sun from the face's ratio), {} never shadowed, {} ill-conditioned, {} unseen (filled from neighbours)",
+        refl.cells.len(),
+        count(CellStatus::Solved),
+        count(CellStatus::NeverSunlit),
+        count(CellStatus::NeverShadowed),
+        count(CellStatus::IllConditioned),
+        count(CellStatus::Unseen)
+    ));
+    for photo in refl.photos.iter().filter(|c| c.outlier) {
+        p = p.with_note(format!(
+            "photo {} left out as an outlier (trimmed mean log ratio {:.3})",
+            photo.label, photo.median_log_ratio
+        ));
+    }
+    p
+}
+
+/// A re-render against the photograph of the same view: the relative RMSE
+/// of 4 × 4-pixel block means over the target pixels.
+pub fn outdoor_render(view: &str, block_rmse: f64, blocks: usize, q: &Quality) -> ProductQuality {
+    ProductQuality::new(
+        format!("render {view}"),
+        vec![Check::new(
+            format!("relative RMSE of 4x4 block means against the photograph ({blocks} blocks)"),
+            block_rmse,
+            q.outdoor.render,
+            Better::Lower,
+        )],
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use campanile_process::render::{Material, Scene};
+use campanile_process::render::{Material, Scene, Texture};
 use nalgebra::Vector3;
 
 use super::WorldError;
@@ -51,7 +51,19 @@ pub fn from_description(description: campanile_config::Scene, obj: &Path) -> Res
     } = geometry;
     let appearances: Vec<Appearance> = material_names
         .iter()
-        .map(|m| appearance(&description.name, m))
+        .map(|m| {
+            // A material whose albedo the scene file gives is that constant
+            // diffuse albedo; the others, the simulator's appearance.
+            match description
+                .materials
+                .iter()
+                .find(|g| &g.name == m)
+                .and_then(|g| g.albedo)
+            {
+                Some((r, g, b)) => Appearance::diffuse(Texture::Constant([r, g, b])),
+                None => appearance(&description.name, m),
+            }
+        })
         .collect();
     let materials = material_names
         .iter()

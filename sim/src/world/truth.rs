@@ -53,7 +53,7 @@ impl Appearance {
         self.finish.as_ref().map(Finish::lobe).transpose()
     }
 
-    fn diffuse(albedo: Texture) -> Appearance {
+    pub(crate) fn diffuse(albedo: Texture) -> Appearance {
         Appearance { albedo, finish: None }
     }
 }

@@ -31,8 +31,9 @@ use campanile_process::report::{Section, Table};
 use campanile_process::sun::sun_position;
 use campanile_sim::world::World;
 
-use super::super::process::outdoor_stage::{block_rmse, rig_of};
+use super::super::process::outdoor_stage::rig_of;
 use super::super::process::{Outdoor, Processed};
+use campanile_process::outdoor::novel_view::block_rmse;
 
 /// One term of the budget for one view: relative RMSE per pixel and per 4 × 4 block.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -70,7 +71,7 @@ fn term(view: &str, name: &str, a: &RadianceImage, b: &RadianceImage, mask: &[bo
         view: view.to_owned(),
         term: name.to_owned(),
         pixel: campanile_process::outdoor::rerender::relative_rmse(a, b, mask).unwrap_or(f64::NAN) * factor,
-        block: block_rmse(a, b, mask, 4).unwrap_or(f64::NAN) * factor,
+        block: block_rmse(a, b, mask, 4).map_or(f64::NAN, |(r, _)| r) * factor,
     }
 }
 

@@ -11,11 +11,11 @@ use std::time::Instant;
 use anyhow::{Context, Result, anyhow};
 use campanile_config::scene::MaterialModel;
 use campanile_process::camera::image::RadianceImage;
+use campanile_process::outdoor::novel_view::{compare_view, render_view};
 use campanile_process::outdoor::rerender::Reference;
-use campanile_process::outdoor::rerender::{relative_rmse, target_mask};
-use campanile_process::outdoor::texture_transfer::{MIN_REFERENCES, TextureSource, texture_sources, transfer_texture};
+use campanile_process::outdoor::texture_transfer::texture_sources;
 use campanile_process::outdoor::{
-    Illumination, Photo, Reflectance, ReflectanceSettings, RerenderSettings, recover_reflectance, rerender,
+    Illumination, Photo, Reflectance, ReflectanceSettings, RerenderSettings, recover_reflectance,
 };
 use campanile_process::pipeline::{MeasuredSky, MergedGroup, Purpose, mean_time, measured_sky, predicted_sky};
 use campanile_process::render::{CameraRig, Scene};
@@ -110,40 +110,6 @@ fn photo_of(p: &Processed, g: &MergedGroup, time: DateTime<Utc>) -> Photo {
     }
 }
 
-/// Whether two rigs are the same camera (position, head angles, size).
-fn same_camera(a: &CameraRig, b: &CameraRig) -> bool {
-    a.width == b.width
-        && a.height == b.height
-        && (a.position - b.position).norm() < 1e-3
-        && (a.head.pan_rad - b.head.pan_rad).abs() < 1e-6
-        && (a.head.tilt_rad - b.head.tilt_rad).abs() < 1e-6
-}
-
-/// 4×4-block relative RMSE over blocks with at least half their pixels in the mask.
-pub fn block_rmse(a: &RadianceImage, b: &RadianceImage, mask: &[bool], k: usize) -> Option<f64> {
-    let (mut num, mut den) = (0.0, 0.0);
-    for by in 0..a.height / k {
-        for bx in 0..a.width / k {
-            let (mut sa, mut sb, mut n) = (0.0, 0.0, 0usize);
-            for y in by * k..(by + 1) * k {
-                for x in bx * k..(bx + 1) * k {
-                    let i = y * a.width + x;
-                    if mask[i] {
-                        sa += (0..3).map(|c| f64::from(a.data[3 * i + c])).sum::<f64>();
-                        sb += (0..3).map(|c| f64::from(b.data[3 * i + c])).sum::<f64>();
-                        n += 1;
-                    }
-                }
-            }
-            if 2 * n >= k * k {
-                num += (sa - sb).powi(2);
-                den += sb * sb;
-            }
-        }
-    }
-    (den > 0.0).then(|| (num / den).sqrt())
-}
-
 /// Pseudo-albedos from the training views, then the held-out views.
 pub fn outdoor(p: &Processed, scene: &Scene, settings: &ReflectanceSettings) -> Result<OutdoorProducts> {
     let targets = targets(p, scene)?;
@@ -216,45 +182,23 @@ pub fn outdoor(p: &Processed, scene: &Scene, settings: &ReflectanceSettings) -> 
             time: g.time,
             sky: &sky,
         };
-        let settings = RerenderSettings::default();
-        let (grid_only, _) = rerender(scene, &reflectance, &rig, &light, &settings);
-        // The training photographs from this camera carry the texture finer
-        // than the grid (§5.6.4, eq. 5.16): the grid-only re-render's error
-        // against noise-free photographs is 2.4–2.8% per 4×4 block on the
-        // simulated day even with the true cell albedos (BENCHMARKS.md,
-        // "The held-out error, term by term").
-        // Photos from this very camera where there are any (exact pixel
-        // alignment), else every training photo that sees the point.
-        let same: Vec<&TextureSource> = sources.iter().filter(|s| same_camera(&s.photo.rig, &rig)).collect();
-        let chosen: Vec<&TextureSource> = if same.is_empty() {
-            sources.iter().collect()
-        } else {
-            same
-        };
-        let references = chosen.len();
-        let (rendered, _) = transfer_texture(scene, &reflectance, &rig, &grid_only, &chosen, MIN_REFERENCES);
+        let view = render_view(scene, &reflectance, &rig, &light, &sources);
         let measured = RadianceImage {
             width: g.map.width,
             height: g.map.height,
             data: g.map.rgb.clone(),
         };
-        let mask: Vec<bool> = target_mask(scene, &reflectance, &rig)
-            .into_iter()
-            .zip(&g.map.mask)
-            .map(|(t, &m)| t && m == 0)
-            .collect();
-        let rmse_pixel = relative_rmse(&rendered, &measured, &mask).unwrap_or(f64::NAN);
-        let rmse_block = block_rmse(&rendered, &measured, &mask, 4).unwrap_or(f64::NAN);
-        let rmse_block_grid = block_rmse(&grid_only, &measured, &mask, 4).unwrap_or(f64::NAN);
+        let valid: Vec<bool> = g.map.mask.iter().map(|&m| m == 0).collect();
+        let c = compare_view(scene, &reflectance, &rig, &view, &measured, Some(&valid));
         held_out.push(HeldOutView {
-            references,
-            rmse_block_grid,
+            references: view.references,
+            rmse_block_grid: c.rmse_block_grid,
             label: g.key.clone(),
             measured,
-            rendered,
-            mask,
-            rmse_pixel,
-            rmse_block,
+            rendered: view.rendered,
+            mask: c.mask,
+            rmse_pixel: c.rmse_pixel,
+            rmse_block: c.rmse_block,
         });
     }
     seconds.push((
