@@ -7,7 +7,8 @@
 #   validation/outdoor/generate.sh --fixtures  # rewrites validation/outdoor/fixtures/ (96x64, committed)
 #
 # Environment: OUTDOOR_AD (rpict -ad, default 512), OUTDOOR_AB (-ab, default 5),
-# OUTDOOR_JOBS (parallel rpict runs, default 2). Creates (or reuses) the peer
+# OUTDOOR_JOBS (parallel rpict runs, default 2), OUTDOOR_BOUNCE (-ab values of the
+# bounce study, default 1,2; empty: none). Creates (or reuses) the peer
 # venv outside the repository with bench/venv.sh.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -22,7 +23,7 @@ if [ "$#" -gt 1 ] || { [ "$fixtures" = 1 ] && [ "$#" -gt 0 ]; }; then
     exit 2
 fi
 venv="$("$repo/bench/venv.sh" pyradiance==1.3.1 numpy)"
-opts=(--ad "${OUTDOOR_AD:-512}" --ab "${OUTDOOR_AB:-5}" --jobs "${OUTDOOR_JOBS:-2}")
+opts=(--ad "${OUTDOOR_AD:-512}" --ab "${OUTDOOR_AB:-5}" --jobs "${OUTDOOR_JOBS:-2}" --bounce-study "${OUTDOOR_BOUNCE-1,2}")
 if [ "$fixtures" = 1 ]; then
     "$venv/bin/python" "$here/generate.py" --fixtures "$here/fixtures" "${opts[@]}"
 else
@@ -32,3 +33,4 @@ else
     esac
     "$venv/bin/python" "$here/generate.py" "$out" --size 192x128 "${opts[@]}"
 fi
+"$venv/bin/python" "$here/test_outdoor.py" "$([ "$fixtures" = 1 ] && echo "$here/fixtures" || echo "$out")" > /dev/null
