@@ -4,6 +4,7 @@
 //! - [`controller`]: runs a timeline's shots through the devices into the store.
 //! - [`device`]: the traits the controller drives (camera, head, wheel, lights).
 //! - [`driver`]: real drivers over serial links and camera APIs.
+//! - [`import`]: a folder of hand-taken JPEG brackets made into a session.
 //! - [`conformance`]: suites any driver or emulator must pass.
 //! - [`schedule`]: when sessions run and what shots they take, as a pure function of plan, site and time.
 //! - [`station`]: a real station's devices, built from its configuration, reconnecting with backoff.
@@ -15,6 +16,7 @@ pub mod conformance;
 pub mod controller;
 pub mod device;
 pub mod driver;
+pub mod import;
 pub mod schedule;
 pub mod station;
 pub mod store;

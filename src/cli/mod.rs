@@ -17,6 +17,7 @@ mod plan;
 mod process;
 mod render;
 mod ron_output;
+mod session;
 mod site;
 mod sky;
 mod station;
@@ -96,6 +97,11 @@ pub enum Command {
         #[command(subcommand)]
         action: station::StationCommand,
     },
+    /// Sessions from hand-taken photographs (`session import FOLDER --out SESSION`), and checking one (`session verify`).
+    Session {
+        #[command(subcommand)]
+        action: session::SessionCommand,
+    },
     /// Process a captured session: response, HDR, sun, sky and environment, with a summary.
     Process(process::ProcessArgs),
     /// List serial ports and cameras, or test a station's devices (`devices test --station FILE`).
@@ -149,6 +155,7 @@ pub fn run() -> ExitCode {
         Command::Capture(args) => finish(capture::run(args)),
         Command::Station { action } => finish(station::run(action)),
         Command::Demo(args) => report(demo::run(args)),
+        Command::Session { action } => report(session::run(action)),
         Command::Process(args) => report(process::run(args)),
         Command::Devices(args) => finish(devices::run(args)),
         Command::Render(args) => report(render::run(args)),

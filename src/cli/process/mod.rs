@@ -324,6 +324,7 @@ pub fn run(args: ProcessArgs) -> Result<()> {
     if let Some(o) = &outdoor {
         quality.push(outdoor_quality(&processed, o));
     }
+    note_import_estimates(&args.session, &mut quality)?;
     let quality = QualityReport::new(quality, &processed.thresholds);
     let report = Report {
         title: format!("Campanile: {}", args.session.display()),
@@ -357,6 +358,33 @@ pub fn run(args: ProcessArgs) -> Result<()> {
         }
     }
     verdicts::finish(&quality, &out.join("quality.json"))
+}
+
+/// For a session made by `campanile session import`: each product's notes
+/// say what it rests on that was estimated or stated rather than measured
+/// (the camera from EXIF, the time from a stated clock offset, no sky
+/// frames), from the session's import record.
+fn note_import_estimates(session: &Path, quality: &mut Vec<ProductQuality>) -> Result<()> {
+    let Some(record) =
+        campanile_capture::import::record::ImportRecord::read(session).map_err(super::exit::bad_input)?
+    else {
+        return Ok(());
+    };
+    let mut import = ProductQuality::new(format!("session import {}", record.folder), Vec::new());
+    import.notes = record
+        .estimated
+        .iter()
+        .map(|e| format!("estimated, not measured ({}): {}", e.what, e.how))
+        .collect();
+    for q in quality.iter_mut() {
+        let notes: Vec<String> = record
+            .estimates_for(&q.product)
+            .map(|e| format!("estimated, not measured ({}): {}", e.what, e.how))
+            .collect();
+        q.notes.extend(notes);
+    }
+    quality.push(import);
+    Ok(())
 }
 
 /// The pseudo-albedos' verdict: what they inherited from the response and

@@ -1,0 +1,255 @@
+//! `campanile session`: sessions from hand-taken photographs (`import`),
+//! and checking a session's frames (`verify`).
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use campanile_capture::import::clock::ClockSettings;
+use campanile_capture::import::station_estimate::SiteGiven;
+use campanile_capture::import::{ImportError, ImportOptions, plan_import, write_session};
+use campanile_capture::store::SessionReader;
+use clap::{Args, Subcommand};
+
+use super::exit::bad_input;
+
+#[derive(Debug, Subcommand)]
+pub enum SessionCommand {
+    Import(Box<ImportArgs>),
+    Verify(VerifyArgs),
+}
+
+/// Turn a folder of hand-taken JPEG brackets into a session that `campanile process` takes.
+///
+/// Every file of FOLDER must be a JPEG with EXIF (hidden files are passed
+/// over). The photographs are put in time order (DateTimeOriginal,
+/// SubSecTimeOriginal, then name) and grouped into brackets: consecutive
+/// frames at one focal length and aperture, each starting within
+/// --bracket-gap-s of the previous frame's end, no exposure twice (the same
+/// exposure again starts the next bracket). The grouping is printed as a
+/// table. A lone frame is refused (one JPEG cannot calibrate the response,
+/// and its clipped highlights would pass for radiance) unless --skip-single
+/// leaves it out.
+///
+///   time       DateTimeOriginal at OffsetTimeOriginal (or --utc-offset), less
+///              --clock-offset-s (camera clock minus true time); both must be
+///              stated: a wrong time is a wrong sun
+///   exposure   ExposureTime (or --times), and the effective time
+///              t·(ISO/ISO₀)·(N₀/N)² that the journal's exposure_actual_s holds
+///   poses      --poses POSES.ron, per bracket (first file name or pattern):
+///              a pose of --scene, or azimuth/elevation (and position)
+///   sky        brackets marked sky: true in the poses, or by --sky PATTERN:
+///              processed as a sky scan
+///   camera     --station STATION.ron (calibrated), or estimated from EXIF
+///              (focal length and pixel pitch) at --site LAT,LON[,ELEV_M]
+///
+/// The frames are copied byte for byte into SESSION/frames and journaled
+/// with their CRCs; SESSION/import.json records where every value came from
+/// and what was estimated, which `process` repeats in its verdicts.
+///
+/// POSES.ron:
+///   ImportPoses(brackets: [
+///       (files: "IMG_6955.JPG", pose: "view-se"),
+///       (files: "IMG_70*.JPG", position_m: (12.0, -30.0, 1.6), azimuth_deg: 20.0, elevation_deg: 8.0),
+///       (files: "SKY_*.JPG", sky: true, azimuth_deg: 0.0, elevation_deg: 90.0),
+///   ])
+///
+/// Exit status: 0 imported; 1 failure while working; 2 bad input (a file
+/// that is not a JPEG or has no EXIF, a missing tag or option, mixed
+/// cameras, a lone frame, an output directory that exists or cannot be made).
+///
+/// Example:
+///   campanile session import photos/ --out tower-session --clock-offset-s 0 --utc-offset +02:00 \
+///       --poses poses.ron --scene tower-scene.ron --site 45.4371,12.3326,5
+///   campanile process tower-session --out tower-processed
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub struct ImportArgs {
+    /// The folder of camera files.
+    #[arg(value_name = "FOLDER")]
+    folder: PathBuf,
+    /// The session directory to make (absent or empty).
+    #[arg(long, value_name = "SESSION")]
+    out: PathBuf,
+    /// The camera's clock minus the true time, seconds (0 if checked right). Required.
+    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    clock_offset_s: Option<f64>,
+    /// The camera clock's offset from UTC, for files without OffsetTimeOriginal (e.g. +02:00).
+    #[arg(long, value_name = "+HH:MM", allow_hyphen_values = true, value_parser = utc_offset)]
+    utc_offset: Option<chrono::FixedOffset>,
+    /// Largest gap from one frame's end to the next frame's start within a bracket, seconds.
+    #[arg(long, value_name = "S", default_value_t = 10.0)]
+    bracket_gap_s: f64,
+    /// Largest gap between brackets taken under one light (one occurrence), minutes.
+    #[arg(long, value_name = "MIN", default_value_t = 15.0)]
+    occurrence_gap_min: f64,
+    /// Exposure times for files without ExposureTime (CSV `file,time`, or `NAME TIME` lines).
+    #[arg(long, value_name = "FILE")]
+    times: Option<PathBuf>,
+    /// The poses of the brackets (see above).
+    #[arg(long, value_name = "POSES.ron")]
+    poses: Option<PathBuf>,
+    /// The scene (its named poses, its geometry for the outdoor stages).
+    #[arg(long, value_name = "SCENE.ron")]
+    scene: Option<PathBuf>,
+    /// The station: a calibrated camera and the site. Default: estimated from EXIF at --site.
+    #[arg(long, value_name = "STATION.ron")]
+    station: Option<PathBuf>,
+    /// The site when no --station is given: latitude, longitude (degrees), elevation (m).
+    #[arg(long, value_name = "LAT,LON[,ELEV_M]", allow_hyphen_values = true)]
+    site: Option<SiteGiven>,
+    /// Brackets of the sky, by their first file's name (`*` and `?`); repeatable.
+    #[arg(long, value_name = "PATTERN")]
+    sky: Vec<String>,
+    /// Leave lone frames out (listed) instead of refusing them.
+    #[arg(long)]
+    skip_single: bool,
+}
+
+/// Check every frame of a session: present, its journaled size and CRC-32C, decodable at its journaled size.
+///
+/// Exit status: 0 every frame intact; 2 a frame missing or damaged (listed), or not a session.
+///
+/// Example:
+///   campanile session verify tower-session
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub struct VerifyArgs {
+    /// The session directory.
+    #[arg(value_name = "SESSION")]
+    session: PathBuf,
+}
+
+fn utc_offset(s: &str) -> Result<chrono::FixedOffset, String> {
+    campanile_capture::import::camera_file::parse_utc_offset(s)
+        .ok_or_else(|| format!("{s:?}: expected an offset from UTC, +HH:MM or -HH:MM (e.g. +02:00)"))
+}
+
+fn import_error(e: ImportError) -> anyhow::Error {
+    if e.is_bad_input() {
+        bad_input(e.to_string())
+    } else {
+        anyhow::Error::new(e)
+    }
+}
+
+pub fn run(command: SessionCommand) -> Result<()> {
+    match command {
+        SessionCommand::Import(args) => import(*args),
+        SessionCommand::Verify(args) => verify(args),
+    }
+}
+
+fn import(args: ImportArgs) -> Result<()> {
+    if !(args.occurrence_gap_min.is_finite() && args.occurrence_gap_min >= 0.0) {
+        return Err(bad_input(format!(
+            "--occurrence-gap-min {}: expected minutes ≥ 0",
+            args.occurrence_gap_min
+        )));
+    }
+    let opts = ImportOptions {
+        folder: args.folder.clone(),
+        bracket_gap_s: args.bracket_gap_s,
+        occurrence_gap_s: args.occurrence_gap_min * 60.0,
+        clock: ClockSettings {
+            clock_offset_s: args.clock_offset_s,
+            utc_offset: args.utc_offset,
+        },
+        times: args.times,
+        poses: args.poses,
+        scene: args.scene,
+        station: args.station,
+        site: args.site,
+        sky: args.sky,
+        skip_single: args.skip_single,
+    };
+    let bar = super::process::bar(0, "reading EXIF");
+    let plan = plan_import(&opts, &|i, n| {
+        bar.set_length(n as u64);
+        bar.set_position(i as u64);
+    })
+    .map_err(import_error)?;
+    bar.finish_and_clear();
+    let bar = super::process::bar(0, "copying frames");
+    let record = write_session(&plan, &args.out, &|i, n| {
+        bar.set_length(n as u64);
+        bar.set_position(i as u64);
+    })
+    .map_err(import_error)?;
+    bar.finish_and_clear();
+
+    outln!(
+        "imported {} → {}: {} brackets, {} frames, camera {} (station {})",
+        args.folder.display(),
+        args.out.display(),
+        record.brackets.len(),
+        record.brackets.iter().map(|b| b.frames.len()).sum::<usize>(),
+        record.camera,
+        record.station_from
+    )?;
+    outln!(
+        "{:<28} {:<5} {:>3}  {:<16} {:<16} {:<26} {:<20} began",
+        "group",
+        "kind",
+        "n",
+        "first",
+        "last",
+        "start (UTC)",
+        "exposures (s)"
+    )?;
+    for b in &record.brackets {
+        let (first, last) = (&b.frames[0], &b.frames[b.frames.len() - 1]);
+        let exposures: Vec<f64> = b.frames.iter().map(|f| f.exposure_time_s).collect();
+        let lo = exposures.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = exposures.iter().copied().fold(0.0, f64::max);
+        outln!(
+            "{:<28} {:<5} {:>3}  {:<16} {:<16} {:<26} {:<20} {}",
+            b.group,
+            b.purpose,
+            b.frames.len(),
+            first.file,
+            last.file,
+            first.utc,
+            format!("{lo}…{hi}"),
+            if b.began.is_empty() { "first" } else { &b.began }
+        )?;
+    }
+    for s in &record.skipped {
+        outln!("left out: {s}")?;
+    }
+    for p in &plan.unused_poses {
+        outln!("warning: poses entry {p:?} matches no bracket's first file")?;
+    }
+    for e in &record.estimated {
+        outln!("estimated ({}): {}", e.what, e.how)?;
+    }
+    Ok(())
+}
+
+fn verify(args: VerifyArgs) -> Result<()> {
+    let reader = SessionReader::open(&args.session).map_err(|e| bad_input(e.to_string()))?;
+    let mut problems = Vec::new();
+    let mut checked = 0;
+    for f in reader.frames() {
+        checked += 1;
+        if let Err(e) = reader.read_frame(f) {
+            problems.push(e.to_string());
+        }
+    }
+    outln!(
+        "{}: {checked} frames checked, {} damaged or missing",
+        args.session.display(),
+        problems.len()
+    )?;
+    for p in &problems {
+        outln!("  {p}")?;
+    }
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        Err(bad_input(format!(
+            "{}: {} of {checked} frames damaged or missing (listed above)",
+            args.session.display(),
+            problems.len()
+        )))
+    }
+}
