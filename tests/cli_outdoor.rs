@@ -70,6 +70,7 @@ const SCENE: &str = r#"Scene(
         (name: "ground", groups: ["ground"], material: "ground"),
         (name: "neighbour", groups: ["n-south", "n-north", "n-east", "n-west", "n-roof"], material: "neighbour"),
     ],
+    poses: [(name: "south", position_m: (3.0, -24.0, 1.6), azimuth_deg: 353.0, elevation_deg: 3.3)],
 )
 "#;
 
@@ -346,6 +347,40 @@ fn simulated_site_recovers_and_renders_a_held_out_time() {
         eprintln!("{surface}: rho_se median error {:.2} %", 100.0 * m);
         assert!(m < 0.03, "{surface}: median rho_se error {m}\n{stdout}");
     }
+
+    // `campanile render` takes the materials as it takes `process`'s.
+    let o = campanile(&[
+        "render",
+        "--scene",
+        s(&dir.join("scene.ron")),
+        "--station",
+        "examples/sim-station.ron",
+        "--materials",
+        s(&rec.join("albedo/materials.ron")),
+        "--pose",
+        "south",
+        "--time",
+        "2026-06-21T22:00:00Z",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--out",
+        s(&out.path().join("render")),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let exr: Vec<_> = std::fs::read_dir(out.path().join("render"))
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.path().extension().is_some_and(|x| x == "exr"))
+        .collect();
+    assert_eq!(exr.len(), 1, "one render-<time>.exr");
 
     let renders = out.path().join("renders");
     let o = campanile(&[
