@@ -198,10 +198,18 @@ fn make_site(dir: &Path) {
         let stamp = time.format("%H%M");
         std::fs::write(dir.join(format!("skies/{stamp}.ron")), sky_file(&sky)).unwrap();
         let e = sky.sun_irradiance;
+        let sun = if k == 0 {
+            // The first time's sun as a filtered photograph of the disc.
+            write_sun_image(&dir.join("images/sun.exr"), e);
+            format!(
+                "Disc(image: \"images/sun.exr\", vfov_deg: {SUN_VFOV_DEG}, transmittance: Some(({SUN_ND}, {SUN_ND}, {SUN_ND})))"
+            )
+        } else {
+            format!("Irradiance(({}, {}, {}))", e[0], e[1], e[2])
+        };
         writeln!(
             light,
-            "        (time: {t:?}, sun: Irradiance(({}, {}, {})), sky: File(\"skies/{stamp}.ron\")),",
-            e[0], e[1], e[2]
+            "        (time: {t:?}, sun: {sun}, sky: File(\"skies/{stamp}.ron\")),"
         )
         .unwrap();
         for (name, p, at) in CAMERAS {
@@ -248,6 +256,45 @@ fn make_site(dir: &Path) {
         ),
     )
     .unwrap();
+}
+
+const SUN_VFOV_DEG: f64 = 2.0;
+const SUN_ND: f64 = 1e-4;
+
+/// A filtered HDR photograph of a disc of irradiance `e` (0.2666° radius,
+/// 8 × 8 sub-samples per pixel) at the centre of a 64 × 64 pinhole frame
+/// spanning `SUN_VFOV_DEG`, over a faint sky.
+fn write_sun_image(path: &Path, e: [f64; 3]) {
+    let (w, h) = (64usize, 64usize);
+    let f = 0.5 * h as f64 / (0.5 * SUN_VFOV_DEG.to_radians()).tan();
+    let radius = 0.2666f64.to_radians();
+    let omega = std::f64::consts::TAU * (1.0 - radius.cos());
+    let mut data = Vec::with_capacity(w * h * 3);
+    for y in 0..h {
+        for x in 0..w {
+            let mut inside = 0.0;
+            for a in 0..8 {
+                for b in 0..8 {
+                    let u = (x as f64 + (a as f64 + 0.5) / 8.0 - 0.5 * w as f64) / f;
+                    let v = (y as f64 + (b as f64 + 0.5) / 8.0 - 0.5 * h as f64) / f;
+                    if (u * u + v * v).sqrt().atan() < radius {
+                        inside += 1.0 / 64.0;
+                    }
+                }
+            }
+            for c in 0..3 {
+                data.push((SUN_ND * (e[c] / omega * inside + 300.0)) as f32);
+            }
+        }
+    }
+    write_exr(
+        &RadianceImage {
+            width: w,
+            height: h,
+            data,
+        },
+        path,
+    );
 }
 
 fn write_exr(img: &RadianceImage, path: &Path) {
@@ -334,6 +381,22 @@ fn simulated_site_recovers_and_renders_a_held_out_time() {
         "recovery.json",
     ] {
         assert!(rec.join(f).is_file(), "{f} missing");
+    }
+    // The sun measured from its photograph at the first time: within 1 %.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(rec.join("outdoor.json")).unwrap()).unwrap();
+    let first = &json["light"][0];
+    assert!(
+        first["sun_irradiance_from"]
+            .as_str()
+            .unwrap()
+            .starts_with("measured from"),
+        "{first}"
+    );
+    let want = sky_at(TIMES[0].parse().unwrap()).sun_irradiance;
+    for c in 0..3 {
+        let got = first["sun_irradiance"][c].as_f64().unwrap();
+        assert!((got / want[c] - 1.0).abs() < 0.01, "channel {c}: {got} vs {}", want[c]);
     }
     let cells = cells(&rec);
     for (surface, truth) in [("south-wall", BRICK), ("west-wall", PLASTER)] {

@@ -255,9 +255,10 @@ fn recover(args: RecoverArgs) -> Result<()> {
     }
     for l in &light_set {
         albedo = albedo.with_note(format!(
-            "{}: sun irradiance {:?} W/m² as given (not measured here), its direction {}",
+            "{}: sun irradiance {:?} W/m² ({}), its direction {}",
             l.time.to_rfc3339(),
             l.sky.measured.sun_irradiance,
+            l.sun_source,
             l.sun_direction_source
         ));
     }
@@ -304,6 +305,7 @@ fn recover(args: RecoverArgs) -> Result<()> {
             "sun_direction": l.sky.measured.sun_direction,
             "sun_direction_from": l.sun_direction_source,
             "sun_irradiance": l.sky.measured.sun_irradiance,
+            "sun_irradiance_from": l.sun_source,
             "below_horizon": l.sky.below_horizon,
             "sky": l.sky_source,
         })).collect::<Vec<_>>(),

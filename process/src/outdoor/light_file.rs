@@ -12,7 +12,8 @@
 //!         (time: "2026-06-21T08:00:00Z", sun: Irradiance((830.0, 810.0, 760.0)),
 //!          sky: File("skies/0800.ron"), below_horizon: Some((30.0, 29.0, 31.0))),
 //!         (time: "2026-06-21T12:00:00Z", sun_direction: Some((azimuth_deg: 180.0, zenith_deg: 14.5)),
-//!          sun: Hidden, sky: Image(image: "skies/1200-fisheye.hdr", view: "from-image")),
+//!          sun: Disc(image: "sun-1200.exr", vfov_deg: 4.0, transmittance: Some((1e-5, 1e-5, 1e-5))),
+//!          sky: Image(image: "skies/1200-fisheye.hdr", view: "from-image")),
 //!     ],
 //! )
 //! ```
@@ -27,6 +28,7 @@ use crate::igi::scene_file::SceneFileError;
 use nalgebra::Vector3;
 
 use crate::pipeline::MeasuredSky;
+use crate::radiance_file::read_radiance_image;
 use crate::render::{Sky, SolarDisc};
 use crate::sky::{ChannelSky, SkyFile, angle_between, direction};
 use crate::sun::{Observer, sun_position};
@@ -55,13 +57,86 @@ pub struct SunDirectionEntry {
 }
 
 /// The solar disc.
-#[derive(Debug, Clone, Copy, Deserialize)]
+#[derive(Debug, Clone, Deserialize)]
 pub enum SunEntry {
     /// The disc's irradiance on a plane normal to the sun, W·m⁻² per
     /// channel (r, g, b), in the photos' radiance units times sr.
     Irradiance((f64, f64, f64)),
+    /// A photograph of the disc to integrate (thesis §5.3.1,
+    /// [`crate::sun::measure_sun`]): an HDR radiance image (OpenEXR, RGBE,
+    /// PFM) from a rectified pinhole camera, principal point at the image
+    /// centre, taken through a filter of the given transmittance per
+    /// channel (a neutral-density filter: 1e-5 for ND 5.0).
+    Disc {
+        /// The image.
+        image: PathBuf,
+        /// Vertical field of view, degrees (or `hfov_deg`).
+        #[serde(default)]
+        vfov_deg: Option<f64>,
+        /// Horizontal field of view, degrees (or `vfov_deg`).
+        #[serde(default)]
+        hfov_deg: Option<f64>,
+        /// The filter's transmittance per channel, in (0, 1]; absent: none.
+        #[serde(default)]
+        transmittance: Option<(f64, f64, f64)>,
+    },
     /// No direct sunlight (clouds over the disc, or the sun set).
     Hidden,
+}
+
+/// The normal irradiance per channel integrated from a sun photograph;
+/// `Err((value, expected))` names what was wrong.
+fn measured_disc(
+    base: &Path,
+    image: &Path,
+    fov: (Option<f64>, Option<f64>),
+    transmittance: Option<(f64, f64, f64)>,
+    time: DateTime<Utc>,
+) -> Result<[f64; 3], SceneFileError> {
+    let full = base.join(image);
+    let file_err = |message: String| SceneFileError::File {
+        path: full.clone(),
+        message,
+    };
+    let picture = read_radiance_image(&full).map_err(|e| file_err(e.message))?;
+    let img = &picture.image;
+    let half = |deg: f64| (0.5 * deg.to_radians()).tan();
+    let focal_px = match fov {
+        (Some(v), None) if v > 0.0 && v < 180.0 => 0.5 * img.height as f64 / half(v),
+        (None, Some(h)) if h > 0.0 && h < 180.0 => 0.5 * img.width as f64 / half(h),
+        _ => {
+            return Err(file_err(format!(
+                "the sun's camera: vfov_deg {:?}, hfov_deg {:?}: expected exactly one field of view in (0, 180) degrees",
+                fov.0, fov.1
+            )));
+        }
+    };
+    let (tr, tg, tb) = transmittance.unwrap_or((1.0, 1.0, 1.0));
+    let expected_sr = crate::sun::Ephemeris::at(time, None)
+        .map(|e| crate::sun::sun_solid_angle_sr(e.earth_sun_distance_au()))
+        .map_err(|e| file_err(format!("the sun's solid angle at {time}: {e}")))?;
+    let mut out = [0.0; 3];
+    for (c, t) in [tr, tg, tb].into_iter().enumerate() {
+        if !(t > 0.0 && t <= 1.0) {
+            return Err(file_err(format!(
+                "transmittance {t} in channel {c}: expected a value in (0, 1]"
+            )));
+        }
+        let channel: Vec<f32> = img.data.iter().skip(c).step_by(3).copied().collect();
+        let frame = crate::sun::SunFrame {
+            width: img.width,
+            height: img.height,
+            radiance: &channel,
+            clipped: None,
+            focal_px,
+            principal_px: (0.5 * img.width as f64, 0.5 * img.height as f64),
+            transmittance: t,
+        };
+        let disc = crate::sun::measure_sun(&frame, expected_sr)
+            .map_err(|e| file_err(format!("channel {}: {e}", ["r", "g", "b"][c])))?;
+        out[c] = disc.irradiance;
+    }
+    Ok(out)
 }
 
 /// The sky.
@@ -124,6 +199,9 @@ pub struct TimeLight {
     pub sun_direction_source: &'static str,
     /// Where the sky came from (the file, or the image fitted).
     pub sky_source: String,
+    /// Where the sun's irradiance came from: `given`, `hidden`, or
+    /// `measured from IMAGE`.
+    pub sun_source: String,
 }
 
 /// A measured sky with a uniform radiance below the horizon.
@@ -289,9 +367,32 @@ pub fn load_light(path: &Path) -> Result<Vec<TimeLight>, SceneFileError> {
             ));
         }
         let models = [channels[0].model, channels[1].model, channels[2].model];
-        let sun_irradiance = match t.sun {
+        let sun_source = match &t.sun {
+            SunEntry::Irradiance(_) => "given".to_string(),
+            SunEntry::Hidden => "hidden".to_string(),
+            SunEntry::Disc { image, .. } => format!("measured from {}", base.join(image).display()),
+        };
+        let sun_irradiance = match &t.sun {
             SunEntry::Hidden => [0.0; 3],
-            SunEntry::Irradiance((r, g, b)) => {
+            SunEntry::Disc {
+                image,
+                vfov_deg,
+                hfov_deg,
+                transmittance,
+            } => {
+                if sun_dir[2] <= 0.0 {
+                    return Err(field(
+                        at("sun"),
+                        format!(
+                            "Disc with the sun {:.2}° below the horizon",
+                            -(sun_dir[2].asin().to_degrees())
+                        ),
+                        "Hidden when the sun is below the horizon",
+                    ));
+                }
+                measured_disc(base, image, (*vfov_deg, *hfov_deg), *transmittance, t.time)?
+            }
+            &SunEntry::Irradiance((r, g, b)) => {
                 if ![r, g, b].iter().all(|e| e.is_finite() && *e >= 0.0) {
                     return Err(field(
                         at("sun"),
@@ -337,6 +438,7 @@ pub fn load_light(path: &Path) -> Result<Vec<TimeLight>, SceneFileError> {
             channels,
             sun_direction_source: source,
             sky_source,
+            sun_source,
         });
     }
     Ok(out)
