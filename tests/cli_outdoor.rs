@@ -282,8 +282,8 @@ fn write_sun_image(path: &Path, e: [f64; 3]) {
                     }
                 }
             }
-            for c in 0..3 {
-                data.push((SUN_ND * (e[c] / omega * inside + 300.0)) as f32);
+            for ec in e {
+                data.push((SUN_ND * (ec / omega * inside + 300.0)) as f32);
             }
         }
     }
