@@ -376,3 +376,295 @@ fn simulated_site_recovers_and_renders_a_held_out_time() {
         assert!(renders.join(v["file"].as_str().unwrap()).is_file());
     }
 }
+
+// ---------------------------------------------------------------- RADIANCE
+
+/// The RADIANCE building of `validation/outdoor` (rpict, -ab 5, gendaylit
+/// per channel; README there): committed fixtures, no renderer needed.
+fn radiance() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/outdoor/fixtures")
+}
+
+/// The truth's reflectance (green) at a world point of `surface`.
+fn truth_green(truth: &serde_json::Value, surface: &str, p: [f64; 3]) -> f64 {
+    let entry = truth["surfaces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["name"] == surface)
+        .unwrap_or_else(|| panic!("no truth for {surface}"));
+    let Some(tex) = entry.get("texture") else {
+        return entry["rho"][1].as_f64().unwrap();
+    };
+    let v = |k: &str| -> [f64; 3] { [0, 1, 2].map(|i| tex[k][i].as_f64().unwrap()) };
+    let (o, sa, ta) = (v("origin_m"), v("s_axis"), v("t_axis"));
+    let rel = [p[0] - o[0], p[1] - o[1], p[2] - o[2]];
+    let dot = |a: [f64; 3]| rel[0] * a[0] + rel[1] * a[1] + rel[2] * a[2];
+    let px = tex["pixel_m"].as_f64().unwrap();
+    let (w, h) = (tex["width"].as_i64().unwrap(), tex["height"].as_i64().unwrap());
+    let i = ((dot(sa) / px).floor() as i64).clamp(0, w - 1) as usize;
+    let j = ((dot(ta) / px).floor() as i64).clamp(0, h - 1) as usize;
+    let level = tex["index"][j][i].as_u64().unwrap() as usize;
+    tex["levels"][level][1].as_f64().unwrap()
+}
+
+/// Median and p95 of |ρ/ρ_true − 1| (green) over every cell, ρ_se then
+/// ρ_sun, the truth averaged over each cell's points (cell_points.csv).
+fn radiance_errors(out: &Path) -> (f64, f64, f64, f64) {
+    let truth: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(radiance().join("truth.json")).unwrap()).unwrap();
+    let cells = cells(out);
+    let points = std::fs::read_to_string(out.join("cell_points.csv")).unwrap();
+    let mut sums = vec![(0.0, 0usize); cells.len()];
+    for line in points.lines().skip(1) {
+        let f: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        let k = f[0] as usize;
+        sums[k].0 += truth_green(&truth, &cells[k].0, [f[1], f[2], f[3]]);
+        sums[k].1 += 1;
+    }
+    let (mut se, mut sun) = (Vec::new(), Vec::new());
+    for (c, (sum, n)) in cells.iter().zip(&sums) {
+        assert!(*n > 0, "a cell without points");
+        let t = sum / *n as f64;
+        se.push((c.3[1] / t - 1.0).abs());
+        sun.push((c.2[1] / t - 1.0).abs());
+    }
+    let q = |mut v: Vec<f64>, p: f64| {
+        v.sort_by(f64::total_cmp);
+        v[((v.len() - 1) as f64 * p).round() as usize]
+    };
+    (q(se.clone(), 0.5), q(se, 0.95), q(sun.clone(), 0.5), q(sun, 0.95))
+}
+
+fn recover(light: &Path, out: &Path) -> std::process::Output {
+    let f = radiance();
+    campanile(&[
+        "outdoor",
+        "recover",
+        "--scene",
+        s(&f.join("scene.ron")),
+        "--photos",
+        s(&f.join("photos.ron")),
+        "--light",
+        s(light),
+        "--out",
+        s(out),
+        "--grid-spacing",
+        "1",
+    ])
+}
+
+/// The issue's bounds on RADIANCE's building, through the commands: the
+/// pseudo-albedos within 2 % median of RADIANCE's reflectances (measured
+/// ρ_se 0.53 %, p95 3.7 %; ρ_sun 0.24 %, p95 1.7 %), with the sky given as
+/// gendaylit's coefficients and as fitted from RADIANCE's fisheye images
+/// (ρ_se 1.2 %); and the held-out time (14:30) within 3 % per 4×4 block of
+/// RADIANCE's render in every view (measured 0.3–2.3 %), rendered as rpict
+/// samples (one ray per pixel centre). Without the landscape below the
+/// horizon (RADIANCE's ground glow beyond the ground plane) ρ_se is 2.7 %
+/// high: the model needs it.
+#[test]
+fn radiance_building_within_the_issue_bounds() {
+    let f = radiance();
+    let tmp = tempfile::tempdir().unwrap();
+    let rec = tmp.path().join("rec");
+    let o = recover(&f.join("light.ron"), &rec);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let (se, se95, sun, sun95) = radiance_errors(&rec);
+    eprintln!(
+        "RADIANCE building: rho_se median {:.2} % p95 {:.2} %, rho_sun median {:.2} % p95 {:.2} %",
+        100.0 * se,
+        100.0 * se95,
+        100.0 * sun,
+        100.0 * sun95
+    );
+    assert!(se < 0.02 && sun < 0.02, "rho_se {se}, rho_sun {sun}");
+
+    let renders = tmp.path().join("renders");
+    let o = campanile(&[
+        "outdoor",
+        "render",
+        s(&rec),
+        "--photos",
+        s(&f.join("photos-heldout.ron")),
+        "--light",
+        s(&f.join("light.ron")),
+        "--out",
+        s(&renders),
+        "--pixel-samples",
+        "1",
+    ]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(renders.join("render.json")).unwrap()).unwrap();
+    let views = json["views"].as_array().unwrap();
+    assert_eq!(views.len(), 4);
+    for v in views {
+        let r = v["rmse_block_4x4"].as_f64().unwrap();
+        eprintln!("held out {}: {:.2} % per 4x4 block", v["view"], 100.0 * r);
+        assert!(r < 0.03, "{v}");
+    }
+
+    // The sky fitted from RADIANCE's fisheye pictures of it.
+    let fish = tmp.path().join("fish");
+    let o = recover(&f.join("light-fisheye.ron"), &fish);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stdout));
+    let (se_f, _, sun_f, _) = radiance_errors(&fish);
+    eprintln!(
+        "fisheye skies: rho_se {:.2} %, rho_sun {:.2} %",
+        100.0 * se_f,
+        100.0 * sun_f
+    );
+    assert!(se_f < 0.02 && sun_f < 0.02, "rho_se {se_f}, rho_sun {sun_f}");
+
+    // The same light without the landscape below the horizon.
+    let bare = tmp.path().join("bare");
+    std::fs::create_dir_all(&bare).unwrap();
+    let text = std::fs::read_to_string(f.join("light.ron")).unwrap();
+    let stripped: String = text
+        .lines()
+        .filter(|l| !l.contains("below_horizon"))
+        .map(|l| l.replace("skies/", &format!("{}/skies/", f.display())) + "\n")
+        .collect();
+    std::fs::write(bare.join("light.ron"), stripped).unwrap();
+    let o = recover(&bare.join("light.ron"), &tmp.path().join("bare-out"));
+    assert_eq!(o.status.code(), Some(0));
+    let (se_b, _, _, _) = radiance_errors(&tmp.path().join("bare-out"));
+    eprintln!("without below_horizon: rho_se {:.2} %", 100.0 * se_b);
+    assert!(
+        se_b > 0.02 && se_b > 3.0 * se,
+        "rho_se {se_b} without the ground glow, {se} with"
+    );
+}
+
+/// Runs `outdoor recover` on the RADIANCE building with one file replaced
+/// by `edit` of it; returns the exit code and stderr.
+fn recover_edited(file: &str, edit: &dyn Fn(String) -> String) -> (Option<i32>, String) {
+    let f = radiance();
+    let tmp = tempfile::tempdir().unwrap();
+    // Copy the small files; point at the fixture's images and skies.
+    for name in [
+        "scene.ron",
+        "photos.ron",
+        "light.ron",
+        "light-fisheye.ron",
+        "building.obj",
+    ] {
+        let mut text = std::fs::read_to_string(f.join(name)).unwrap();
+        for dir in ["views/", "masks/", "skies/"] {
+            text = text.replace(&format!("\"{dir}"), &format!("\"{}/{dir}", f.display()));
+        }
+        if name == file {
+            text = edit(text);
+        }
+        std::fs::write(tmp.path().join(name), text).unwrap();
+    }
+    let light = if file == "light-fisheye.ron" {
+        "light-fisheye.ron"
+    } else {
+        "light.ron"
+    };
+    let o = campanile(&[
+        "outdoor",
+        "recover",
+        "--scene",
+        s(&tmp.path().join("scene.ron")),
+        "--photos",
+        s(&tmp.path().join("photos.ron")),
+        "--light",
+        s(&tmp.path().join(light)),
+        "--out",
+        s(&tmp.path().join("out")),
+    ]);
+    (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+/// A file to edit, the edit, and what the error must say.
+type BadCase = (&'static str, Box<dyn Fn(String) -> String>, &'static [&'static str]);
+
+/// Bad input exits 2 naming the file, the field and what was expected.
+#[test]
+fn bad_outdoor_files_exit_2_naming_the_field() {
+    let cases: Vec<BadCase> = vec![
+        (
+            "scene.ron",
+            Box::new(|t| {
+                t.replace(
+                    "(name: \"ground\", model: Diffuse, albedo: (0.20, 0.19, 0.17))",
+                    "(name: \"ground\", model: Diffuse)",
+                )
+            }),
+            &["scene.ron", "materials[3].albedo", "known diffuse albedo"],
+        ),
+        (
+            "photos.ron",
+            Box::new(|t| t.replacen("2026-06-21T15:10:27Z", "2026-06-21T16:10:27Z", 1)),
+            &["south-west@2026-06-21T16:10:27Z", "no light within 120 s"],
+        ),
+        (
+            "photos.ron",
+            Box::new(|t| t.replacen("camera: \"south-west\"", "camera: \"south-wets\"", 1)),
+            &["photos[0].camera", "\"south-wets\"", "a camera named in cameras"],
+        ),
+        (
+            "light.ron",
+            Box::new(|t| t.replacen("azimuth_deg: 79.240148", "azimuth_deg: 85.0", 1)),
+            &["times[0].sky", "0700.ron", "apart, more than 1°"],
+        ),
+        (
+            "light.ron",
+            Box::new(|t| t.replacen("sun: Irradiance((939.983936", "sun: Irradiance((-939.983936", 1)),
+            &["times[0].sun", "finite irradiances >= 0"],
+        ),
+        (
+            "light-fisheye.ron",
+            Box::new(|t| {
+                t.replacen(
+                    "view: \"from-image\"",
+                    "view: \"-vtv -vd 0 0 1 -vu 0 1 0 -vh 60 -vv 60\"",
+                    1,
+                )
+            }),
+            &["times[0].sky.view", "-vta"],
+        ),
+    ];
+    for (file, edit, want) in cases {
+        let (code, stderr) = recover_edited(file, &*edit);
+        assert_eq!(code, Some(2), "{file}: {stderr}");
+        for w in want {
+            assert!(stderr.contains(w), "{file}: {w:?} not in:\n{stderr}");
+        }
+    }
+    // `outdoor render` on a directory `outdoor recover` did not write.
+    let tmp = tempfile::tempdir().unwrap();
+    let f = radiance();
+    let o = campanile(&[
+        "outdoor",
+        "render",
+        s(tmp.path()),
+        "--photos",
+        s(&f.join("photos-heldout.ron")),
+        "--light",
+        s(&f.join("light.ron")),
+        "--out",
+        s(&tmp.path().join("r")),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("recovery.json") && stderr.contains("outdoor recover"),
+        "{stderr}"
+    );
+}

@@ -48,7 +48,7 @@ pub enum OutdoorCommand {
 /// Writes to --out: albedo/materials.ron and its EXR atlases (what
 /// `campanile render --materials` and `outdoor render` read), cells.csv
 /// (each cell's pseudo-albedos, uncertainty and status), cell_points.csv
-/// (16 points over each cell), outdoor.json (diagnostics), quality.json
+/// (16 points over each cell, its centroid for a sliver), outdoor.json (diagnostics), quality.json
 /// (verdicts: the fit's residual, each sky's), recovery.json (the inputs,
 /// for `outdoor render`).
 ///
@@ -113,6 +113,13 @@ pub struct RenderArgs {
     /// The grid's pseudo-albedos alone: no texture from the training photographs.
     #[arg(long)]
     grid_only: bool,
+    /// Rays per pixel side (N × N per pixel, box filtered, as a camera
+    /// integrates its pixels; default 2). 1: one ray through each pixel centre, as a
+    /// renderer without anti-aliasing samples (RADIANCE's `rpict -ps 1
+    /// -pj 0`): compare like with like, or a building's edges count as
+    /// error.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=16))]
+    pixel_samples: Option<u16>,
     /// Quality thresholds (a `Quality(...)` RON file).
     #[arg(long, value_name = "FILE.ron")]
     thresholds: Option<PathBuf>,
@@ -250,7 +257,7 @@ fn recover(args: RecoverArgs) -> Result<()> {
         albedo = albedo.with_note(format!(
             "{}: sun irradiance {:?} W/m² as given (not measured here), its direction {}",
             l.time.to_rfc3339(),
-            l.sky.sun_irradiance,
+            l.sky.measured.sun_irradiance,
             l.sun_direction_source
         ));
     }
@@ -294,9 +301,10 @@ fn recover(args: RecoverArgs) -> Result<()> {
         "pixels": {"used": refl.sampling.used, "shadow_edge": refl.sampling.shadow_edge, "mirror": refl.sampling.mirror, "grazing": refl.sampling.grazing, "invalid": refl.sampling.invalid, "mixed": refl.sampling.mixed},
         "light": light_set.iter().map(|l| serde_json::json!({
             "time": l.time.to_rfc3339(),
-            "sun_direction": l.sky.sun_direction,
+            "sun_direction": l.sky.measured.sun_direction,
             "sun_direction_from": l.sun_direction_source,
-            "sun_irradiance": l.sky.sun_irradiance,
+            "sun_irradiance": l.sky.measured.sun_irradiance,
+            "below_horizon": l.sky.below_horizon,
             "sky": l.sky_source,
         })).collect::<Vec<_>>(),
         "diagnostics": refl.diagnostics,
@@ -399,7 +407,12 @@ fn write_cells(scene: &OutdoorScene, refl: &Reflectance, out: &Path) -> Result<(
             e.rms_relative,
             e.observations
         );
-        for p in refl.grid.cell_points(&scene.scene, k, 4) {
+        // A sliver of a cell may hold none of the 4 × 4 sub-samples: its centroid then.
+        let mut pts = refl.grid.cell_points(&scene.scene, k, 4);
+        if pts.is_empty() {
+            pts.push(c.centre);
+        }
+        for p in pts {
             let _ = writeln!(points, "{k},{:.6},{:.6},{:.6}", p.x, p.y, p.z);
         }
     }
@@ -472,8 +485,13 @@ fn render(args: RenderArgs) -> Result<()> {
                 .map(|(_, light)| Reference { photo: p, light })
         })
         .collect();
+    let defaults = RerenderSettings::default();
+    let settings = RerenderSettings {
+        samples_per_side: args.pixel_samples.map_or(defaults.samples_per_side, usize::from),
+        ..defaults
+    };
     let b = bar(views.len() as u64 + 1, "re-renders");
-    let sources = texture_sources(&scene.scene, &refl, &references, &RerenderSettings::default());
+    let sources = texture_sources(&scene.scene, &refl, &references, &settings);
     b.inc(1);
 
     std::fs::create_dir_all(&args.out).with_context(|| format!("{}: cannot create", args.out.display()))?;
@@ -484,7 +502,7 @@ fn render(args: RenderArgs) -> Result<()> {
             time: v.time,
             sky: &l.sky,
         };
-        let view = render_view(&scene.scene, &refl, &v.rig, &light, &sources);
+        let view = render_view(&scene.scene, &refl, &v.rig, &light, &sources, &settings);
         let path = args.out.join(format!("{}.exr", file_name(&v.label)));
         write_exr(&view.rendered, &path)?;
         let mut entry = serde_json::json!({

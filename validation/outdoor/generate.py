@@ -275,12 +275,14 @@ def write_light(out, path, entries, fisheye):
         sky = (f"Image(image: \"skies/{e['stem']}-fisheye.hdr\", view: \"from-image\")" if fisheye
                else f"File(\"skies/{e['stem']}.ron\")")
         es = e["e_sun"]
+        g = e["ground"]
         rows.append(
             "        (\n"
             f"            time: \"{e['utc']}\",\n"
             f"            sun_direction: Some((azimuth_deg: {e['az']!r}, zenith_deg: {e['zen']!r})),\n"
             f"            sun: Irradiance(({es[0]!r}, {es[1]!r}, {es[2]!r})),\n"
             f"            sky: {sky},\n"
+            f"            below_horizon: Some(({g[0]!r}, {g[1]!r}, {g[2]!r})),\n"
             "        ),"
         )
     (out / path).write_text(
@@ -422,7 +424,10 @@ def main():
         (out / "skies" / f"{stem}-skyonly.rad").write_text(sky_rad(sky, with_sun=False))
         with open(out / "skies" / f"{stem}-skyonly.oct", "wb") as f:
             subprocess.run(["oconv", f"skies/{stem}-skyonly.rad"], env=env, cwd=out, stdout=f, check=True)
-        entries.append(dict(stem=stem, utc=utc, az=round(az, 6), zen=round(zen, 6), e_sun=e_sun))
+        # The ground glow's brightness A2 per channel: what lies below the
+        # horizon beyond the ground plane (Campanile's `below_horizon`).
+        ground = [sky[ch]["args"][1] for ch in CHANNELS]
+        entries.append(dict(stem=stem, utc=utc, az=round(az, 6), zen=round(zen, 6), e_sun=e_sun, ground=ground))
         report["times"].append({
             "stem": stem, "solar_time_h": hour, "utc": utc, "sun_azimuth_deg": az, "sun_zenith_deg": zen,
             "sun_vector_printed": sv, "e_sun_normal": e_sun, "sky_check_max_rel": check,

@@ -17,7 +17,15 @@
 //!   non-target surface (ground, landscape: the *environment*) brings its
 //!   scene material's albedo times its direct irradiance over π; the sky
 //!   part of that is computed once per square of an environment lattice
-//!   whose spacing grows with the distance from the targets.
+//!   whose spacing grows with the distance from the targets;
+//! - **a second bounce through the environment**: each environment square
+//!   also gathers the light of the target cells it sees (as coefficients,
+//!   like the first bounce) and of the environment squares it sees (their
+//!   albedo times their sun and sky), and passes its albedo's share on.
+//!   The thesis stops at one bounce; across a narrow street from a sunlit
+//!   wall the light that wall sends back through its neighbour is a fifth
+//!   of the shadowed wall's `E_se` (`validation/outdoor`, RADIANCE `-ab 2`).
+//!   Light reaching a target through two target bounces is left out.
 //!
 //! `E_se = E_sky + E_bounce` is the irradiance of eq. (5.11)–(5.12)'s
 //! sky-and-environment term.
@@ -174,6 +182,14 @@ pub(super) fn env_sky(
     sky: &dyn Fn(&Vector3<f64>) -> [f64; 3],
     rays_per_side: usize,
 ) -> [f64; 3] {
+    let (p, n, seed) = env_point(scene, key, base_m);
+    let hidden = hidden_sky(scene, &p, &cosine_directions(&n, rays_per_side, seed), sky);
+    [0, 1, 2].map(|c| (open[c] - hidden[c]).max(0.0))
+}
+
+/// The centre of environment square `key`, its normal on the side seen,
+/// and the seed of its rays.
+fn env_point(scene: &Scene, key: EnvKey, base_m: f64) -> (Vector3<f64>, Vector3<f64>, u64) {
     let (ti, front, level, i, j) = key;
     let tri = &scene.triangles()[ti];
     let n = if front { tri.normal } else { -tri.normal };
@@ -183,12 +199,86 @@ pub(super) fn env_sky(
     let base = tri.vertices[0] - sa * st0[0] - ta * st0[1];
     let p = base + sa * ((i as f64 + 0.5) * k) + ta * ((j as f64 + 0.5) * k);
     let seed = (ti as u64) << 40 ^ (i as u64) << 20 ^ (j as u64) ^ (level as u64) << 60;
-    let hidden = hidden_sky(scene, &p, &cosine_directions(&n, rays_per_side, seed), sky);
-    [0, 1, 2].map(|c| (open[c] - hidden[c]).max(0.0))
+    (p, n, seed)
 }
 
-/// π/N Σ L_sky over the rays of `dirs` from `p` that meet the scene while
-/// pointing above the horizon: the sky irradiance the scene hides.
+/// What environment square `key`'s rays meet: target cells, as one-bounce
+/// coefficients of its irradiance (the form of [`CellLight::reflections`]),
+/// and other environment squares with their albedo and sun cosine (0 where
+/// the sun is hidden), each weighted by 1/N. The light the targets and the
+/// rest of the environment send to the environment, which it sends on to
+/// the targets: between a sunlit wall and a building across a narrow street
+/// this second bounce is a fifth of the shadowed wall's `E_se`
+/// (`validation/outdoor`, against RADIANCE's `rtrace -I -ab 2`).
+#[allow(clippy::too_many_arguments)]
+fn env_hits(
+    scene: &Scene,
+    grid: &Grid,
+    key: EnvKey,
+    base_m: f64,
+    rays_per_side: usize,
+    sun: Option<&SolarDisc>,
+    e_sun: [f64; 3],
+    sky: &[[f64; 3]],
+    centre: &Vector3<f64>,
+) -> EnvHits {
+    let (p, n, seed) = env_point(scene, key, base_m);
+    let dirs = cosine_directions(&n, rays_per_side, seed);
+    let rays = dirs.len().max(1) as f64;
+    let origin = offset(&p, &n);
+    let mut coef: HashMap<usize, ([f64; 3], [f64; 3])> = HashMap::new();
+    let mut environment = Vec::new();
+    for d in dirs {
+        let Some(h) = scene.intersect(&Ray { origin, direction: d }, f64::INFINITY) else {
+            continue;
+        };
+        let tri = &scene.triangles()[h.triangle];
+        let n_hit = if tri.normal.dot(&d) < 0.0 {
+            tri.normal
+        } else {
+            -tri.normal
+        };
+        let lit_cos = sun
+            .filter(|s| sun_visible(scene, s, &h.point, &n_hit))
+            .map_or(0.0, |s| n_hit.dot(&s.direction));
+        if let Some(vn) = grid.visible_normal(scene, h.triangle) {
+            let Some(cell) = grid.cell_at(scene, h.triangle, &h.point).filter(|_| vn.dot(&d) < 0.0) else {
+                continue;
+            };
+            let cos_j = sun.map_or(0.0, |s| vn.dot(&s.direction).max(0.0));
+            let e = coef.entry(cell).or_insert(([0.0; 3], [0.0; 3]));
+            for ch in 0..3 {
+                if lit_cos > 0.0 {
+                    e.0[ch] += e_sun[ch] * cos_j / rays;
+                }
+                e.1[ch] += sky[cell][ch] / rays;
+            }
+        } else {
+            let front = n_hit.dot(&tri.normal) > 0.0;
+            let albedo = scene.albedo_at(h.triangle, &h.point);
+            environment.push((
+                env_key(scene, h.triangle, &h.point, front, centre, base_m),
+                albedo.map(|a| a / rays),
+                lit_cos,
+            ));
+        }
+    }
+    let mut targets: Vec<(usize, [f64; 3], [f64; 3])> = coef.into_iter().map(|(k, (a, b))| (k, a, b)).collect();
+    targets.sort_by_key(|r| r.0);
+    EnvHits { targets, environment }
+}
+
+/// What an environment square's rays meet ([`env_hits`]).
+struct EnvHits {
+    /// Target cells: (cell, sun coefficient, sky coefficient).
+    targets: Vec<(usize, [f64; 3], [f64; 3])>,
+    /// Environment squares: (square, albedo / N, sun cosine or 0).
+    environment: Vec<(EnvKey, [f64; 3], f64)>,
+}
+
+/// π/N Σ L_sky over the rays of `dirs` from `p` that meet the scene: the
+/// sky irradiance the scene hides (below the horizon, the landscape's,
+/// [`crate::render::Sky::below_horizon`]; zero for most skies).
 fn hidden_sky(
     scene: &Scene,
     p: &Vector3<f64>,
@@ -197,7 +287,7 @@ fn hidden_sky(
 ) -> [f64; 3] {
     let n = dirs.len().max(1) as f64;
     let mut out = [0.0; 3];
-    for d in dirs.iter().filter(|d| d.z > 0.0) {
+    for d in dirs {
         let origin = p + d * 1e-6 * (1.0 + p.norm() * 1e-3);
         if scene.occluded(&Ray { origin, direction: *d }, f64::INFINITY) {
             let l = sky(d);
@@ -210,11 +300,17 @@ fn hidden_sky(
 }
 
 /// The unoccluded sky irradiance on a plane of unit normal `n` (App. B).
+/// With a uniform radiance `L_g` below the horizon ([`Sky::below_horizon`]),
+/// its part is added in closed form: the lower half-space seen from a
+/// plane of normal `n` gives `π L_g (1 − n_z) / 2`.
 pub(super) fn open_sky(light: &Illumination, n: &Vector3<f64>, subdivision: &SkySubdivision) -> [f64; 3] {
     let f = |d: [f64; 3]| light.sky.radiance(&Vector3::new(d[0], d[1], d[2]));
-    sky_irradiance(&Vector3::zeros(), n, &f, None, subdivision)
+    let sky = sky_irradiance(&Vector3::zeros(), n, &f, None, subdivision)
         .map(|s| s.rgb)
-        .unwrap_or([0.0; 3])
+        .unwrap_or([0.0; 3]);
+    let below = light.sky.below_horizon();
+    let k = std::f64::consts::PI * (1.0 - n.z.clamp(-1.0, 1.0)) / 2.0;
+    [0, 1, 2].map(|c| sky[c] + below[c] * k)
 }
 
 /// The light on every cell of `grid` under `light`.
@@ -249,7 +345,7 @@ pub fn gather(scene: &Scene, grid: &Grid, light: &Illumination, settings: &Gathe
                     let Some(h) = scene.intersect(&Ray { origin, direction: d }, f64::INFINITY) else {
                         return Hit::Sky;
                     };
-                    if d.z > 0.0 {
+                    {
                         let l = sky_of(&d);
                         for ch in 0..3 {
                             hidden[ch] += std::f64::consts::PI * l[ch] / (m * m) as f64;
@@ -312,6 +408,29 @@ pub fn gather(scene: &Scene, grid: &Grid, light: &Illumination, settings: &Gathe
         .collect();
     keys.sort_unstable();
     keys.dedup();
+    // What those squares see in turn: targets and other environment
+    // squares (the second bounce, target or environment → environment → target).
+    let e_sun = sun.map_or([0.0; 3], |s| s.normal_irradiance());
+    let second: HashMap<EnvKey, EnvHits> = keys
+        .par_iter()
+        .map(|&key| {
+            let h = env_hits(
+                scene,
+                grid,
+                key,
+                base_m,
+                settings.environment_rays_per_side,
+                sun.as_ref(),
+                e_sun,
+                &sky,
+                &centre,
+            );
+            (key, h)
+        })
+        .collect();
+    keys.extend(second.values().flat_map(|h| h.environment.iter().map(|e| e.0)));
+    keys.sort_unstable();
+    keys.dedup();
     let open_cache: HashMap<(usize, bool), [f64; 3]> = {
         let mut tris: Vec<(usize, bool)> = keys.iter().map(|k| (k.0, k.1)).collect();
         tris.dedup();
@@ -332,8 +451,21 @@ pub fn gather(scene: &Scene, grid: &Grid, light: &Illumination, settings: &Gathe
             (key, e)
         })
         .collect();
+    // The environment squares' irradiance from other environment squares.
+    let env_bounce: HashMap<EnvKey, [f64; 3]> = second
+        .iter()
+        .map(|(key, h)| {
+            let mut e = [0.0; 3];
+            for (k2, albedo_n, lit_cos) in &h.environment {
+                let es = env.get(k2).copied().unwrap_or([0.0; 3]);
+                for ch in 0..3 {
+                    e[ch] += albedo_n[ch] * (e_sun[ch] * lit_cos + es[ch]);
+                }
+            }
+            (*key, e)
+        })
+        .collect();
     // 4. Assemble.
-    let e_sun = sun.map_or([0.0; 3], |s| s.normal_irradiance());
     let rays = (m * m) as f64;
     let cells = grid
         .cells
@@ -357,8 +489,16 @@ pub fn gather(scene: &Scene, grid: &Grid, light: &Illumination, settings: &Gathe
                     }
                     Hit::Environment { key, albedo, lit_cos } => {
                         let es = env.get(key).copied().unwrap_or([0.0; 3]);
+                        let eb = env_bounce.get(key).copied().unwrap_or([0.0; 3]);
                         for ch in 0..3 {
-                            environment[ch] += albedo[ch] * (e_sun[ch] * lit_cos + es[ch]) / rays;
+                            environment[ch] += albedo[ch] * (e_sun[ch] * lit_cos + es[ch] + eb[ch]) / rays;
+                        }
+                        for (j, a_sun, a_sky) in second.get(key).map_or(&[][..], |h| h.targets.as_slice()) {
+                            let e = coef.entry(*j).or_insert(([0.0; 3], [0.0; 3]));
+                            for ch in 0..3 {
+                                e.0[ch] += albedo[ch] * a_sun[ch] / rays;
+                                e.1[ch] += albedo[ch] * a_sky[ch] / rays;
+                            }
                         }
                     }
                     Hit::Sky | Hit::Nothing => {}

@@ -10,7 +10,7 @@
 //!     site: Some((latitude_deg: 37.87, longitude_deg: -122.26, elevation_m: 60.0)),
 //!     times: [
 //!         (time: "2026-06-21T08:00:00Z", sun: Irradiance((830.0, 810.0, 760.0)),
-//!          sky: File("skies/0800.ron")),
+//!          sky: File("skies/0800.ron"), below_horizon: Some((30.0, 29.0, 31.0))),
 //!         (time: "2026-06-21T12:00:00Z", sun_direction: Some((azimuth_deg: 180.0, zenith_deg: 14.5)),
 //!          sun: Hidden, sky: Image(image: "skies/1200-fisheye.hdr", view: "from-image")),
 //!     ],
@@ -24,7 +24,10 @@ use serde::Deserialize;
 
 use super::sky_image::fit_fisheye_sky;
 use crate::igi::scene_file::SceneFileError;
+use nalgebra::Vector3;
+
 use crate::pipeline::MeasuredSky;
+use crate::render::{Sky, SolarDisc};
 use crate::sky::{ChannelSky, SkyFile, angle_between, direction};
 use crate::sun::{Observer, sun_position};
 
@@ -90,6 +93,11 @@ pub struct TimeEntry {
     pub sun: SunEntry,
     /// The sky.
     pub sky: SkyEntry,
+    /// The radiance below the horizon beyond the scene's geometry (the
+    /// distant landscape; RADIANCE's ground glow), W·m⁻²·sr⁻¹ per channel,
+    /// uniform; absent: none.
+    #[serde(default)]
+    pub below_horizon: Option<(f64, f64, f64)>,
 }
 
 /// The file.
@@ -109,13 +117,40 @@ pub struct TimeLight {
     /// When.
     pub time: DateTime<Utc>,
     /// Sky and sun as the renderer and the solver take them.
-    pub sky: MeasuredSky,
+    pub sky: PlainSky,
     /// The sky's channels as fitted (for their verdicts).
     pub channels: Vec<ChannelSky>,
     /// Where the sun's direction came from: `given`, `ephemeris` or `sky file`.
     pub sun_direction_source: &'static str,
     /// Where the sky came from (the file, or the image fitted).
     pub sky_source: String,
+}
+
+/// A measured sky with a uniform radiance below the horizon.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlainSky {
+    /// Sky and sun.
+    pub measured: MeasuredSky,
+    /// Radiance below the horizon, per channel.
+    pub below_horizon: [f64; 3],
+}
+
+impl Sky for PlainSky {
+    fn radiance(&self, d: &Vector3<f64>) -> [f64; 3] {
+        if d.z <= 0.0 {
+            self.below_horizon
+        } else {
+            self.measured.radiance(d)
+        }
+    }
+
+    fn sun(&self) -> Option<SolarDisc> {
+        self.measured.sun()
+    }
+
+    fn below_horizon(&self) -> [f64; 3] {
+        self.below_horizon
+    }
 }
 
 /// The sun's direction must agree with the sky file's within this (the
@@ -277,13 +312,27 @@ pub fn load_light(path: &Path) -> Result<Vec<TimeLight>, SceneFileError> {
                 [r, g, b]
             }
         };
+        let below_horizon = match t.below_horizon {
+            None => [0.0; 3],
+            Some((r, g, b)) if [r, g, b].iter().all(|v| v.is_finite() && *v >= 0.0) => [r, g, b],
+            Some((r, g, b)) => {
+                return Err(field(
+                    at("below_horizon"),
+                    format!("({r}, {g}, {b})"),
+                    "finite radiances >= 0 W/m²/sr per channel",
+                ));
+            }
+        };
         out.push(TimeLight {
             time: t.time,
-            sky: MeasuredSky {
-                sun_direction: sun_dir,
-                models,
-                sun_irradiance,
-                overcast: None,
+            sky: PlainSky {
+                measured: MeasuredSky {
+                    sun_direction: sun_dir,
+                    models,
+                    sun_irradiance,
+                    overcast: None,
+                },
+                below_horizon,
             },
             channels,
             sun_direction_source: source,

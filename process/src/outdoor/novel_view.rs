@@ -49,17 +49,20 @@ pub fn same_camera(a: &CameraRig, b: &CameraRig) -> bool {
         && (a.mount.pitch_rad - b.mount.pitch_rad).abs() < 1e-6
 }
 
-/// Renders `rig` under `light`. The texture comes from the sources taken
-/// by this very camera where there are any (exact pixel alignment), else
-/// from every source that sees the point; with no sources, the grid alone.
+/// Renders `rig` under `light` with `settings` (the sources' low-resolution
+/// renders should use the same pixel sampling). The texture comes from the
+/// sources taken by this very camera where there are any (exact pixel
+/// alignment), else from every source that sees the point; with no
+/// sources, the grid alone.
 pub fn render_view(
     scene: &Scene,
     refl: &Reflectance,
     rig: &CameraRig,
     light: &Illumination,
     sources: &[TextureSource],
+    settings: &RerenderSettings,
 ) -> NovelView {
-    let (grid_only, _) = rerender(scene, refl, rig, light, &RerenderSettings::default());
+    let (grid_only, _) = rerender(scene, refl, rig, light, settings);
     let same: Vec<&TextureSource> = sources.iter().filter(|s| same_camera(&s.photo.rig, rig)).collect();
     let chosen: Vec<&TextureSource> = if same.is_empty() {
         sources.iter().collect()

@@ -41,6 +41,14 @@ pub trait Sky: Sync {
 
     /// The solar disc, if the sun is up and not hidden.
     fn sun(&self) -> Option<SolarDisc>;
+
+    /// A uniform radiance below the horizon, per channel: the distant
+    /// landscape beyond the scene's geometry (RADIANCE's ground glow).
+    /// [`Sky::radiance`] gives it for directions below the horizon. Zero
+    /// by default: nothing but the scene's own ground lies below.
+    fn below_horizon(&self) -> [f64; 3] {
+        [0.0; 3]
+    }
 }
 
 /// A sky of the same radiance in every direction above the horizon and

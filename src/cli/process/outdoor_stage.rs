@@ -233,7 +233,14 @@ pub fn outdoor(p: &Processed, scene: &Scene, settings: &ReflectanceSettings) -> 
             time: g.time,
             sky: &sky,
         };
-        let view = render_view(scene, &reflectance, &rig, &light, &sources);
+        let view = render_view(
+            scene,
+            &reflectance,
+            &rig,
+            &light,
+            &sources,
+            &RerenderSettings::default(),
+        );
         let measured = RadianceImage {
             width: g.map.width,
             height: g.map.height,
