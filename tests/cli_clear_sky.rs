@@ -1,17 +1,28 @@
 //! `campanile process` on a simulated session with no sky scan and no sun
 //! shot (what hand-taken brackets give): the quick campanile day without
-//! its `SkyScan` and `SunShot` steps. The light is estimated from the CIE
-//! clear-sky model, the views' sky pixels and the photographs'
-//! sunlit/shadowed ratio; the pseudo-albedos come out, `poor` with the
-//! reason, and quality.json says the light was estimated. Their errors
-//! against the simulator's truth are printed: measured ρ_se median 70.5%
-//! (p95 100%), ρ_sun 60.0% (p95 100%) on 1496 cells. That is NOT a pass:
-//! the pairs' sun/sky ratio comes out 1.8–2.9 times the model's on the
-//! campanile although the simulator renders with the model's own
-//! atmosphere (on the small site of process/tests/estimated_light.rs it is
-//! within 4%); the cause is not found yet, so no bound is asserted on them.
+//! its `SkyScan` and `SunShot` steps, captured as `campanile demo --quick`
+//! captures (4 paths per pixel, 3 bounces). The light is estimated from the
+//! CIE clear-sky model, the views' sky pixels and the photographs'
+//! sunlit/shadowed ratio; quality.json says the light was estimated.
+//!
+//! The simulator renders with the model's own atmosphere
+//! (`Atmosphere::clear()`), so the sun/sky ratio must come out ≈ 1 of the
+//! model's, and the pseudo-albedos near the measured-light figures of
+//! tests/demo.rs (ρ_se/ρ_sun medians 2.5 %/2.1 %).
+//!
+//! Issue 31: captured with `capture`'s default `--sim-bounces 1` (direct
+//! light only: no light from the ground or the neighbours in the
+//! photographs), the shaded walls were lit by the open sky alone, 41–54 %
+//! of the irradiance the model (rightly) gathers there, and the ratio came
+//! out 2.94 (morning) and 1.79 (afternoon), the pseudo-albedos 70 % (ρ_se)
+//! and 60 % (ρ_sun) off.
 
 mod common;
+
+/// Bounds on the median relative errors of ρ_se and ρ_sun (green) under the estimated light.
+/// Measured here: 5.3 % and 4.4 % (1496 cells); before the fix 70.5 % and 60.0 %.
+const BOUND_SE: f64 = 0.06;
+const BOUND_SUN: f64 = 0.05;
 
 use std::path::Path;
 
@@ -52,6 +63,13 @@ fn a_session_without_sky_frames_gets_pseudo_albedos_under_estimated_light() {
         &s(&station),
         "--out",
         &s(&session),
+        // As `campanile demo --quick` captures: the ground's and the
+        // neighbours' light on the shaded walls needs the second and third
+        // bounces (the default, one, is direct light only).
+        "--sim-samples",
+        "4",
+        "--sim-bounces",
+        "3",
     ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
 
@@ -60,9 +78,7 @@ fn a_session_without_sky_frames_gets_pseudo_albedos_under_estimated_light() {
     let out = campanile(&["process", &s(&session), "--out", &s(&processed)]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     println!("{stdout}");
-    // `poor` (exit 0): the light's stated uncertainty is above the 2% gate.
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
-    assert!(stdout.contains("poor: pseudo-albedos"), "{stdout}");
 
     let quality: serde_json::Value =
         serde_json::from_slice(&std::fs::read(processed.join("quality.json")).unwrap()).unwrap();
@@ -72,7 +88,9 @@ fn a_session_without_sky_frames_gets_pseudo_albedos_under_estimated_light() {
         .iter()
         .find(|p| p["product"] == "pseudo-albedos")
         .expect("a pseudo-albedo verdict");
-    assert_eq!(albedo["verdict"], "poor", "{albedo:#}");
+    // Not `failed`: the estimate is near the truth; `ok` or `poor` by its
+    // stated uncertainty against the 2 % gate (1.9 % here).
+    assert_ne!(albedo["verdict"], "failed", "{albedo:#}");
     let check = &albedo["checks"][0];
     assert!(
         check["figure"].as_str().unwrap().contains("estimated light"),
@@ -95,6 +113,20 @@ fn a_session_without_sky_frames_gets_pseudo_albedos_under_estimated_light() {
                 && note.contains("sky pixels")
                 && note.contains("not measured"),
             "{note}"
+        );
+        // "… pairs (K within a cell): X ± S of the model's (green)"
+        let x: f64 = note
+            .split("within a cell): ")
+            .nth(1)
+            .and_then(|t| t.split(' ').next())
+            .and_then(|t| t.parse().ok())
+            .unwrap_or_else(|| panic!("no sun/sky ratio in {note}"));
+        println!("{occ}: sun/sky ratio {x:.3} of the model's");
+        // The truth is the model's own atmosphere: x = 1 (measured 0.994
+        // morning, 1.039 afternoon; before the fix 2.94 and 1.79).
+        assert!(
+            (x - 1.0).abs() < 0.06,
+            "{occ}: sun/sky ratio {x}, expected 1 ± 0.06: {note}"
         );
     }
 
@@ -132,5 +164,10 @@ fn a_session_without_sky_frames_gets_pseudo_albedos_under_estimated_light() {
         100.0 * sun50,
         100.0 * sun95
     );
-    assert!(!se.is_empty());
+    assert!(se.len() > 1000, "{} cells", se.len());
+    // Measured light (tests/demo.rs): medians 2.5 % / 2.1 %.
+    assert!(
+        se50 < BOUND_SE && sun50 < BOUND_SUN,
+        "rho_se median {se50}, rho_sun median {sun50}"
+    );
 }
