@@ -268,6 +268,13 @@ pub struct OutdoorGates {
     /// Default poor 0.03 (the thesis-level figure: 1.9–2.5 % on the
     /// simulated station's held-out views), failed 0.10.
     pub render: Gate,
+    /// Where the sun or the sky was estimated rather than measured (no sun
+    /// shot, no sky scan: a clear-sky model and the photographs'
+    /// sunlit/shadowed ratio), the stated relative standard uncertainty of
+    /// the light the pseudo-albedos are divided by (lower is better).
+    /// Default poor 0.02 (the thesis-level pseudo-albedo figure: light
+    /// known less well than that cannot give it), failed 0.5.
+    pub estimated_light: Gate,
 }
 
 impl Default for OutdoorGates {
@@ -275,6 +282,7 @@ impl Default for OutdoorGates {
         OutdoorGates {
             residual: Gate::new(0.05, 0.15),
             render: Gate::new(0.03, 0.10),
+            estimated_light: Gate::new(0.02, 0.5),
         }
     }
 }
@@ -282,7 +290,7 @@ impl Default for OutdoorGates {
 impl Validate for Quality {
     fn validate(&self, v: &mut Validator) {
         use Better::{Higher, Lower};
-        let gates: [(&str, &str, &Gate, Better); 18] = [
+        let gates: [(&str, &str, &Gate, Better); 19] = [
             ("response", "condition", &self.response.condition, Lower),
             ("response", "exposures_used", &self.response.exposures_used, Higher),
             ("response", "code_coverage", &self.response.code_coverage, Higher),
@@ -311,6 +319,7 @@ impl Validate for Quality {
             ("igi", "interreflection", &self.igi.interreflection, Lower),
             ("outdoor", "residual", &self.outdoor.residual, Lower),
             ("outdoor", "render", &self.outdoor.render, Lower),
+            ("outdoor", "estimated_light", &self.outdoor.estimated_light, Lower),
         ];
         for (product, figure, gate, better) in gates {
             v.at(product, |v| v.at(figure, |v| gate.validate_as(better, v)));

@@ -577,7 +577,7 @@ pub fn plan_import(opts: &ImportOptions, progress: &dyn Fn(usize, usize)) -> Res
     if skies == 0 {
         estimated.push(Estimate {
             what: "sky".into(),
-            how: "no sky frames were imported: the sky is not measured (process has no clear-sky fallback yet)".into(),
+            how: "no sky frames were imported: the sky is not measured (process estimates it from the CIE clear-sky model, scaled by the views' sky pixels, and the photographs' sunlit/shadowed ratio)".into(),
             affects: all(&["sky", "pseudo-albedos"]),
         });
     }

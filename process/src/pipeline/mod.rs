@@ -2,7 +2,9 @@
 //! data (no files, no devices): frames grouped by shot, the camera response
 //! (Debevec–Malik, the thesis's [11]), HDR radiance per group, and per
 //! occurrence the sun (§5.3.1), the sky (§5.3.2, eq. 5.9) and the
-//! environment map (§5.3.3).
+//! environment map (§5.3.3); where the sky or the sun was not measured,
+//! [`estimated_light`] makes them from a clear-sky model and the
+//! photographs' sunlit/shadowed ratio.
 //!
 //! The binary reads a session directory, turns its journal and frames into
 //! [`CapturedFrame`]s (through the plan, which says what each shot was for)
@@ -20,6 +22,7 @@
 //! of radiance to irradiance measured by the same camera) do not depend on
 //! it. The sun's irradiance is measured in the same units.
 
+mod estimated_light;
 mod frames;
 mod illumination;
 mod measured_sky;
@@ -27,6 +30,10 @@ mod radiance;
 mod response;
 pub mod room_views;
 
+pub use estimated_light::{
+    EstimateSettings, EstimatedLight, KnownLight, MIN_PAIRS, MIN_SUN_TO_SKY, MODEL_GLOBAL_UNCERTAINTY, ScaleSource,
+    SplitEstimate, estimated_light, predicted_estimated_light,
+};
 pub use frames::{CapturedFrame, FrameGroup, LOSSY_CLIP_MARGIN, Purpose, clip_lossy_top, group_frames, mean_time};
 pub use illumination::{
     OccurrenceLight, SUN_MARGIN_RAD, SunMeasurement, TRIPLET_AGREEMENT, fisheye_average, illumination, sky_fisheye,

@@ -17,8 +17,12 @@ use campanile_process::outdoor::texture_transfer::texture_sources;
 use campanile_process::outdoor::{
     Illumination, Photo, Reflectance, ReflectanceSettings, RerenderSettings, recover_reflectance,
 };
-use campanile_process::pipeline::{MeasuredSky, MergedGroup, Purpose, mean_time, measured_sky, predicted_sky};
+use campanile_process::pipeline::{
+    EstimateSettings, EstimatedLight, KnownLight, MeasuredSky, MergedGroup, OccurrenceLight, Purpose, ScaleSource,
+    estimated_light, mean_time, measured_sky, predicted_estimated_light, predicted_sky,
+};
 use campanile_process::render::{CameraRig, Scene};
+use campanile_process::sky::Atmosphere;
 use campanile_process::sun::sun_position;
 use chrono::{DateTime, Utc};
 use nalgebra::Vector3;
@@ -54,6 +58,12 @@ pub struct OutdoorProducts {
     pub reflectance: Reflectance,
     /// The held-out views.
     pub held_out: Vec<HeldOutView>,
+    /// The training occurrences whose sun or sky was estimated rather
+    /// than measured, and how.
+    pub estimated: Vec<(String, EstimatedLight)>,
+    /// Held-out views lit by the clear-sky model scaled as the estimated
+    /// training lights were (no measured light to predict from).
+    pub predicted_from_model: Vec<String>,
     /// Stage times.
     pub seconds: Vec<(String, f64)>,
 }
@@ -124,6 +134,13 @@ pub fn outdoor(p: &Processed, scene: &Scene, settings: &ReflectanceSettings) -> 
         }
     }
     let mut skies: Vec<(DateTime<Utc>, MeasuredSky)> = Vec::new();
+    let mut estimated: Vec<(String, EstimatedLight)> = Vec::new();
+    let estimate = EstimateSettings {
+        spacing_m: settings.spacing_m,
+        gather: settings.gather,
+        footprint: settings.footprint,
+        ..EstimateSettings::default()
+    };
     let mut photos = Vec::new();
     for (occurrence, groups) in &by_occurrence {
         let Some(light) = p.light.iter().find(|l| l.occurrence == *occurrence) else {
@@ -135,10 +152,29 @@ pub fn outdoor(p: &Processed, scene: &Scene, settings: &ReflectanceSettings) -> 
         let time = mean_time(&groups.iter().map(|g| g.time).collect::<Vec<_>>());
         let sun = sun_position(time, &p.optics.observer, p.optics.delta_t_s)
             .map_err(|e| anyhow!("sun position at {time}: {e}"))?;
-        let mut sky = measured_sky(light).with_context(|| format!("the light of {occurrence}"))?;
-        sky.sun_direction = sun.direction();
+        let here: Vec<Photo> = groups.iter().map(|g| photo_of(p, g, time)).collect();
+        let sky = if light.sky.is_some() && light.sun_irradiance.is_some() {
+            let mut sky = measured_sky(light).with_context(|| format!("the light of {occurrence}"))?;
+            sky.sun_direction = sun.direction();
+            sky
+        } else {
+            // No sky scan or no sun shot: the clear-sky model, split by the
+            // photographs' sunlit/shadowed ratio (pipeline::estimated_light).
+            let est = estimated_light(
+                scene,
+                &targets,
+                &here,
+                &known_light(light, sun.direction()),
+                time,
+                &estimate,
+            )
+            .map_err(|e| anyhow!("estimating the light of {occurrence}: {e}"))?;
+            let sky = est.sky.clone();
+            estimated.push(((*occurrence).to_owned(), est));
+            sky
+        };
         skies.push((time, sky));
-        photos.extend(groups.iter().map(|g| photo_of(p, g, time)));
+        photos.extend(here);
     }
     let lights: Vec<Illumination> = skies
         .iter()
@@ -169,6 +205,7 @@ pub fn outdoor(p: &Processed, scene: &Scene, settings: &ReflectanceSettings) -> 
         .collect();
     let sources = texture_sources(scene, &reflectance, &references, &RerenderSettings::default());
     let mut held_out = Vec::new();
+    let mut predicted_from_model = Vec::new();
     for g in p
         .merged
         .iter()
@@ -176,7 +213,21 @@ pub fn outdoor(p: &Processed, scene: &Scene, settings: &ReflectanceSettings) -> 
     {
         let sun = sun_position(g.time, &p.optics.observer, p.optics.delta_t_s)
             .map_err(|e| anyhow!("sun position at {}: {e}", g.time))?;
-        let sky = predicted_sky(&p.light, &sun).with_context(|| format!("predicting the light of {}", g.key))?;
+        let sky = match predicted_sky(&p.light, &sun) {
+            Ok(sky) => sky,
+            // No measured light to predict from: the model, scaled as the
+            // estimated training lights were (those not scaled to a fitted sky).
+            Err(_) if !estimated.is_empty() => {
+                let from_model: Vec<&EstimatedLight> = estimated
+                    .iter()
+                    .map(|(_, e)| e)
+                    .filter(|e| e.scale != ScaleSource::FittedSky)
+                    .collect();
+                predicted_from_model.push(g.key.clone());
+                predicted_estimated_light(&from_model, sun.direction(), &Atmosphere::clear())
+            }
+            Err(e) => return Err(anyhow!(e).context(format!("predicting the light of {}", g.key))),
+        };
         let rig = rig_of(p, g);
         let light = Illumination {
             time: g.time,
@@ -215,6 +266,20 @@ pub fn outdoor(p: &Processed, scene: &Scene, settings: &ReflectanceSettings) -> 
     Ok(OutdoorProducts {
         reflectance,
         held_out,
+        estimated,
+        predicted_from_model,
         seconds,
     })
+}
+
+/// What was measured of an occurrence's light.
+fn known_light(l: &OccurrenceLight, sun_direction: [f64; 3]) -> KnownLight {
+    KnownLight {
+        sun_direction,
+        sky: match l.sky.as_deref() {
+            Some([r, g, b]) => Some([r.fit.model, g.fit.model, b.fit.model]),
+            _ => None,
+        },
+        sun_irradiance: l.sun_irradiance.as_ref().map(|s| s.irradiance),
+    }
 }
