@@ -31,8 +31,8 @@ mod response;
 pub mod room_views;
 
 pub use estimated_light::{
-    EstimateSettings, EstimatedLight, KnownLight, MIN_PAIRS, MIN_SUN_TO_SKY, MODEL_GLOBAL_UNCERTAINTY, ScaleSource,
-    SplitEstimate, estimated_light, predicted_estimated_light,
+    EstimateSettings, EstimatedLight, KnownLight, MIN_PAIRS, MIN_SUN_TO_SKY, MODEL_GLOBAL_UNCERTAINTY, SPLIT_FLOOR,
+    ScaleSource, SplitEstimate, estimated_light, predicted_estimated_light,
 };
 pub use frames::{CapturedFrame, FrameGroup, LOSSY_CLIP_MARGIN, Purpose, clip_lossy_top, group_frames, mean_time};
 pub use illumination::{
