@@ -144,10 +144,58 @@ pub fn rerender_with_pixel_albedos(
     } else {
         grid.cells.iter().map(|c| c.centre).sum::<Vector3<f64>>() / grid.cells.len() as f64
     };
+    // The unoccluded sky on each side of each environment triangle the
+    // image shows (App. B, the costly part), once per image rather than once
+    // per row: a first pass finds them.
+    let open: HashMap<(usize, bool), [f64; 3]> = {
+        let mut sides: Vec<(usize, bool)> = (0..h)
+            .into_par_iter()
+            .flat_map_iter(|y| {
+                let mut row = Vec::new();
+                for x in 0..w {
+                    for a in 0..k {
+                        for b in 0..k {
+                            let u = x as f64 + (a as f64 + 0.5) / k as f64;
+                            let v = y as f64 + (b as f64 + 0.5) / k as f64;
+                            let Some(ray) = rig.ray(u, v) else { continue };
+                            let Some(hit) = scene.intersect(&ray, f64::INFINITY) else {
+                                continue;
+                            };
+                            let tri = &scene.triangles()[hit.triangle];
+                            let n = if tri.normal.dot(&ray.direction) < 0.0 {
+                                tri.normal
+                            } else {
+                                -tri.normal
+                            };
+                            let on_target = grid
+                                .visible_normal(scene, hit.triangle)
+                                .filter(|vn| vn.dot(&n) > 0.0)
+                                .and_then(|_| grid.nearest_cell(scene, hit.triangle, &hit.point))
+                                .is_some();
+                            if !on_target {
+                                row.push((hit.triangle, n.dot(&tri.normal) > 0.0));
+                            }
+                        }
+                    }
+                }
+                row.sort_unstable();
+                row.dedup();
+                row
+            })
+            .collect();
+        sides.sort_unstable();
+        sides.dedup();
+        sides
+            .par_iter()
+            .map(|&(ti, front)| {
+                let n = scene.triangles()[ti].normal * if front { 1.0 } else { -1.0 };
+                ((ti, front), open_sky(light, &n, &settings.gather.sky))
+            })
+            .collect()
+    };
     let mut data = vec![0f32; w * h * 3];
     data.par_chunks_mut(w * 3).enumerate().for_each(|(y, row)| {
         let mut cache: HashMap<EnvKey, [f64; 3]> = HashMap::new();
-        let mut open: HashMap<(usize, bool), [f64; 3]> = HashMap::new();
         for x in 0..w {
             let mut sum = [0.0; 3];
             let mut count = 0.0;
@@ -202,9 +250,10 @@ pub fn rerender_with_pixel_albedos(
                         let albedo = scene.albedo_at(hit.triangle, &hit.point);
                         let front = n.dot(&tri.normal) > 0.0;
                         let key = env_key(scene, hit.triangle, &hit.point, front, &centre, base_m);
-                        let o = *open
-                            .entry((hit.triangle, front))
-                            .or_insert_with(|| open_sky(light, &n, &settings.gather.sky));
+                        let o = open
+                            .get(&(hit.triangle, front))
+                            .copied()
+                            .unwrap_or_else(|| open_sky(light, &n, &settings.gather.sky));
                         let es = *cache.entry(key).or_insert_with(|| {
                             env_sky(
                                 scene,
