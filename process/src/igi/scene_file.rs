@@ -500,6 +500,50 @@ pub fn view_camera(
     Ok(cam)
 }
 
+/// Reads the RON file at `path` as a `T` (Campanile's RON dialect);
+/// `expected` names the format in the error.
+pub fn read_ron_file<T: serde::de::DeserializeOwned>(path: &Path, expected: &str) -> Result<T, SceneFileError> {
+    let text = std::fs::read_to_string(path).map_err(|e| SceneFileError::File {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    campanile_config::source::ron_options()
+        .from_str(&text)
+        .map_err(|e| SceneFileError::File {
+            path: path.to_path_buf(),
+            message: format!(
+                "line {}, column {}: {} (expected {expected})",
+                e.span.start.line, e.span.start.col, e.code
+            ),
+        })
+}
+
+/// Reads the 8-bit PNG mask `full` (non-zero pixels are used), which must
+/// be `width` × `height`; `field` names it in `path` for the error.
+pub fn read_mask(
+    path: &Path,
+    field: String,
+    full: &Path,
+    width: usize,
+    height: usize,
+) -> Result<Vec<bool>, SceneFileError> {
+    let img = image::open(full)
+        .map_err(|err| SceneFileError::File {
+            path: full.to_path_buf(),
+            message: format!("{err} (expected an 8-bit PNG mask)"),
+        })?
+        .to_luma8();
+    if img.width() as usize != width || img.height() as usize != height {
+        return Err(SceneFileError::Field {
+            path: path.to_path_buf(),
+            field,
+            value: format!("{} ({}x{})", full.display(), img.width(), img.height()),
+            expected: format!("a mask of the camera's size {width}x{height}"),
+        });
+    }
+    Ok(img.pixels().map(|p| p.0[0] > 0).collect())
+}
+
 /// Parses the text of a scene file (`path` names it in errors).
 pub fn parse(path: &Path, text: &str) -> Result<IgiScene, SceneFileError> {
     campanile_config::source::ron_options()
@@ -698,23 +742,13 @@ pub fn load(path: &Path) -> Result<LoadedIgiScene, SceneFileError> {
         let image = read_image(format!("images[{i}].image"), &e.image, &cam)?;
         let mask = match &e.mask {
             None => None,
-            Some(m) => {
-                let full = base.join(m);
-                let img = image::open(&full)
-                    .map_err(|err| SceneFileError::File {
-                        path: full.clone(),
-                        message: format!("{err} (expected an 8-bit PNG mask)"),
-                    })?
-                    .to_luma8();
-                if img.width() as usize != cam.width || img.height() as usize != cam.height {
-                    return Err(field(
-                        format!("images[{i}].mask"),
-                        format!("{} ({}x{})", full.display(), img.width(), img.height()),
-                        &format!("a mask of the camera's size {}x{}", cam.width, cam.height),
-                    ));
-                }
-                Some(img.pixels().map(|p| p.0[0] > 0).collect())
-            }
+            Some(m) => Some(read_mask(
+                path,
+                format!("images[{i}].mask"),
+                &base.join(m),
+                cam.width,
+                cam.height,
+            )?),
         };
         views.push(View {
             name: format!("{}#{i}", e.camera),
@@ -801,19 +835,10 @@ fn back_facing_groups(
 /// Reads a lights file: a RON list of `Known(...)` lights (as in the scene
 /// file), for relighting.
 pub fn load_lights(path: &Path) -> Result<Vec<(String, IgiLight)>, SceneFileError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneFileError::File {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })?;
-    let entries: Vec<LightEntry> = campanile_config::source::ron_options()
-        .from_str(&text)
-        .map_err(|e| SceneFileError::File {
-            path: path.to_path_buf(),
-            message: format!(
-                "line {}, column {}: {} (expected a list of Known(name, position_m, radius_m, intensity_w_sr) or RadianceLight(name, position_m, radius_m, radiance))",
-                e.span.start.line, e.span.start.col, e.code
-            ),
-        })?;
+    let entries: Vec<LightEntry> = read_ron_file(
+        path,
+        "a list of Known(name, position_m, radius_m, intensity_w_sr) or RadianceLight(name, position_m, radius_m, radiance)",
+    )?;
     let mut out = Vec::new();
     for (i, e) in entries.into_iter().enumerate() {
         let field = |field: &str, value: String, expected: &str| SceneFileError::Field {

@@ -24,7 +24,7 @@ use chrono::{DateTime, Utc};
 use serde::Deserialize;
 
 use super::sky_image::fit_fisheye_sky;
-use crate::igi::scene_file::SceneFileError;
+use crate::igi::scene_file::{SceneFileError, read_ron_file};
 use nalgebra::Vector3;
 
 use crate::pipeline::MeasuredSky;
@@ -237,20 +237,7 @@ const SUN_AGREEMENT_DEG: f64 = 1.0;
 
 /// Reads the light file at `path`, fitting any sky images.
 pub fn load_light(path: &Path) -> Result<Vec<TimeLight>, SceneFileError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneFileError::File {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })?;
-    let file: OutdoorLight =
-        campanile_config::source::ron_options()
-            .from_str(&text)
-            .map_err(|e| SceneFileError::File {
-                path: path.to_path_buf(),
-                message: format!(
-                    "line {}, column {}: {} (expected the OutdoorLight format of the README, \"Outdoor files\")",
-                    e.span.start.line, e.span.start.col, e.code
-                ),
-            })?;
+    let file: OutdoorLight = read_ron_file(path, "the OutdoorLight format of the README, \"Outdoor files\"")?;
     let base = path.parent().unwrap_or(Path::new("."));
     let field = |field: String, value: String, expected: &str| SceneFileError::Field {
         path: path.to_path_buf(),
@@ -280,17 +267,7 @@ pub fn load_light(path: &Path) -> Result<Vec<TimeLight>, SceneFileError> {
         let (channels, fitted_sun, sky_source) = match &t.sky {
             SkyEntry::File(f) => {
                 let full = base.join(f);
-                let text = std::fs::read_to_string(&full).map_err(|e| SceneFileError::File {
-                    path: full.clone(),
-                    message: e.to_string(),
-                })?;
-                let sky: SkyFile = ron::from_str(&text).map_err(|e| SceneFileError::File {
-                    path: full.clone(),
-                    message: format!(
-                        "line {}, column {}: {} (expected a fitted-sky file as `campanile sky fit` writes it)",
-                        e.span.start.line, e.span.start.col, e.code
-                    ),
-                })?;
+                let sky: SkyFile = read_ron_file(&full, "a fitted-sky file as `campanile sky fit` writes it")?;
                 (
                     sky.channels,
                     Some((sky.sun_zenith_deg, sky.sun_azimuth_deg)),

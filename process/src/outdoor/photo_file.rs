@@ -28,7 +28,7 @@ use serde::Deserialize;
 
 use super::photo::Photo;
 use crate::camera::image::RadianceImage;
-use crate::igi::scene_file::{CameraEntry, SceneFileError, view_camera};
+use crate::igi::scene_file::{CameraEntry, SceneFileError, read_mask, read_ron_file, view_camera};
 use crate::radiance_file::read_radiance_image;
 use crate::render::CameraRig;
 
@@ -93,20 +93,7 @@ impl PosedView {
 
 /// Reads the photographs file at `path`, its cameras and images.
 pub fn load_photos(path: &Path) -> Result<Vec<PosedView>, SceneFileError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneFileError::File {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })?;
-    let file: OutdoorPhotos =
-        campanile_config::source::ron_options()
-            .from_str(&text)
-            .map_err(|e| SceneFileError::File {
-                path: path.to_path_buf(),
-                message: format!(
-                    "line {}, column {}: {} (expected the OutdoorPhotos format of the README, \"Outdoor files\")",
-                    e.span.start.line, e.span.start.col, e.code
-                ),
-            })?;
+    let file: OutdoorPhotos = read_ron_file(path, "the OutdoorPhotos format of the README, \"Outdoor files\"")?;
     let base = path.parent().unwrap_or(Path::new("."));
     let field = |field: String, value: String, expected: &str| SceneFileError::Field {
         path: path.to_path_buf(),
@@ -203,23 +190,13 @@ pub fn load_photos(path: &Path) -> Result<Vec<PosedView>, SceneFileError> {
                     "no mask without an image (a mask selects the image's pixels)",
                 ));
             }
-            Some(m) => {
-                let full = base.join(m);
-                let img = image::open(&full)
-                    .map_err(|err| SceneFileError::File {
-                        path: full.clone(),
-                        message: format!("{err} (expected an 8-bit PNG mask)"),
-                    })?
-                    .to_luma8();
-                if img.width() as usize != rig.width || img.height() as usize != rig.height {
-                    return Err(field(
-                        format!("photos[{i}].mask"),
-                        format!("{} ({}x{})", full.display(), img.width(), img.height()),
-                        &format!("a mask of the camera's size {}x{}", rig.width, rig.height),
-                    ));
-                }
-                Some(img.pixels().map(|px| px.0[0] > 0).collect::<Vec<bool>>())
-            }
+            Some(m) => Some(read_mask(
+                path,
+                format!("photos[{i}].mask"),
+                &base.join(m),
+                rig.width,
+                rig.height,
+            )?),
         };
         let (mask, bad_pixels) = match &image {
             None => (None, 0),
