@@ -4,7 +4,7 @@
 //! (`validation/igi`).
 //!
 //! `cargo run --release -p campanile-process --example igi_knobs -- SCENE OUT
-//! [cells_per_edge gather_rays lobe_rays iterations seed]`
+//! [cells_per_edge gather_rays lobe_rays iterations seed lobe_ray_factor_max]`
 
 use campanile_process::brdf::WardVariant;
 use campanile_process::igi::material_record::{records, variant_name};
@@ -14,7 +14,7 @@ use campanile_process::igi::{IgiOptions, recover};
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if args.len() < 3 {
-        eprintln!("usage: igi_knobs SCENE OUT [cells gather lobe iterations seed]");
+        eprintln!("usage: igi_knobs SCENE OUT [cells gather lobe iterations seed factor]");
         std::process::exit(2);
     }
     let knob = |i: usize, d: u64| args.get(i).and_then(|a| a.parse().ok()).unwrap_or(d);
@@ -34,6 +34,7 @@ fn main() {
         cells_per_edge: knob(3, 6) as usize,
         gather_rays: knob(4, 64) as u32,
         lobe_rays: knob(5, 16) as u32,
+        lobe_ray_factor_max: knob(8, 1) as u32,
         iterations: knob(6, 4) as u32,
         seed: knob(7, 1),
         ..IgiOptions::default()
@@ -55,5 +56,15 @@ fn main() {
     let out = std::path::Path::new(&args[2]);
     std::fs::create_dir_all(out).expect("output directory");
     std::fs::write(out.join("materials.json"), serde_json::to_string_pretty(&json).unwrap()).expect("write");
+    for (i, it) in r.iterations.iter().enumerate() {
+        println!(
+            "pass {}: {:.2} s (gather {:.2}, ΔS {:.2}, fit {:.2})",
+            i + 1,
+            it.seconds,
+            it.gather_seconds,
+            it.delta_s_seconds,
+            it.fit_seconds
+        );
+    }
     println!("{:.2} s; {}", r.seconds, r.interreflection.message);
 }

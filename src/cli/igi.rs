@@ -114,12 +114,18 @@ pub fn settings(quick: bool) -> (IgiOptions, AlbedoMapOptions, RelightSettings) 
         // most within 2–5 % (examples/igi_knobs; BENCHMARKS.md), 24 is no
         // better at 64² views with 1.7 % noise.
         cells_per_edge: if quick { 4 } else { 12 },
-        // 256 gather rays: on the RADIANCE studio with interreflection the
+        // 1024 gather rays: on the RADIANCE studio with interreflection the
         // weak lobes' ρs moved by 3.8 % and 10.5 % between seeds at 64
-        // rays (more than their views-bootstrap σ), 1.8 % and 3.2 % at 256,
-        // for no measurable time (the gather is 1 % of the solve).
-        gather_rays: if quick { 32 } else { 256 },
+        // rays (more than their views-bootstrap σ), 1.8 % and 3.2 % at 256;
+        // at 256 the south wall's ρs (0.03) was still 6.5 % high, at 1024
+        // within 2 % (examples/igi_knobs; BENCHMARKS.md), for about 0.5 s a
+        // pass (the gather does not grow with the pixels).
+        gather_rays: if quick { 32 } else { 1024 },
         iterations: if quick { 3 } else { 4 },
+        // More ΔS rays on strongly specular surfaces (up to 8 × 16 on a
+        // metal): RADIANCE's metal wall's ρd 2.5–3 % high at 16, 1.1–1.3 %
+        // with the factor (IgiOptions::lobe_ray_factor_max).
+        lobe_ray_factor_max: if quick { 1 } else { 8 },
         ..IgiOptions::default()
     };
     // Stratified rays and paths (igi::lamp_paths): the maps' irradiance and

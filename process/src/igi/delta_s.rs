@@ -8,6 +8,13 @@
 //! sampling, stratified), so a lobe of any width costs the same few rays.
 //! The lobe is the current roughness estimate, held fixed while ρd, ρs and
 //! α are refitted, and the whole is iterated (Fig. 4.6).
+//!
+//! The rays per sample may grow with the surface's specular share
+//! ([`ray_factor`], up to `IgiOptions::lobe_ray_factor_max`): ΔS's noise enters the measured radiance scaled by ρs,
+//! and it matters beyond its spread, because the fit weights each pixel by
+//! 1 / L̂²: a pixel whose ΔS draw fell low gets more weight where the
+//! measurement exceeds its prediction. On RADIANCE's metal wall (ρs 0.56,
+//! ρd 0.24) 16 rays a pixel put ρd 2.5–3 % high, 64 rays 1.1–1.7 %.
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -34,6 +41,7 @@ pub(crate) fn indirect_specular(
     observations: &[Observation],
     shapes: &[Option<WardLobe>],
     rays: u32,
+    factor_max: u32,
     seed: u64,
 ) -> Vec<[f64; 3]> {
     observations
@@ -43,6 +51,7 @@ pub(crate) fn indirect_specular(
             let Some(lobe) = shapes.get(o.surface).copied().flatten() else {
                 return [0.0; 3];
             };
+            let rays = rays * ray_factor(materials.get(o.surface).copied().flatten().as_ref(), factor_max);
             let kernel = WardKernel::new(&lobe);
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             rng.set_stream(i as u64);
@@ -81,4 +90,22 @@ pub(crate) fn indirect_specular(
             sum.map(|s| s / f64::from(rays))
         })
         .collect()
+}
+
+/// The factor on the base ΔS rays for a surface with material `m`: its
+/// specular share ρs / (ρd + ρs) (channel means) over 5 %, rounded, from
+/// 1 to `factor_max` (a plastic wall 1–3, a metal 8 or more); 1 before the
+/// first fit.
+pub(crate) fn ray_factor(m: Option<&WardMaterial>, factor_max: u32) -> u32 {
+    let Some(m) = m else {
+        return 1;
+    };
+    let Some(lobe) = m.lobe else {
+        return 1;
+    };
+    let (d, s) = (m.rho_d.iter().sum::<f64>(), lobe.rho_s.iter().sum::<f64>());
+    if d + s <= 0.0 || !(d + s).is_finite() {
+        return 1;
+    }
+    ((s / (d + s) / 0.05).round() as u32).clamp(1, factor_max.max(1))
 }

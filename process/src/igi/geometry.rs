@@ -106,6 +106,18 @@ impl Geometry {
         tri * n * n + i * n + j
     }
 
+    /// The cell holding point `p` of triangle `tri`, and the point's
+    /// fractional position in it (each in [0, 1]).
+    pub fn cell_with_fraction(&self, tri: usize, p: &Vector3<f64>) -> (usize, [f64; 2]) {
+        let (u, v) = self.barycentric(tri, p);
+        let n = self.n;
+        let (x, y) = (u * n as f64, v * n as f64);
+        let i = ((x.floor().max(0.0)) as usize).min(n - 1);
+        let j = ((y.floor().max(0.0)) as usize).min(n - 1);
+        let f = [(x - i as f64).clamp(0.0, 1.0), (y - j as f64).clamp(0.0, 1.0)];
+        (tri * n * n + i * n + j, f)
+    }
+
     /// The triangle a cell belongs to.
     pub fn cell_triangle(&self, cell: usize) -> usize {
         cell / (self.n * self.n)

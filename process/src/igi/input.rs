@@ -64,6 +64,15 @@ pub struct IgiOptions {
     pub gather_rays: u32,
     /// Lobe-sampled rays per sample for the indirect specular term ΔS.
     pub lobe_rays: u32,
+    /// The most [`Self::lobe_rays`] is multiplied by on surfaces with a
+    /// large specular share (`delta_s::ray_factor`: the share ρs / (ρd +
+    /// ρs) over 5 %, so a metal gets the most). 1 (the default): every
+    /// surface the same. On RADIANCE's metal wall (`validation/igi`) 8 took
+    /// ρd from 2.5–3 % high to 1.1–1.3 %; on the simulated room's faceted
+    /// metal sphere (ρd 0.02) it moved ρd from 3 % to 13 % low, which is
+    /// not understood (BENCHMARKS.md), so only the command line's full
+    /// setting uses it.
+    pub lobe_ray_factor_max: u32,
     /// At most this many samples per surface in the sparse set the
     /// roughness search uses (§4.5 footnote); the linear step uses all.
     pub sparse_samples: usize,
@@ -98,6 +107,7 @@ impl Default for IgiOptions {
             cells_per_edge: 24,
             gather_rays: 256,
             lobe_rays: 16,
+            lobe_ray_factor_max: 1,
             sparse_samples: 2500,
             iterations: 3,
             max_view_angle_rad: 84f64.to_radians(),

@@ -53,7 +53,7 @@ pub use error::IgiError;
 pub use input::{IgiInput, IgiLight, IgiOptions, View};
 pub use observation::DroppedPixels;
 pub use recover::{
-    IgiProgress, IgiResult, IterationReport, SpecularKind, SurfaceModel, SurfaceResult, canonical_lobe, recover,
-    recover_with_progress, specular_kind,
+    IgiProgress, IgiResult, IterationReport, PredictedSample, SpecularKind, SurfaceModel, SurfaceResult,
+    canonical_lobe, predict, recover, recover_with_progress, specular_kind,
 };
 pub use table::format_table;

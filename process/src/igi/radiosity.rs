@@ -37,18 +37,33 @@ use crate::render::Ray;
 /// [`RadiosityField::radiance_toward`]).
 pub(crate) const REFLECTION_DEPTH: u32 = 1;
 
+/// The direct irradiance of a cell is averaged over this many points per
+/// side of the cell (a lamp 30 cm from a wall changes its irradiance
+/// several times across a 30 cm cell: the centre's value is not the mean).
+const DIRECT_POINTS: usize = 4;
+
 /// Per-cell quantities of the radiosity solution.
 #[derive(Debug, Clone)]
 pub(crate) struct RadiosityField {
-    /// Diffuse radiance B per cell, W·m⁻²·sr⁻¹.
+    /// Diffuse radiance B per cell (cell average), W·m⁻²·sr⁻¹.
     pub diffuse: Vec<[f64; 3]>,
+    /// Per cell, B / E (the diffuse radiance per unit irradiance, ρd / π
+    /// of the cell), when the indirect irradiance is known: the radiance
+    /// at a point of the cell is then this times the point's irradiance
+    /// ([`Self::diffuse_at`]), so that a lamp's sharp spot keeps its shape
+    /// within the cell. `None` before the first gathering.
+    pub reflectance: Option<Vec<[f64; 3]>>,
     /// Whether any observation fell in the cell.
     pub observed: Vec<bool>,
     /// Indirect irradiance per cell (cell average), W·m⁻².
     pub e_indirect: Vec<[f64; 3]>,
-    /// Direct irradiance at the cell's representative point, W·m⁻².
+    /// Direct irradiance, the cell's average ([`DIRECT_POINTS`]), W·m⁻².
     pub e_direct: Vec<[f64; 3]>,
-    /// Lights visible from the cell's representative point.
+    /// Direct irradiance at the cell's [`DIRECT_POINTS`]² points (row
+    /// `i` along the triangle's first edge), `None` for points outside
+    /// the triangle.
+    pub e_direct_points: Vec<[Option<[f64; 3]>; DIRECT_POINTS * DIRECT_POINTS]>,
+    /// Lights visible from some point of the cell.
     pub visible: Vec<Vec<usize>>,
     /// Per triangle, the unit normal of the side the cameras see.
     pub side: Vec<Vector3<f64>>,
@@ -59,33 +74,109 @@ impl RadiosityField {
     /// of each triangle given by `side`.
     pub fn new(geometry: &Geometry, input: &IgiInput, side: Vec<Vector3<f64>>) -> RadiosityField {
         let n = geometry.cell_count();
-        let per_cell: Vec<(Vec<usize>, [f64; 3])> = (0..n)
+        type PerCell = (Vec<usize>, [f64; 3], [Option<[f64; 3]>; DIRECT_POINTS * DIRECT_POINTS]);
+        let per_cell: Vec<PerCell> = (0..n)
             .into_par_iter()
             .map(|cell| {
-                let Some(p) = geometry.cell_centre(cell) else {
-                    return (Vec::new(), [0.0; 3]);
-                };
                 let tri = geometry.cell_triangle(cell);
                 let frame = geometry.frame(tri, &side[tri]);
-                let terms = light_terms(geometry, input, &p, &frame, None);
                 let mut e = [0.0; 3];
-                for t in &terms {
-                    for c in 0..3 {
-                        e[c] += t.irradiance[c];
+                let mut points = [None; DIRECT_POINTS * DIRECT_POINTS];
+                let mut visible = vec![false; input.lights.len()];
+                let mut count = 0u32;
+                let mut at = |p: &Vector3<f64>| {
+                    let mut ep = [0.0; 3];
+                    for t in light_terms(geometry, input, p, &frame, None) {
+                        visible[t.light] = true;
+                        for c in 0..3 {
+                            ep[c] += t.irradiance[c];
+                        }
                     }
+                    ep
+                };
+                for (k, slot) in points.iter_mut().enumerate() {
+                    let f = [
+                        ((k / DIRECT_POINTS) as f64 + 0.5) / DIRECT_POINTS as f64,
+                        ((k % DIRECT_POINTS) as f64 + 0.5) / DIRECT_POINTS as f64,
+                    ];
+                    let Some(p) = geometry.cell_point(cell, f) else {
+                        continue;
+                    };
+                    let ep = at(&p);
+                    count += 1;
+                    for c in 0..3 {
+                        e[c] += ep[c];
+                    }
+                    *slot = Some(ep);
                 }
-                (terms.iter().map(|t| t.light).collect(), e)
+                if count == 0
+                    && let Some(p) = geometry.cell_centre(cell)
+                {
+                    e = at(&p);
+                    count = 1;
+                }
+                let e = e.map(|v| v / f64::from(count.max(1)));
+                ((0..visible.len()).filter(|&l| visible[l]).collect(), e, points)
             })
             .collect();
-        let (visible, e_direct) = per_cell.into_iter().unzip();
+        let mut visible = Vec::with_capacity(n);
+        let mut e_direct = Vec::with_capacity(n);
+        let mut e_direct_points = Vec::with_capacity(n);
+        for (v, e, p) in per_cell {
+            visible.push(v);
+            e_direct.push(e);
+            e_direct_points.push(p);
+        }
         RadiosityField {
             diffuse: vec![[0.0; 3]; n],
+            reflectance: None,
             observed: vec![false; n],
             e_indirect: vec![[0.0; 3]; n],
             e_direct,
+            e_direct_points,
             visible,
             side,
         }
+    }
+
+    /// The direct irradiance at point `y` of cell `cell`, bilinear between
+    /// the cell's [`DIRECT_POINTS`]² points (`f`: the fractional position
+    /// in the cell); points outside the triangle take the cell's average.
+    fn direct_at(&self, cell: usize, f: [f64; 2]) -> [f64; 3] {
+        let points = &self.e_direct_points[cell];
+        let n = DIRECT_POINTS as f64;
+        let (x, y) = (
+            (f[0] * n - 0.5).clamp(0.0, n - 1.0),
+            (f[1] * n - 0.5).clamp(0.0, n - 1.0),
+        );
+        let (i0, j0) = (
+            (x.floor() as usize).min(DIRECT_POINTS - 2),
+            (y.floor() as usize).min(DIRECT_POINTS - 2),
+        );
+        let (fx, fy) = (x - i0 as f64, y - j0 as f64);
+        let mut e = [0.0; 3];
+        for (di, wx) in [(0, 1.0 - fx), (1, fx)] {
+            for (dj, wy) in [(0, 1.0 - fy), (1, fy)] {
+                let v = points[(i0 + di) * DIRECT_POINTS + j0 + dj].unwrap_or(self.e_direct[cell]);
+                for c in 0..3 {
+                    e[c] += wx * wy * v[c];
+                }
+            }
+        }
+        e
+    }
+
+    /// The diffuse radiance leaving point `y` of triangle `tri` (in cell
+    /// `cell`): the cell's reflectance times the point's direct irradiance
+    /// plus the cell's indirect irradiance, once known; the cell's mean
+    /// before.
+    pub fn diffuse_at(&self, geometry: &Geometry, tri: usize, y: &Vector3<f64>) -> (usize, [f64; 3]) {
+        let (cell, f) = geometry.cell_with_fraction(tri, y);
+        let Some(r) = &self.reflectance else {
+            return (cell, self.diffuse[cell]);
+        };
+        let e = self.direct_at(cell, f);
+        (cell, [0, 1, 2].map(|c| r[cell][c] * (e[c] + self.e_indirect[cell][c])))
     }
 
     /// The radiance leaving point `y` of triangle `tri` in unit direction
@@ -107,8 +198,7 @@ impl RadiosityField {
         depth: u32,
         rng: &mut ChaCha8Rng,
     ) -> [f64; 3] {
-        let cell = geometry.cell(tri, y);
-        let mut l = self.diffuse[cell];
+        let (cell, mut l) = self.diffuse_at(geometry, tri, y);
         let surface = geometry.triangles()[tri].surface as usize;
         let Some(lobe) = materials.get(surface).and_then(|m| m.as_ref()).and_then(|m| m.lobe) else {
             return l;
