@@ -280,7 +280,9 @@ fn the_plain_fit_chooses_as_before_within_its_evaluation_budget() {
     // which model wins, counted, and the Levenberg–Marquardt evaluations
     // over all candidates. The choice was measured before the fit was made
     // cheaper (41 seven-parameter, 28 Perez form, 10 CIE; 1322 evaluations
-    // at commit 639d777), and a cheaper fit must choose the same.
+    // at commit 639d777; 1181 with the reduction test that skips the
+    // confirming evaluation; 996 with the seven-parameter candidate started
+    // at λ = 10⁻⁶ from the Perez fit), and a cheaper fit must choose the same.
     let (mut seven, mut perez, mut cie, mut other, mut evaluations) = (0, 0, 0, 0, 0);
     for r in references() {
         for (c, values) in &r.channels {
@@ -296,5 +298,5 @@ fn the_plain_fit_chooses_as_before_within_its_evaluation_budget() {
     }
     eprintln!("{seven} seven-parameter, {perez} Perez, {cie} CIE, {other} fixed aureole; {evaluations} evaluations");
     assert_eq!((seven, perez, cie, other), (41, 28, 10, 0));
-    assert!(evaluations <= 1200, "{evaluations} evaluations");
+    assert!(evaluations <= 1000, "{evaluations} evaluations");
 }

@@ -95,6 +95,8 @@ pub struct Settings {
     pub gtol: f64,
     /// Residual-and-Jacobian evaluations.
     pub max_evaluations: usize,
+    /// The damping λ of the first step, relative to diag JᵀJ.
+    pub initial_lambda: f64,
 }
 
 impl Default for Settings {
@@ -104,6 +106,7 @@ impl Default for Settings {
             xtol: 1e-9,
             gtol: 1e-9,
             max_evaluations: 200,
+            initial_lambda: 1e-3,
         }
     }
 }
@@ -236,7 +239,7 @@ pub fn minimize(
     let mut ev = evaluate(prep, &theta, free, &scale)?;
     let mut evaluations = 1;
     let mut iterations = 0;
-    let mut lambda = 1e-3;
+    let mut lambda = settings.initial_lambda;
     let mut nu = 2.0;
     // Whether the last evaluation was an accepted step whose reduction the
     // model predicted well (ρ ≥ ½).
