@@ -211,10 +211,11 @@ impl Rows {
 
 /// Fills `rows` for the `m` ≤ [`BLOCK`] samples from `start`, each
 /// residual and derivative multiplied by `scale`. `t` holds θ's natural
-/// parameters; `H_ONE` says h = 1, when γ^h is γ. Each loop is one
-/// operation over the block, so that each vectorizes.
+/// parameters; `H_ONE` says h = 1, when γ^h is γ; without `JAC` only
+/// the model L (`col[0]`) is filled, all the starts' scale sums need. Each
+/// loop is one operation over the block, so that each vectorizes.
 #[inline(always)]
-fn rows<const H_ONE: bool, const FMA: bool>(
+fn rows<const H_ONE: bool, const FMA: bool, const JAC: bool>(
     prep: &Prepared,
     t: &[f64; 7],
     scale: &[f64],
@@ -261,6 +262,14 @@ fn rows<const H_ONE: bool, const FMA: bool>(
         &mut c6.as_flattened_mut()[..m],
         &mut r.as_flattened_mut()[..m],
     );
+    if !JAC {
+        for i in 0..m {
+            let bg = 1.0 + a * e1[i];
+            let sa = 1.0 + c * e2[i] + e * cos2[i];
+            c0[i] = lz * bg * scale[i] * sa;
+        }
+        return;
+    }
     for i in 0..m {
         let bg = 1.0 + a * e1[i];
         let sa = 1.0 + c * e2[i] + e * cos2[i];
@@ -373,7 +382,7 @@ fn accumulate_with<const K: usize, const H_ONE: bool, const FMA: bool>(
     for start in (0..total).step_by(BLOCK) {
         let m = BLOCK.min(total - start);
         let chunks = (m / LANES).min(CHUNKS);
-        rows::<H_ONE, FMA>(prep, t, scale, start, m, &mut block);
+        rows::<H_ONE, FMA, true>(prep, t, scale, start, m, &mut block);
         // One call per group, each with its pairs known at compile time,
         // so that the loop over them unrolls.
         let [a0, a1, a2, a3, a4, a5] = &mut acc;
@@ -448,7 +457,7 @@ fn scale_sums_with<const H_ONE: bool, const FMA: bool>(prep: &Prepared, t: &[f64
     for start in (0..total).step_by(BLOCK) {
         let m = BLOCK.min(total - start);
         // col[0] is S/σ.
-        rows::<H_ONE, FMA>(prep, &t, &prep.inv_sigma, start, m, &mut block);
+        rows::<H_ONE, FMA, false>(prep, &t, &prep.inv_sigma, start, m, &mut block);
         let s = &block.col[0].as_flattened()[..m];
         let y = &prep.y[start..start + m];
         let w = &prep.inv_sigma[start..start + m];
