@@ -1,7 +1,9 @@
 //! The sky fit on the independent references of `validation/sky` (RADIANCE
 //! gendaylit skies rendered by rtrace, CIE standard skies): per sky and
 //! channel, the fit's time and its error against the references, noise-free
-//! and with 2% Gaussian noise; and the start the fit chose, so that
+//! and with 2% Gaussian noise; the time of Campanile's Levenberg–Marquardt
+//! of the Perez form alone from the start the fit chose (`fit_perez_from`,
+//! the like-for-like figure against scipy); and that start, so that
 //! `validation/sky/scipy_fit.py --start` runs scipy's Levenberg–Marquardt
 //! from the same start in the same run (`bench/sky/run.sh`).
 //!
@@ -17,7 +19,9 @@ use std::path::Path;
 use std::time::Instant;
 
 use campanile_process::error_figures::quantile;
-use campanile_process::sky::{SkyModel, SkySample, angle_between, direction, fit_sky, fit_sky_robust};
+use campanile_process::sky::{
+    SkyModel, SkyModelKind, SkySample, angle_between, direction, fit_perez_from, fit_sky, fit_sky_robust,
+};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -57,7 +61,7 @@ fn main() -> Result<(), Error> {
     let mut starts = std::fs::File::create(Path::new(out).join("start.csv"))?;
     writeln!(
         results,
-        "id,channel,n,kind,converged,plain_ms,robust_ms,median_err,p95_err,max_err,robust_median_err,robust_p95_err,robust_max_err,masked,noisy_median_err,noisy_p95_err,evaluations,samples_evaluated"
+        "id,channel,n,kind,converged,plain_ms,robust_ms,median_err,p95_err,max_err,robust_median_err,robust_p95_err,robust_max_err,masked,noisy_median_err,noisy_p95_err,evaluations,samples_evaluated,perez_evaluations,seven_evaluations,fixed_evaluations,lm_ms,lm_evaluations,lm_p95_err"
     )?;
     writeln!(starts, "id,channel,lz,a,b,c,d,e")?;
     let mut three = std::fs::File::create(Path::new(out).join("three.csv"))?;
@@ -118,6 +122,18 @@ fn main() -> Result<(), Error> {
             let plain = plain?;
             let (robust_ms, robust) = best_ms(5, || fit_sky_robust(&samples, zs));
             let robust = robust?;
+            let (lm_ms, lm) = best_ms(5, || fit_perez_from(&samples, &plain.start_model));
+            let (lm_model, lm_convergence) = lm?;
+            let (_, lm_p95, _) = errors(&lm_model, &samples, v);
+            let candidate_evaluations = |kind: SkyModelKind| {
+                plain
+                    .candidates
+                    .iter()
+                    .find(|c| c.kind == kind)
+                    .map_or(0, |c| c.evaluations)
+            };
+            let seven = candidate_evaluations(SkyModelKind::SevenParameter);
+            let fixed = candidate_evaluations(SkyModelKind::SevenParameterFixedAureole);
             let (m, p, x) = errors(&plain.model, &samples, v);
             let (rm, rp, rx) = errors(&robust.fit.model, &samples, v);
             let noisy: Vec<SkySample> = samples
@@ -135,13 +151,15 @@ fn main() -> Result<(), Error> {
             let (nm, np, _) = errors(&nf.fit.model, &samples, v);
             writeln!(
                 results,
-                "{id},{name},{},{},{},{plain_ms:.4},{robust_ms:.4},{m:.6e},{p:.6e},{x:.6e},{rm:.6e},{rp:.6e},{rx:.6e},{:.4},{nm:.6e},{np:.6e},{},{}",
+                "{id},{name},{},{},{},{plain_ms:.4},{robust_ms:.4},{m:.6e},{p:.6e},{x:.6e},{rm:.6e},{rp:.6e},{rx:.6e},{:.4},{nm:.6e},{np:.6e},{},{},{},{seven},{fixed},{lm_ms:.4},{},{lm_p95:.6e}",
                 samples.len(),
                 plain.kind.label(),
                 plain.convergence.converged,
                 robust.masked_fraction,
                 plain.evaluations,
-                plain.evaluations * samples.len()
+                plain.evaluations * samples.len(),
+                plain.evaluations - seven - fixed,
+                lm_convergence.evaluations
             )?;
             let s = plain.start_model;
             writeln!(starts, "{id},{name},{},{},{},{},{},{}", s.lz, s.a, s.b, s.c, s.d, s.e)?;

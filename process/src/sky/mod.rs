@@ -24,8 +24,8 @@ pub use daylight::{Atmosphere, Daylight, REDDENING_ONSET_AIR_MASS, SUN_ANGULAR_R
 pub use file::{ChannelSelection, ChannelSky, SampleTable, SampleTableError, SkyFile, read_directions, read_samples};
 pub use fit::{
     Candidate, Convergence, MAX_MASKED_FRACTION, OUTLIER_FLOOR, PARAMETER_NAMES, PARAMETER_RANGES, RCOND_FLOOR,
-    RobustSkyFit, SkyFit, SkyFitError, SkyFitOptions, SkyModelKind, SkySample, Termination, WEIGHT_FLOOR, fit_sky,
-    fit_sky_robust, fit_sky_with,
+    RobustSkyFit, SkyFit, SkyFitError, SkyFitOptions, SkyModelKind, SkySample, Termination, WEIGHT_FLOOR,
+    fit_perez_from, fit_sky, fit_sky_robust, fit_sky_with,
 };
 pub use frame_samples::{FrameSampleError, MIN_ELEVATION_RAD, SkyFrame, sky_samples};
 pub use geometry::{angle_between, direction};

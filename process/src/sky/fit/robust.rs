@@ -155,6 +155,7 @@ fn graduated(prep: &Prepared, start: &[f64; 7]) -> Option<([f64; 7], f64)> {
         xtol: 1e-8,
         gtol: 1e-8,
         max_evaluations: 30,
+        ..Settings::default()
     };
     let mut theta = *start;
     let mut u = log_ratios(prep, &theta);

@@ -95,6 +95,8 @@ pub struct Settings {
     pub gtol: f64,
     /// Residual-and-Jacobian evaluations.
     pub max_evaluations: usize,
+    /// The damping λ of the first step, relative to diag JᵀJ.
+    pub initial_lambda: f64,
 }
 
 impl Default for Settings {
@@ -104,6 +106,7 @@ impl Default for Settings {
             xtol: 1e-9,
             gtol: 1e-9,
             max_evaluations: 200,
+            initial_lambda: 1e-3,
         }
     }
 }
@@ -236,8 +239,11 @@ pub fn minimize(
     let mut ev = evaluate(prep, &theta, free, &scale)?;
     let mut evaluations = 1;
     let mut iterations = 0;
-    let mut lambda = 1e-3;
+    let mut lambda = settings.initial_lambda;
     let mut nu = 2.0;
+    // Whether the last evaluation was an accepted step whose reduction the
+    // model predicted well (ρ ≥ ½).
+    let mut trusted = false;
     let at = |theta: &[f64; 7], j: usize| {
         let (lo, hi) = bounds(j);
         let tol = 1e-12 * (hi - lo).min(1e12);
@@ -315,6 +321,13 @@ pub fn minimize(
         }
         let step_norm = step[..k].iter().map(|s| s * s).sum::<f64>().sqrt();
         let theta_norm = free.iter().map(|&j| theta[j] * theta[j]).sum::<f64>().sqrt();
+        // The reduction test without the evaluation that would only confirm
+        // it: the model, just shown to predict well, predicts less than ftol
+        // of reduction from here (MINPACK evaluates the step first; the
+        // reduction it finds is then at most about the prediction).
+        if trusted && pred <= settings.ftol * ev.cost {
+            break Termination::Reduction;
+        }
         let next = evaluate(prep, &trial, free, &scale);
         evaluations += 1;
         // MINPACK's test, on accepted and refused steps alike: the cost
@@ -331,6 +344,7 @@ pub fn minimize(
                 iterations += 1;
                 lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
                 nu = 2.0;
+                trusted = rho >= 0.5;
                 if stop {
                     break Termination::Reduction;
                 }
@@ -340,6 +354,7 @@ pub fn minimize(
             _ => {
                 lambda *= nu;
                 nu *= 2.0;
+                trusted = false;
                 false
             }
         };

@@ -307,3 +307,31 @@ fn rejection_can_be_turned_off_and_the_mask_is_capped() {
         whole.masked_summary()
     );
 }
+
+#[test]
+fn the_perez_form_alone_from_a_start_reaches_a_perez_sky_and_refuses_a_start_it_cannot_evaluate() {
+    // Noise-free samples of a Perez-form sky (h = 1), started from CIE
+    // type 12 scaled by 3: the fit ends at the sky to 10⁻⁸ and says it
+    // converged.
+    let zs = 0.7;
+    let truth = SkyModel { h: 1.0, ..clear_sky() };
+    let dirs = directions(zs, 85f64.to_radians(), 3.0);
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let samples = samples_of(&truth, &dirs, 0.0, &mut rng);
+    let cie12 = CieSky::new(CieSkyType::new(12).expect("type 12"), 3.0 * truth.lz, zs).as_seven_parameter();
+    let (fit, convergence) = fit_perez_from(&samples, &cie12).expect("fits");
+    assert!(convergence.converged, "{}", convergence.summary());
+    assert_eq!(fit.h, 1.0);
+    let err = rel_rms(&fit, &truth, &dirs);
+    assert!(err < 1e-8, "relative RMS {err:e}");
+    // Lz = ∞ gives residuals that are not finite.
+    let bad = SkyModel {
+        lz: f64::INFINITY,
+        ..cie12
+    };
+    assert!(
+        matches!(fit_perez_from(&samples, &bad), Err(SkyFitError::StartNotFinite { .. })),
+        "{:?}",
+        fit_perez_from(&samples, &bad)
+    );
+}
