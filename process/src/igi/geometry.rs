@@ -99,11 +99,7 @@ impl Geometry {
 
     /// The cell holding point `p` of triangle `tri`.
     pub fn cell(&self, tri: usize, p: &Vector3<f64>) -> usize {
-        let (u, v) = self.barycentric(tri, p);
-        let n = self.n;
-        let i = ((u * n as f64).floor().max(0.0) as usize).min(n - 1);
-        let j = ((v * n as f64).floor().max(0.0) as usize).min(n - 1);
-        tri * n * n + i * n + j
+        self.cell_with_fraction(tri, p).0
     }
 
     /// The cell holding point `p` of triangle `tri`, and the point's

@@ -270,6 +270,22 @@ mod tests {
     }
 
     #[test]
+    fn predict_refuses_materials_that_do_not_match_the_surfaces() {
+        let opts = IgiOptions {
+            cells_per_edge: 2,
+            gather_rays: 4,
+            ..IgiOptions::default()
+        };
+        let one = vec![None; 1];
+        let e = crate::igi::predict(&input(), &opts, &one).unwrap_err();
+        assert!(matches!(e, IgiError::Option { name: "materials", .. }), "{e}");
+        assert!(e.to_string().contains("1 entries"), "{e}");
+        let all = vec![None; 6];
+        let got = crate::igi::predict(&input(), &opts, &all).unwrap();
+        assert_eq!(got.len(), 12, "one prediction per usable pixel: {}", got.len());
+    }
+
+    #[test]
     fn bad_inputs_are_typed_errors_naming_what_is_wrong() {
         let opts = IgiOptions::default();
         assert!(recover(&input(), &opts).is_ok());

@@ -207,21 +207,8 @@ pub fn recover_with_progress(
     progress: &mut dyn FnMut(IgiProgress),
 ) -> Result<IgiResult, IgiError> {
     let start = Instant::now();
-    options.validate()?;
-    input.validate()?;
-    let geometry = Geometry::new(&input.triangles, &input.surfaces, options.cells_per_edge)?;
-    let (obs, dropped) = observations(&geometry, input, options);
+    let (geometry, obs, dropped, mut field) = setup(input, options)?;
     let n_surf = input.surfaces.len();
-
-    // The side of each triangle the cameras see.
-    let mut side: Vec<Vector3<f64>> = vec![Vector3::zeros(); geometry.triangles().len()];
-    for o in &obs {
-        side[o.triangle] += o.frame.normal;
-    }
-    for (s, t) in side.iter_mut().zip(geometry.triangles()) {
-        *s = if s.dot(&t.normal) >= 0.0 { t.normal } else { -t.normal };
-    }
-    let mut field = RadiosityField::new(&geometry, input, side);
 
     let mut by_surface: Vec<Vec<usize>> = vec![Vec::new(); n_surf];
     for (i, o) in obs.iter().enumerate() {
@@ -291,24 +278,23 @@ pub fn recover_with_progress(
         // pass's own indirect light: a weak lobe (ρs 0.02) stands 9–11 %
         // above the diffuse fit, so the first pass's rougher estimate
         // decided it by chance.
-        {
-            for s in 0..n_surf {
-                let samples: Vec<DetectorSample> = by_surface[s]
-                    .iter()
-                    .map(|&i| {
-                        let o = &obs[i];
-                        let e = total_irradiance(o, &field);
-                        DetectorSample {
-                            view: o.view,
-                            radiance: o.radiance.iter().sum::<f64>() / 3.0,
-                            diffuse: e.iter().sum::<f64>() / (3.0 * std::f64::consts::PI),
-                            deltas: o.lights.iter().map(|t| (t.light, t.delta)).collect(),
-                        }
-                    })
-                    .collect();
-                highlights[s] = detect(&samples);
-            }
+        for s in 0..n_surf {
+            let samples: Vec<DetectorSample> = by_surface[s]
+                .iter()
+                .map(|&i| {
+                    let o = &obs[i];
+                    let e = total_irradiance(o, &field);
+                    DetectorSample {
+                        view: o.view,
+                        radiance: o.radiance.iter().sum::<f64>() / 3.0,
+                        diffuse: e.iter().sum::<f64>() / (3.0 * std::f64::consts::PI),
+                        deltas: o.lights.iter().map(|t| (t.light, t.delta)).collect(),
+                    }
+                })
+                .collect();
+            highlights[s] = detect(&samples);
         }
+
         // (4) Refit.
         let previous = fits.clone();
         fits = (0..n_surf)
@@ -468,6 +454,29 @@ pub fn recover_with_progress(
     })
 }
 
+/// What [`recover`] and [`predict`] start from: the inputs validated, the
+/// geometry and its cells, every usable pixel's observation, the drops per
+/// view, and the radiosity field on the side of each triangle the cameras
+/// see.
+fn setup(
+    input: &IgiInput,
+    options: &IgiOptions,
+) -> Result<(Geometry, Vec<Observation>, Vec<DroppedPixels>, RadiosityField), IgiError> {
+    options.validate()?;
+    input.validate()?;
+    let geometry = Geometry::new(&input.triangles, &input.surfaces, options.cells_per_edge)?;
+    let (obs, dropped) = observations(&geometry, input, options);
+    let mut side: Vec<Vector3<f64>> = vec![Vector3::zeros(); geometry.triangles().len()];
+    for o in &obs {
+        side[o.triangle] += o.frame.normal;
+    }
+    for (s, t) in side.iter_mut().zip(geometry.triangles()) {
+        *s = if s.dot(&t.normal) >= 0.0 { t.normal } else { -t.normal };
+    }
+    let field = RadiosityField::new(&geometry, input, side);
+    Ok((geometry, obs, dropped, field))
+}
+
 /// One observation under given materials ([`predict`]): what the model
 /// predicts and what the image holds.
 #[derive(Debug, Clone, PartialEq)]
@@ -502,18 +511,14 @@ pub fn predict(
     options: &IgiOptions,
     materials: &[Option<WardMaterial>],
 ) -> Result<Vec<PredictedSample>, IgiError> {
-    options.validate()?;
-    input.validate()?;
-    let geometry = Geometry::new(&input.triangles, &input.surfaces, options.cells_per_edge)?;
-    let (obs, _) = observations(&geometry, input, options);
-    let mut side: Vec<Vector3<f64>> = vec![Vector3::zeros(); geometry.triangles().len()];
-    for o in &obs {
-        side[o.triangle] += o.frame.normal;
+    if materials.len() != input.surfaces.len() {
+        return Err(IgiError::Option {
+            name: "materials",
+            value: format!("{} entries", materials.len()),
+            expected: "one per surface of the input",
+        });
     }
-    for (s, t) in side.iter_mut().zip(geometry.triangles()) {
-        *s = if s.dot(&t.normal) >= 0.0 { t.normal } else { -t.normal };
-    }
-    let mut field = RadiosityField::new(&geometry, input, side);
+    let (geometry, obs, _, mut field) = setup(input, options)?;
     let shapes: Vec<Option<WardLobe>> = materials.iter().map(|m| m.and_then(|m| m.lobe)).collect();
     let mut kind_ind: Vec<[f64; 3]> = vec![[0.0; 3]; obs.len()];
     let albedos = specular_albedos(materials);
