@@ -83,5 +83,40 @@ impl Validate for Station {
             ),
             None => {}
         }
+        if self.uses_simulation() {
+            self.validate_all_simulated(v);
+        }
+    }
+}
+
+impl Station {
+    /// A station with any simulated device is simulated as a whole (the
+    /// simulator stands in for every device, whatever its port says), so a
+    /// real port or camera beside a simulated one is refused: otherwise a
+    /// real head's conformance suite, or a capture, would silently run on
+    /// the simulator's head instead.
+    fn validate_all_simulated(&self, v: &mut Validator) {
+        use crate::camera::CameraDriver;
+        const WHY: &str = "since other devices of this station are simulated and the simulator then stands in \
+                           for every device; a station is either all simulated or all real";
+        if self.camera.driver != CameraDriver::Sim {
+            v.at("camera", |v| {
+                v.invalid("driver", format!("{:?}", self.camera.driver), &format!("Sim, {WHY}"))
+            });
+        }
+        let links = [
+            ("head", Some(&self.head.link)),
+            ("filter_wheel", self.filter_wheel.as_ref().map(|w| &w.link)),
+            ("lights", self.lights.as_ref().map(|l| &l.link)),
+        ];
+        for (device, link) in links {
+            if let Some(link) = link.filter(|l| !l.is_simulated()) {
+                v.at(device, |v| {
+                    v.at("link", |v| {
+                        v.invalid("port", format!("{:?}", link.port), &format!("a `sim:` port, {WHY}"))
+                    })
+                });
+            }
+        }
     }
 }
