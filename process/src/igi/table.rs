@@ -4,7 +4,7 @@
 
 use std::fmt::Write;
 
-use super::recover::{IgiResult, SurfaceResult};
+use super::recover::{IgiResult, SurfaceResult, canonical_lobe};
 use crate::brdf::{WardLobe, WardMaterial};
 
 /// The errors (percent) Table 4.1 of the thesis reports for its six
@@ -41,12 +41,16 @@ pub fn nearest_representation(lobe: &WardLobe, gamma_rad: f64) -> WardLobe {
 
 /// The parameters (ρd, ρs, αx, αy, γ in degrees) of a material in channel
 /// 0 (the thesis's surfaces are grey), in the representation nearest
-/// `gamma_rad`.
-fn params(m: &WardMaterial, gamma_rad: f64) -> [Option<f64>; 5] {
+/// `gamma_rad`, or in the canonical one (αx ≥ αy, γ in (−90°, 90°],
+/// [`canonical_lobe`]) when there is no γ to match.
+fn params(m: &WardMaterial, gamma_rad: Option<f64>) -> [Option<f64>; 5] {
     match m.lobe {
         None => [Some(m.rho_d[0]), Some(0.0), None, None, None],
         Some(l) => {
-            let l = nearest_representation(&l, gamma_rad);
+            let l = match gamma_rad {
+                Some(g) => nearest_representation(&l, g),
+                None => canonical_lobe(l),
+            };
             [
                 Some(m.rho_d[0]),
                 Some(l.rho_s[0]),
@@ -63,7 +67,7 @@ fn params(m: &WardMaterial, gamma_rad: f64) -> [Option<f64>; 5] {
 /// nearest the truth's γ; `None` where a parameter is missing on either side.
 pub fn errors(recovered: &WardMaterial, truth: &WardMaterial) -> [Option<f64>; 5] {
     let g = truth.lobe.map_or(0.0, |l| l.gamma_rad);
-    let (r, t) = (params(recovered, g), params(truth, g));
+    let (r, t) = (params(recovered, Some(g)), params(truth, Some(g)));
     let mut e = [None; 5];
     for k in 0..5 {
         if let (Some(a), Some(b)) = (r[k], t[k]) {
@@ -86,7 +90,9 @@ fn cell(v: Option<f64>, digits: usize) -> String {
 /// Table 4.1's layout: for each surface, rows "True" (when `truth` has
 /// it), "Recovered", "Error(%)" (γ in degrees) and, when `thesis` has the
 /// row, "Thesis(%)"; then the model chosen and why. Anisotropic surfaces
-/// are shown in the representation nearest the true γ.
+/// are shown in the representation nearest the true γ, or without a true
+/// lobe in the canonical one (αx ≥ αy, γ in (−90°, 90°]), as
+/// `materials.json` gives them.
 pub fn format_table(result: &IgiResult, truth: &[Option<WardMaterial>], thesis: Option<&[[Option<f64>; 4]]>) -> String {
     let mut s = String::new();
     let _ = writeln!(
@@ -109,7 +115,7 @@ pub fn format_table(result: &IgiResult, truth: &[Option<WardMaterial>], thesis: 
     };
     for (i, r) in result.surfaces.iter().enumerate() {
         let t = truth.get(i).copied().flatten();
-        let g = t.and_then(|t| t.lobe).map_or(0.0, |l| l.gamma_rad);
+        let g = t.and_then(|t| t.lobe).map(|l| l.gamma_rad);
         if let Some(t) = &t {
             row(&mut s, &r.name, "True", params(t, g), 4);
         }
@@ -155,6 +161,21 @@ fn describe(r: &SurfaceResult) -> String {
 mod tests {
     use super::*;
     use crate::brdf::WardVariant;
+
+    /// Without a truth to match, the table prints the canonical form that
+    /// materials.json gives (it printed (0.05, 0.287, 44.9°) for a brushed
+    /// board whose materials.json said (0.287, 0.05, −45.1°)).
+    #[test]
+    fn without_a_truth_the_table_prints_the_canonical_form() {
+        let m = WardMaterial {
+            rho_d: [0.17; 3],
+            lobe: Some(WardLobe::new([0.1; 3], 0.05, 0.287, 44.9f64.to_radians(), WardVariant::Ward1992).unwrap()),
+        };
+        let p = params(&m, None);
+        assert_eq!(p[2], Some(0.287));
+        assert_eq!(p[3], Some(0.05));
+        assert!((p[4].unwrap() - (-45.1)).abs() < 1e-9, "{p:?}");
+    }
 
     #[test]
     fn the_swapped_representation_is_matched_to_the_truth() {
