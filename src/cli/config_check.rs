@@ -20,6 +20,9 @@ pub enum ConfigCommand {
     ///
     /// Errors name the file, line and column, the field, the value found and
     /// what was expected. Exit status: 0 if every file is valid, 2 otherwise.
+    ///
+    /// Example:
+    ///   campanile config check examples/campanile-day.ron examples/sim-station.ron examples/real-station.ron
     #[command(verbatim_doc_comment)]
     Check {
         /// Configuration files (RON).

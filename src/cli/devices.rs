@@ -55,6 +55,11 @@ enum DevicesCommand {
     ///
     /// Exit status: 0 when every check passed, 1 when one failed or a
     /// device could not be connected, 2 for a bad station file.
+    ///
+    /// Example:
+    ///   campanile devices test --station examples/sim-station.ron
+    ///   campanile devices test --station my-head.ron --move-limit-s 20
+    #[command(verbatim_doc_comment)]
     Test(TestArgs),
 }
 

@@ -24,6 +24,9 @@ pub enum EnvCommand {
     /// it was never sunlit, the sun term does not pay for itself, or the sun
     /// track is too nearly planar to give a normal; the output says which
     /// and why, with the conditioning figures.
+    ///
+    /// Example:
+    ///   campanile env fit observations.csv --out env.ron
     #[command(verbatim_doc_comment)]
     Fit {
         /// Region observations (CSV).
@@ -41,6 +44,10 @@ pub enum EnvCommand {
     /// Predict every region's radiance under new light (eq. 5.13).
     ///
     /// Prints a CSV: region, r, g, b.
+    ///
+    /// Example:
+    ///   campanile env predict env.ron --sky-irradiance 80,90,120 --sun-irradiance 900,850,780 \
+    ///       --sun-zenith-deg 35 --sun-azimuth-deg 200
     #[command(verbatim_doc_comment)]
     Predict {
         /// Region models (RON from `env fit`).

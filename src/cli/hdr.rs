@@ -90,6 +90,10 @@ pub enum HdrCommand {
     /// Falloff from a flat-field radiance map (EXR with R, G, B; a uniformly
     /// lit uniform target filling the view); distortion from a CSV of
     /// "r_distorted,r_ideal" normalized radii (r = 1 at the corners).
+    ///
+    /// Example:
+    ///   campanile hdr lens --flat flat-field.exr --pairs grid-radii.csv -o lens.txt
+    ///   campanile hdr merge IMG_*.JPG --curve curve.csv --lens lens.txt -o scene.exr
     #[command(verbatim_doc_comment)]
     Lens(LensArgs),
 }

@@ -26,10 +26,10 @@ use clap::Args;
 /// specular parameters), calibrated cameras (or RADIANCE views), lights
 /// (known, RADIANCE light spheres, or HDR images of their bulbs to
 /// triangulate) and radiance images (OpenEXR, RADIANCE RGBE .hdr/.pic or
-/// PFM) with optional masks; the README documents the format. Writes to --out:
+/// PFM) with optional masks; docs/reference/igi-scene-file.md documents the format. Writes to --out:
 /// materials.txt (Table 4.1's layout, with each surface's model and why),
 /// materials.rad (RADIANCE plastic/plastic2/metal/metal2) and materials.xml
-/// (Mitsuba 3; see the README for the conversions),
+/// (Mitsuba 3; see docs/reference/igi-scene-file.md for the conversions),
 /// summary.json, albedo/GROUP.exr for each planar OBJ group, and with
 /// --relight LIGHTS.ron, relit-CAMERA.exr for every camera with an image.
 ///

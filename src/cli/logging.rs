@@ -12,7 +12,9 @@ pub enum LogFormat {
     Json,
 }
 
+/// Shown after each command's own options, under their own heading.
 #[derive(Debug, Args)]
+#[command(next_help_heading = "Global options")]
 pub struct LogArgs {
     /// Format of log lines on standard error.
     #[arg(long, value_enum, default_value_t = LogFormat::Text, global = true)]

@@ -59,7 +59,8 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// The whole station on simulated hardware: capture a day, process it, write a report.
+    // Tuple variants take their help (and example) from their arguments'
+    // doc comments.
     Demo(demo::DemoArgs),
     /// Read and validate configuration files (station, plan, scene).
     Config {
@@ -71,7 +72,6 @@ pub enum Command {
         #[command(subcommand)]
         action: hdr::HdrCommand,
     },
-    /// Where the sun is: one instant, or a CSV table of instants and sites.
     Sun(sun::SunArgs),
     /// The environment: fit region radiance models, predict them under new light.
     Env {
@@ -83,14 +83,12 @@ pub enum Command {
         #[command(subcommand)]
         action: sky::SkyCommand,
     },
-    /// Inverse global illumination indoors: Ward BRDFs and albedo maps from a scene file (SCENE.ron).
     Igi(igi::IgiArgs),
     /// Outdoor reflectance on plain files: pseudo-albedos from posed HDR photos, views at new times.
     Outdoor {
         #[command(subcommand)]
         action: outdoor::OutdoorCommand,
     },
-    /// Run a plan on a station into a session directory, or resume one.
     Capture(capture::CaptureArgs),
     /// The unattended station: run a plan day after day (`station run`), read its heartbeat (`station status`).
     Station {
@@ -102,12 +100,8 @@ pub enum Command {
         #[command(subcommand)]
         action: session::SessionCommand,
     },
-    /// Process a captured session: response, HDR, sun, sky and environment, with a summary.
     Process(process::ProcessArgs),
-    /// List serial ports and cameras, or test a station's devices (`devices test --station FILE`).
     Devices(devices::DevicesArgs),
-    /// Render the scene at a time, a sunrise-to-sunset sequence or overcast, from recovered pseudo-albedos
-    /// (`--zoom EXR`: a zoom photo's view at pixel resolution, with eq. 5.16 per-pixel pseudo-albedos).
     Render(render::RenderArgs),
     /// Plans: simulate one forward without devices (timeline, frames, durations, what it will not cover).
     Plan {

@@ -147,6 +147,9 @@ pub enum SkyCommand {
     /// The upper hemisphere: azimuth 0° (north) at the left edge, east at a
     /// quarter of the width; the zenith on the top row, the horizon at the
     /// bottom; WIDTH × WIDTH/4 pixels, radiance per channel, no sun disc.
+    ///
+    /// Example:
+    ///   campanile sky map sky.ron --out sky.exr --width 1024
     #[command(verbatim_doc_comment)]
     Map {
         /// Fitted skies (RON).

@@ -169,6 +169,9 @@ impl std::str::FromStr for StationOutageArg {
 /// only. A running station rewrites it at every frame and at
 /// least every 60 s while it waits.
 #[derive(Debug, Args)]
+///
+/// Example:
+///   campanile station status sky --max-age 600
 #[command(verbatim_doc_comment)]
 pub struct StatusArgs {
     /// The store directory (`station run --store DIR`).

@@ -34,7 +34,8 @@ use super::process::{self, report_sections::Truth};
 /// The session directories and every product stay in OUT.
 ///
 /// Example:
-///   cargo run --release -- demo --out campanile-demo
+///   campanile demo --out campanile-demo
+///   campanile demo --quick --out demo-quick
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct DemoArgs {
@@ -279,6 +280,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
         .with_context(|| format!("{}: cannot write", args.out.display()))?;
     let report = Report {
         title: "Campanile demo: a simulated day at the bell tower".into(),
+        summary: Vec::new(),
         intro: vec![
             format!(
                 "The plan {} was captured on the simulated station {} and processed; every figure stands beside the simulator's truth.",
