@@ -22,6 +22,42 @@ pub enum Figure {
         /// Caption.
         caption: String,
     },
+    /// A PNG map (false colour, or radiance tone-mapped) with a colour bar
+    /// under it that says what its colours mean.
+    Map {
+        /// The encoded image.
+        bytes: Vec<u8>,
+        /// Caption.
+        caption: String,
+        /// What the colours stand for.
+        scale: ColourScale,
+    },
+    /// Figures side by side in one row that never wraps, sharing the
+    /// page's width equally (a photograph, its re-render and the error
+    /// map, for instance).
+    Row(Vec<Figure>),
+}
+
+/// The meaning of a map's colours, drawn as a bar with its values.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ColourScale {
+    /// [`super::false_colour_png`]'s blue–white–red scale from `low` to
+    /// `high` (white at the middle).
+    Diverging {
+        /// The value drawn blue (and below).
+        low: f64,
+        /// The value drawn red (and above).
+        high: f64,
+        /// Unit or meaning of the values, e.g. "relative error".
+        unit: String,
+    },
+    /// [`super::tonemapped_png`]'s black to white (sRGB), white at `white`.
+    Radiance {
+        /// The value drawn white (and above).
+        white: f64,
+        /// Unit, e.g. "W·m⁻²·sr⁻¹".
+        unit: String,
+    },
 }
 
 /// A table with a header row.
@@ -48,6 +84,23 @@ pub struct Section {
     pub figures: Vec<Figure>,
 }
 
+/// One line of the summary at the top of the page: a product, its
+/// verdict, its headline figure beside its goal, and the section with its
+/// detail.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SummaryRow {
+    /// What was made, e.g. "Pseudo-albedos".
+    pub product: String,
+    /// Its quality verdict (`None`: not gated, e.g. a timing).
+    pub verdict: Option<Verdict>,
+    /// The headline figure, with its unit.
+    pub figure: String,
+    /// The goal or bound it is held to ("" when none).
+    pub goal: String,
+    /// The title of the section that has the detail ("" when none).
+    pub section: String,
+}
+
 /// The whole report.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Report {
@@ -55,11 +108,22 @@ pub struct Report {
     pub title: String,
     /// Lines under the title.
     pub intro: Vec<String>,
+    /// The summary table at the top: one row per product.
+    pub summary: Vec<SummaryRow>,
     /// The products' quality verdicts: a banner at the top names every
     /// `poor` or `failed` product with its figures.
     pub quality: Option<QualityReport>,
     /// Sections, in order.
     pub sections: Vec<Section>,
+}
+
+/// The mark a table cell starts with when its number is out of tolerance.
+const FLAG: &str = "⚠ ";
+
+/// A table cell whose number is out of its tolerance: drawn highlighted,
+/// with a warning sign (so it survives copying the text).
+pub fn flagged(text: impl std::fmt::Display) -> String {
+    format!("{FLAG}{text}")
 }
 
 fn escape(s: &str) -> String {
@@ -76,19 +140,38 @@ fn escape(s: &str) -> String {
     out
 }
 
-const STYLE: &str = "body{font-family:sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;color:#222}\
+const STYLE: &str = "body{font-family:sans-serif;font-size:16px;max-width:1360px;margin:2em auto;padding:0 1em;color:#222}\
 h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:2em}\
-table{border-collapse:collapse;margin:1em 0;font-size:.9em}td,th{border:1px solid #bbb;padding:.25em .6em;text-align:right}\
+table{border-collapse:collapse;margin:1em 0;font-size:.9em;max-width:100%}td,th{border:1px solid #bbb;padding:.25em .6em;text-align:right;overflow-wrap:anywhere}\
 th{background:#eee}td:first-child,th:first-child{text-align:left}caption{text-align:left;font-weight:bold;padding:.3em 0}\
-.figs{display:flex;flex-wrap:wrap;gap:1em}figure{margin:0}figure img{max-width:560px;border:1px solid #ddd;image-rendering:pixelated}\
-figcaption{font-size:.85em;color:#555;max-width:560px}nav a{margin-right:1em}\
+td.flag{background:#fdd;color:#900;font-weight:bold}\
+p,li,figcaption,caption{overflow-wrap:anywhere}\
+.figs{display:flex;flex-wrap:wrap;gap:1em;align-items:flex-start}figure{margin:0;max-width:100%}\
+figure img{max-width:100%;border:1px solid #ddd;image-rendering:pixelated}\
+.row{display:flex;flex-wrap:nowrap;gap:.8em;width:100%;margin:.6em 0}.row figure{flex:1 1 0;min-width:0}.row figure img{width:100%}\
+figcaption{font-size:.85em;color:#444;max-width:640px}.row figcaption{max-width:none}\
+svg.bar{display:block;margin-top:2px}nav{line-height:1.8}nav a{margin-right:1em;white-space:nowrap}\
 .quality{border:2px solid;padding:.5em 1em;margin:1em 0}.quality ul{margin:.3em 0}\
 .quality.ok{border-color:#2a7;background:#eefaf3}.quality.poor{border-color:#d90;background:#fff8e6}\
-.quality.failed{border-color:#c22;background:#fdeeee}";
+.quality.failed{border-color:#c22;background:#fdeeee}\
+#summary{font-size:1em}#summary td.ok{background:#dff3e6}#summary td.poor{background:#ffefc2}#summary td.failed{background:#f8d0d0;font-weight:bold}";
 
-const CHECK: &str = "window.addEventListener('load',function(){var i=document.images,n=0;\
+/// Run once the page has loaded: writes on `<body>` what a headless
+/// browser's DOM dump can check: images decoded (`data-images-loaded`,
+/// "N/M"), summary rows (`data-summary`), elements whose text overflows
+/// their box or a page wider than the window (`data-overflow`, the first
+/// in `data-overflow-first`), and the smallest font size of any text
+/// (`data-min-font`, px).
+const CHECK: &str = "window.addEventListener('load',function(){var b=document.body,i=document.images,n=0;\
 for(var k=0;k<i.length;k++){if(i[k].complete&&i[k].naturalWidth>0)n++;}\
-document.body.setAttribute('data-images-loaded',n+'/'+i.length);});";
+b.setAttribute('data-images-loaded',n+'/'+i.length);\
+b.setAttribute('data-summary',document.querySelectorAll('#summary tr.product').length);\
+var over=0,first='',min=1e9,e=document.querySelectorAll('h1,h2,p,li,td,th,caption,figcaption,nav a,svg.bar text');\
+for(var k=0;k<e.length;k++){var x=e[k];var f=parseFloat(getComputedStyle(x).fontSize);\
+if(x.textContent.trim()&&f<min)min=f;\
+if(x.tagName!=='text'&&x.scrollWidth>x.clientWidth+1&&getComputedStyle(x).display!=='inline'){over++;if(!first)first=x.tagName+': '+x.textContent.slice(0,60);}}\
+if(document.documentElement.scrollWidth>window.innerWidth+1){over++;if(!first)first='page wider than the window: '+document.documentElement.scrollWidth+' px';}\
+b.setAttribute('data-overflow',over);b.setAttribute('data-overflow-first',first);b.setAttribute('data-min-font',Math.round(min*10)/10);});";
 
 /// The quality banner: the overall verdict, then every `failed` and
 /// `poor` product with the figures that put it there.
@@ -136,19 +219,139 @@ fn banner(q: &QualityReport) -> String {
     h
 }
 
+/// A number for a colour bar's label: short, in the figure's own terms.
+fn tick(v: f64) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else if v.abs() >= 1e4 || v.abs() < 1e-3 {
+        format!("{v:.1e}")
+    } else {
+        let s = format!("{v:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
+/// The colour bar under a map: the scale's gradient with its values
+/// (inline SVG, 12 px text, not an image to decode).
+fn colour_bar(scale: &ColourScale) -> String {
+    let (stops, ticks, unit) = match scale {
+        ColourScale::Diverging { low, high, unit } => (
+            "<stop offset=\"0\" stop-color=\"#00f\"/><stop offset=\".5\" stop-color=\"#fff\"/><stop offset=\"1\" stop-color=\"#f00\"/>",
+            [tick(*low), tick(0.5 * (low + high)), tick(*high)],
+            unit,
+        ),
+        ColourScale::Radiance { white, unit } => (
+            "<stop offset=\"0\" stop-color=\"#000\"/><stop offset=\"1\" stop-color=\"#fff\"/>",
+            [tick(0.0), tick(0.5 * white), format!("≥ {}", tick(*white))],
+            unit,
+        ),
+    };
+    let id = format!("g{:x}", {
+        // A stable id per bar content, so that gradients do not collide.
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for b in format!("{scale:?}").bytes() {
+            h = (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3);
+        }
+        h
+    });
+    format!(
+        "<svg class=\"bar\" width=\"320\" height=\"40\" viewBox=\"0 0 320 40\" role=\"img\" aria-label=\"colour scale\">\
+<defs><linearGradient id=\"{id}\">{stops}</linearGradient></defs>\
+<rect x=\"10\" y=\"2\" width=\"300\" height=\"12\" fill=\"url(#{id})\" stroke=\"#888\"/>\
+<text x=\"10\" y=\"29\" font-size=\"12\" text-anchor=\"start\">{}</text>\
+<text x=\"160\" y=\"29\" font-size=\"12\" text-anchor=\"middle\">{}</text>\
+<text x=\"310\" y=\"29\" font-size=\"12\" text-anchor=\"end\">{}</text>\
+<text x=\"160\" y=\"40\" font-size=\"11\" text-anchor=\"middle\" fill=\"#444\">{}</text></svg>",
+        escape(&ticks[0]),
+        escape(&ticks[1]),
+        escape(&ticks[2]),
+        escape(unit)
+    )
+}
+
+fn png_uri(bytes: &[u8]) -> String {
+    format!("data:image/png;base64,{}", STANDARD.encode(bytes))
+}
+
+/// One figure's HTML.
+fn figure_html(f: &Figure) -> String {
+    let img = |src: String, caption: &str, extra: String| {
+        format!(
+            "<figure><img src=\"{src}\" alt=\"{}\">{extra}<figcaption>{}</figcaption></figure>\n",
+            escape(caption),
+            escape(caption)
+        )
+    };
+    match f {
+        Figure::Png { bytes, caption } => img(png_uri(bytes), caption, String::new()),
+        Figure::Svg { svg, caption } => img(
+            format!("data:image/svg+xml;base64,{}", STANDARD.encode(svg.as_bytes())),
+            caption,
+            String::new(),
+        ),
+        Figure::Map { bytes, caption, scale } => img(png_uri(bytes), caption, colour_bar(scale)),
+        Figure::Row(figures) => {
+            let mut h = String::from("<div class=\"row\">\n");
+            for f in figures {
+                h.push_str(&figure_html(f));
+            }
+            h.push_str("</div>\n");
+            h
+        }
+    }
+}
+
+/// The summary at the top: per product its verdict, headline figure,
+/// goal and a link to its section.
+fn summary(rows: &[SummaryRow], sections: &[Section]) -> String {
+    let mut h = String::from(
+        "<table id=\"summary\"><caption>Summary</caption><tr><th>Product</th><th>Verdict</th><th>Figure</th><th>Goal</th><th>Detail</th></tr>\n",
+    );
+    for r in rows {
+        let (class, verdict) = match r.verdict {
+            Some(v) => (v.to_string(), v.to_string()),
+            None => (String::new(), "—".to_string()),
+        };
+        let link = sections
+            .iter()
+            .position(|s| !r.section.is_empty() && s.title == r.section)
+            .map_or_else(String::new, |i| format!("<a href=\"#s{i}\">{}</a>", escape(&r.section)));
+        h.push_str(&format!(
+            "<tr class=\"product\"><td>{}</td><td class=\"{class}\">{verdict}</td><td>{}</td><td>{}</td><td>{link}</td></tr>\n",
+            escape(&r.product),
+            escape(&r.figure),
+            escape(&r.goal)
+        ));
+    }
+    h.push_str("</table>\n");
+    h
+}
+
+fn cell(c: &str) -> String {
+    if c.starts_with(FLAG) {
+        format!("<td class=\"flag\">{}</td>", escape(c))
+    } else {
+        format!("<td>{}</td>", escape(c))
+    }
+}
+
 impl Report {
     /// The page, self-contained.
     pub fn to_html(&self) -> String {
         let mut h = String::new();
         h.push_str("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">");
+        h.push_str("<meta name=\"viewport\" content=\"width=device-width\">");
         h.push_str(&format!("<title>{}</title><style>{STYLE}</style>", escape(&self.title)));
         h.push_str(&format!("<script>{CHECK}</script></head>\n<body>\n"));
         h.push_str(&format!("<h1>{}</h1>\n", escape(&self.title)));
-        for line in &self.intro {
-            h.push_str(&format!("<p>{}</p>\n", escape(line)));
+        if !self.summary.is_empty() {
+            h.push_str(&summary(&self.summary, &self.sections));
         }
         if let Some(q) = &self.quality {
             h.push_str(&banner(q));
+        }
+        for line in &self.intro {
+            h.push_str(&format!("<p>{}</p>\n", escape(line)));
         }
         h.push_str("<nav>");
         for (i, s) in self.sections.iter().enumerate() {
@@ -169,31 +372,23 @@ impl Report {
                 for row in &t.rows {
                     h.push_str("<tr>");
                     for c in row {
-                        h.push_str(&format!("<td>{}</td>", escape(c)));
+                        h.push_str(&cell(c));
                     }
                     h.push_str("</tr>\n");
                 }
                 h.push_str("</table>\n");
             }
-            if !s.figures.is_empty() {
+            let (rows, loose): (Vec<&Figure>, Vec<&Figure>) =
+                s.figures.iter().partition(|f| matches!(f, Figure::Row(_)));
+            if !loose.is_empty() {
                 h.push_str("<div class=\"figs\">\n");
-                for f in &s.figures {
-                    let (src, caption) = match f {
-                        Figure::Png { bytes, caption } => {
-                            (format!("data:image/png;base64,{}", STANDARD.encode(bytes)), caption)
-                        }
-                        Figure::Svg { svg, caption } => (
-                            format!("data:image/svg+xml;base64,{}", STANDARD.encode(svg.as_bytes())),
-                            caption,
-                        ),
-                    };
-                    h.push_str(&format!(
-                        "<figure><img src=\"{src}\" alt=\"{}\"><figcaption>{}</figcaption></figure>\n",
-                        escape(caption),
-                        escape(caption)
-                    ));
+                for f in loose {
+                    h.push_str(&figure_html(f));
                 }
                 h.push_str("</div>\n");
+            }
+            for f in rows {
+                h.push_str(&figure_html(f));
             }
             h.push_str("</section>\n");
         }
@@ -201,9 +396,15 @@ impl Report {
         h
     }
 
-    /// Number of figures.
+    /// Number of images (a row counts its figures).
     pub fn figure_count(&self) -> usize {
-        self.sections.iter().map(|s| s.figures.len()).sum()
+        fn count(f: &Figure) -> usize {
+            match f {
+                Figure::Row(fs) => fs.iter().map(count).sum(),
+                _ => 1,
+            }
+        }
+        self.sections.iter().flat_map(|s| &s.figures).map(count).sum()
     }
 }
 
@@ -216,6 +417,7 @@ mod tests {
         let r = Report {
             title: "a <b> & c".into(),
             intro: vec![],
+            summary: vec![],
             quality: None,
             sections: vec![Section {
                 title: "s".into(),

@@ -10,7 +10,7 @@ mod html;
 mod image_encode;
 mod plot;
 
-pub use html::{Figure, Report, Section, Table};
+pub use html::{ColourScale, Figure, Report, Section, SummaryRow, Table, flagged};
 pub use image_encode::{false_colour_png, tonemapped_png};
 pub use plot::{Series, line_plot_svg};
 

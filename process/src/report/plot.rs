@@ -17,6 +17,12 @@ pub struct Series {
     pub markers: bool,
 }
 
+/// Size of tick labels, legend and axis text, in the SVG's pixels. The
+/// report shows plots at their natural 640 px width, so this is what a
+/// reader sees at 100 % zoom, less the backend's 0.81 (plotters writes a 16
+/// px font as font-size="12.9"): the issue asked for at least 11 px.
+const LABEL_PX: u32 = 16;
+
 /// A plot of `series` with axis labels, sized to fit every finite point.
 pub fn line_plot_svg(title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Result<String, ReportError> {
     let finite: Vec<(f64, f64)> = series
@@ -52,16 +58,18 @@ pub fn line_plot_svg(title: &str, x_label: &str, y_label: &str, series: &[Series
         let root = SVGBackend::with_string(&mut svg, (640, 420)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
         let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 18))
+            .caption(title, ("sans-serif", 20))
             .margin(12)
-            .x_label_area_size(36)
-            .y_label_area_size(56)
+            .x_label_area_size(44)
+            .y_label_area_size(72)
             .build_cartesian_2d(x.0..x.1, y.0..y.1)
             .map_err(|e| err(e.to_string()))?;
         chart
             .configure_mesh()
             .x_desc(x_label)
             .y_desc(y_label)
+            .label_style(("sans-serif", LABEL_PX))
+            .axis_desc_style(("sans-serif", LABEL_PX + 1))
             .draw()
             .map_err(|e| err(e.to_string()))?;
         for s in series {
@@ -90,6 +98,7 @@ pub fn line_plot_svg(title: &str, x_label: &str, y_label: &str, series: &[Series
             .configure_series_labels()
             .background_style(WHITE.mix(0.8))
             .border_style(BLACK)
+            .label_font(("sans-serif", LABEL_PX))
             .draw()
             .map_err(|e| err(e.to_string()))?;
         root.present().map_err(|e| err(e.to_string()))?;
@@ -117,5 +126,26 @@ mod tests {
             ..s("e", false)
         };
         assert!(line_plot_svg("t", "x", "y", &[empty]).is_err());
+    }
+
+    /// Every text in the plot is at least 11 px at its natural size (the
+    /// report's plots were unreadable at about 6 px).
+    #[test]
+    fn every_text_is_readable_at_natural_size() {
+        let s = Series {
+            label: "measured".into(),
+            points: (0..20).map(|i| (f64::from(i), f64::from(i * i))).collect(),
+            colour: (0, 0, 200),
+            markers: false,
+        };
+        let svg = line_plot_svg("title", "time (h)", "E (W/m²)", &[s]).unwrap();
+        let sizes: Vec<f64> = svg
+            .split("font-size=\"")
+            .skip(1)
+            .map(|rest| rest.split('"').next().unwrap().trim_end_matches("px").parse().unwrap())
+            .collect();
+        assert!(sizes.len() > 10, "{} texts", sizes.len());
+        let smallest = sizes.iter().copied().fold(f64::INFINITY, f64::min);
+        assert!(smallest >= 11.0, "smallest text {smallest} px");
     }
 }

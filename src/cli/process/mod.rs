@@ -187,6 +187,7 @@ fn run_room(args: &ProcessArgs, out: &Path, debevec: &DebevecOptions) -> Result<
     super::igi::write_products(&products.recovered, &out.join("room").join("igi"), &quality)?;
     let report = Report {
         title: format!("Campanile: {}", args.session.display()),
+        summary: Vec::new(),
         intro: vec![format!(
             "Room session {}, processed by campanile {}.",
             args.session.display(),
@@ -328,6 +329,7 @@ pub fn run(args: ProcessArgs) -> Result<()> {
     let quality = QualityReport::new(quality, &processed.thresholds);
     let report = Report {
         title: format!("Campanile: {}", args.session.display()),
+        summary: Vec::new(),
         intro: vec![format!(
             "Session {}, processed by campanile {}.",
             args.session.display(),

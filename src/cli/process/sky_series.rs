@@ -409,6 +409,7 @@ pub fn report(
     }
     Ok(Report {
         title: format!("Campanile sky time series: {}", session.display()),
+        summary: Vec::new(),
         intro: vec![format!(
             "Sky-only session {}, processed by campanile {}: every figure below is recomputed from the per-scan products in scans/.",
             session.display(),
