@@ -101,6 +101,45 @@ pub struct SummaryRow {
     pub section: String,
 }
 
+impl SummaryRow {
+    /// A row for the products of `quality` whose names start with
+    /// `prefix` (e.g. "sun " for every sun): the worst verdict among them,
+    /// and as the figure either how many there are, all within their
+    /// gates, or the worst one's figures against the bounds they passed.
+    /// `None` when no product matches.
+    pub fn from_quality(quality: &QualityReport, prefix: &str, product: &str, section: &str) -> Option<SummaryRow> {
+        let matching: Vec<&ProductQuality> = quality
+            .products
+            .iter()
+            .filter(|p| p.product.starts_with(prefix))
+            .collect();
+        // The first of the worst, in the products' order.
+        let worst = matching.iter().rev().max_by_key(|p| p.verdict)?;
+        let figure = match worst.verdict {
+            Verdict::Ok => match matching.len() {
+                1 => "within its gates".to_string(),
+                n => format!("{n} products, all within their gates"),
+            },
+            v => {
+                let count = matching.iter().filter(|p| p.verdict == v).count();
+                let more = if count > 1 {
+                    format!(" (and {} more {v})", count - 1)
+                } else {
+                    String::new()
+                };
+                format!("{}: {}{more}", worst.product, worst.reasons())
+            }
+        };
+        Some(SummaryRow {
+            product: product.to_string(),
+            verdict: Some(worst.verdict),
+            figure,
+            goal: "the gates in quality.json".to_string(),
+            section: section.to_string(),
+        })
+    }
+}
+
 /// The whole report.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Report {
@@ -440,6 +479,97 @@ mod tests {
         // "<svg xmlns='http://www.w3.org/2000/svg'/>" in base64.
         assert!(html.contains("data:image/svg+xml;base64,PHN2ZyB4bWxucz0naHR0cDovL3d3dy53My5vcmcvMjAwMC9zdmcnLz4="));
         assert_eq!(r.figure_count(), 1);
+    }
+
+    #[test]
+    fn summary_rows_take_the_worst_verdict_and_link_their_section() {
+        use crate::quality::{Better, Check, Gate, ProductQuality, Quality, QualityReport};
+        let sun = |name: &str, spread: f64| {
+            ProductQuality::new(
+                format!("sun {name}"),
+                vec![Check::new(
+                    "triplet spread",
+                    spread,
+                    Gate::new(0.03, 0.15),
+                    Better::Lower,
+                )],
+            )
+        };
+        let q = QualityReport::new(
+            vec![
+                sun("a", 0.01),
+                sun("b", 0.05),
+                sun("c", 0.04),
+                ProductQuality::new("sky a", vec![]),
+            ],
+            &Quality::default(),
+        );
+        let row = SummaryRow::from_quality(&q, "sun ", "Sun", "Sun and extinction").unwrap();
+        assert_eq!(row.verdict, Some(Verdict::Poor));
+        assert_eq!(row.figure, "sun b: triplet spread 0.05 > 0.03 (and 1 more poor)");
+        let sky = SummaryRow::from_quality(&q, "sky ", "Sky", "Sky").unwrap();
+        assert_eq!(
+            (sky.verdict, sky.figure.as_str()),
+            (Some(Verdict::Ok), "within its gates")
+        );
+        assert!(SummaryRow::from_quality(&q, "room: ", "Room", "").is_none());
+        let r = Report {
+            title: "t".into(),
+            summary: vec![row, sky],
+            sections: vec![Section {
+                title: "Sky".into(),
+                ..Section::default()
+            }],
+            ..Report::default()
+        };
+        let html = r.to_html();
+        assert!(html.contains("<td class=\"poor\">poor</td>"), "{html}");
+        assert!(
+            html.contains("<a href=\"#s0\">Sky</a></td>"),
+            "the row links its section"
+        );
+        assert_eq!(html.matches("<tr class=\"product\">").count(), 2);
+        assert!(html.find("id=\"summary\"").unwrap() < html.find("<nav>").unwrap());
+    }
+
+    #[test]
+    fn flagged_cells_and_maps_are_drawn_with_their_marks() {
+        let r = Report {
+            title: "t".into(),
+            sections: vec![Section {
+                title: "s".into(),
+                tables: vec![Table {
+                    caption: "c".into(),
+                    header: vec!["a".into(), "b".into()],
+                    rows: vec![vec!["x".into(), flagged("1500 %")]],
+                }],
+                figures: vec![Figure::Row(vec![
+                    Figure::Png {
+                        bytes: vec![1],
+                        caption: "photo".into(),
+                    },
+                    Figure::Map {
+                        bytes: vec![2],
+                        caption: "error".into(),
+                        scale: ColourScale::Diverging {
+                            low: -0.1,
+                            high: 0.1,
+                            unit: "relative error".into(),
+                        },
+                    },
+                ])],
+                ..Section::default()
+            }],
+            ..Report::default()
+        };
+        let html = r.to_html();
+        assert!(html.contains("<td class=\"flag\">⚠ 1500 %</td>"), "{html}");
+        assert!(html.contains("<div class=\"row\">"));
+        assert!(html.contains("<svg class=\"bar\""));
+        for label in [">-0.1<", ">0<", ">0.1<", ">relative error<"] {
+            assert!(html.contains(label), "{label} on the colour bar");
+        }
+        assert_eq!(r.figure_count(), 2);
     }
 
     #[test]
