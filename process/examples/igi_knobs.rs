@@ -58,12 +58,13 @@ fn main() {
     std::fs::write(out.join("materials.json"), serde_json::to_string_pretty(&json).unwrap()).expect("write");
     for (i, it) in r.iterations.iter().enumerate() {
         println!(
-            "pass {}: {:.2} s (gather {:.2}, ΔS {:.2}, fit {:.2})",
+            "pass {}: {:.2} s (gather {:.2}, ΔS {:.2}, fit {:.2}), largest relative change {:.4}",
             i + 1,
             it.seconds,
             it.gather_seconds,
             it.delta_s_seconds,
-            it.fit_seconds
+            it.fit_seconds,
+            it.max_relative_change
         );
     }
     println!("{:.2} s; {}", r.seconds, r.interreflection.message);
