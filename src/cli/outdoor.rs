@@ -22,7 +22,7 @@ use clap::{Args, Subcommand};
 use serde::{Deserialize, Serialize};
 
 use super::exit::bad_input;
-use super::process::bar;
+use campanile_session::progress::bar;
 
 /// `campanile outdoor`.
 #[derive(Debug, Subcommand)]

@@ -214,7 +214,8 @@ fn run_room(args: &RenderArgs, scene: &Path, lights: &Path) -> Result<()> {
         .into_iter()
         .map(|(_, l)| l)
         .collect();
-    let r = super::igi::recover_scene(scene, args.quick).with_context(|| format!("reading {}", scene.display()))?;
+    let r = super::igi::recover_scene(scene, args.quick, Default::default())
+        .with_context(|| format!("reading {}", scene.display()))?;
     let cameras = match &args.camera {
         Some(c) => vec![c.clone()],
         None => r.image_cameras(),
