@@ -14,6 +14,8 @@
 //! - [`scan_processor`]: the [`ScanProcessor`](scan_processor::ScanProcessor)
 //!   the station calls after each scan, and the sky series' one;
 //! - [`igi`]: inverse global illumination on a scene file and its products;
+//! - [`outdoor_files`]: outdoor reflectance on plain files (recover, render);
+//! - [`scene_render`]: the scene at new times from recovered pseudo-albedos;
 //! - [`demo`]: the simulated station's day, cube and room, with every
 //!   figure beside the simulator's truth;
 //! - [`verdicts`], [`partial_file`], [`progress`], [`error`].
@@ -29,11 +31,13 @@ macro_rules! bail {
 pub mod demo;
 pub mod error;
 pub mod igi;
+pub mod outdoor_files;
 pub mod partial_file;
 pub mod process;
 pub mod progress;
 pub mod run;
 pub mod scan_processor;
+pub mod scene_render;
 pub mod sky_series;
 pub mod verdicts;
 
