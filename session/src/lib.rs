@@ -16,6 +16,8 @@
 //! - [`igi`]: inverse global illumination on a scene file and its products;
 //! - [`outdoor_files`]: outdoor reflectance on plain files (recover, render);
 //! - [`scene_render`]: the scene at new times from recovered pseudo-albedos;
+//! - [`capture_inputs`]: a capture's plan, station, scene and timeline, and
+//!   a simulated station's world;
 //! - [`demo`]: the simulated station's day, cube and room, with every
 //!   figure beside the simulator's truth;
 //! - [`verdicts`], [`partial_file`], [`progress`], [`error`].
@@ -28,6 +30,7 @@ macro_rules! bail {
     };
 }
 
+pub mod capture_inputs;
 pub mod demo;
 pub mod error;
 pub mod igi;

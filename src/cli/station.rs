@@ -18,10 +18,10 @@ use campanile_sim::station::{SimOptions, SimStation};
 use chrono::{DateTime, TimeDelta, Utc};
 use clap::{Args, Subcommand};
 
-use super::capture::{Inputs, SimulatedWorld, simulated_world};
 use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
 use campanile_capture::unattended::ScanHook;
 use campanile_process::quality::Quality;
+use campanile_session::capture_inputs::{Inputs, SimulatedWorld, simulated_world};
 use campanile_session::scan_processor::{SkySeriesProcessor, StationHook};
 
 #[derive(Debug, Subcommand)]
