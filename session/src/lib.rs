@@ -15,6 +15,7 @@
 //!   the station calls after each scan, and the sky series' one;
 //! - [`igi`]: inverse global illumination on a scene file and its products;
 //! - [`outdoor_files`]: outdoor reflectance on plain files (recover, render);
+//! - [`sky_files`]: sky models on plain files (fit, predict, map);
 //! - [`scene_render`]: the scene at new times from recovered pseudo-albedos;
 //! - [`capture_inputs`]: a capture's plan, station, scene and timeline, and
 //!   a simulated station's world;
@@ -41,6 +42,7 @@ pub mod progress;
 pub mod run;
 pub mod scan_processor;
 pub mod scene_render;
+pub mod sky_files;
 pub mod sky_series;
 pub mod verdicts;
 
