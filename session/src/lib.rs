@@ -19,6 +19,8 @@
 //! - [`scene_render`]: the scene at new times from recovered pseudo-albedos;
 //! - [`capture_inputs`]: a capture's plan, station, scene and timeline, and
 //!   a simulated station's world;
+//! - [`capture_run`]: a capture's timeline run on the simulated or the real
+//!   station, and the session's tally;
 //! - [`demo`]: the simulated station's day, cube and room, with every
 //!   figure beside the simulator's truth;
 //! - [`verdicts`], [`partial_file`], [`progress`], [`error`].
@@ -32,6 +34,7 @@ macro_rules! bail {
 }
 
 pub mod capture_inputs;
+pub mod capture_run;
 pub mod demo;
 pub mod error;
 pub mod igi;

@@ -6,24 +6,21 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
-use campanile_capture::clock::SystemClock;
-use campanile_capture::controller::{self, Progress, RunError, RunOptions, RunReport, ShotOutcome};
+use campanile_capture::controller::{Progress, ShotOutcome};
 use campanile_capture::schedule::{Occurrence, PlannedShot};
-use campanile_capture::station::{SerialOpener, StationOptions, StationRig, check_ports, open_camera};
+use campanile_capture::station::{check_ports, open_camera};
+use campanile_capture::store::SessionStore;
 use campanile_capture::store::fault::QuotaStorage;
 use campanile_capture::store::{FsStorage, Storage};
-use campanile_capture::store::{JournalEntry, SessionStore};
 use campanile_config::camera::CameraDriver;
 use campanile_firmware_link::link::soak::PROVEN_FAULT_CHANCE;
-use campanile_sim::camera::CameraOptions;
-use campanile_sim::faults::{CameraFaultPlan, Device, FaultPlan, LinkFaults, Outage};
-use campanile_sim::station::{SimOptions, SimStation};
-use chrono::TimeDelta;
+use campanile_sim::faults::{Device, Outage};
 use clap::Args;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
-use campanile_session::capture_inputs::{Inputs, SimulatedWorld, simulated_world};
+use campanile_session::capture_inputs::Inputs;
+use campanile_session::capture_run::{SimFaults, Tally, run_real, run_simulated, tally};
 
 /// Run a plan on a station and store every frame in a session directory.
 ///
@@ -284,6 +281,19 @@ fn capture(args: &CaptureArgs, inputs: &Inputs) -> Result<bool> {
     }
 }
 
+/// The `--sim-*` options of `args`.
+fn sim_faults(args: &CaptureArgs) -> SimFaults {
+    SimFaults {
+        samples: args.sim_samples,
+        bounces: args.sim_bounces,
+        drop_chance: args.sim_drop_chance,
+        corrupt_chance: args.sim_corrupt_chance,
+        camera_timeout_chance: args.sim_camera_timeout_chance,
+        camera_error_chance: args.sim_camera_error_chance,
+        outages: args.sim_outage.iter().map(|o| o.0).collect(),
+    }
+}
+
 /// Open the session (new or resumed) on `storage`, run the timeline on
 /// the station's devices, and report.
 fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> Result<bool> {
@@ -333,7 +343,7 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
     let mut bars = Bars::new(promised);
     let wall = Instant::now();
     let started = if inputs.station.uses_simulation() {
-        run_simulated(args, inputs, &mut store, resumed, &mut bars)
+        run_simulated(&sim_faults(args), inputs, &mut store, resumed, &mut bars)
     } else {
         run_real(inputs, &mut store, &mut bars)
     };
@@ -345,7 +355,7 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
             if let Err(d) = store.discard_unused() {
                 tracing::warn!(dir = %dir.display(), error = %d, "could not remove the unused session");
             }
-            return Err(e);
+            return Err(e.into());
         }
     };
     bars.session.finish_and_clear();
@@ -355,38 +365,16 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
         Ok(r) => (r, None),
         Err(e) => (*e.report.clone(), Some(e)),
     };
-    let promised_keys: std::collections::HashSet<&str> = inputs
-        .timeline
-        .occurrences
-        .iter()
-        .flat_map(|o| o.shots.iter())
-        .filter(|s| s.promised)
-        .map(|s| s.key.as_str())
-        .collect();
-    let (mut stored, mut late, mut extra) = (0, 0, 0);
-    // Shots, not lines: a journal from before one-line-per-shot may hold several.
-    let mut missed_keys = std::collections::HashSet::new();
-    for e in store.entries() {
-        let promised = promised_keys.contains(e.key());
-        match e {
-            JournalEntry::Done(_) if promised => stored += 1,
-            JournalEntry::Late(_) if promised => {
-                stored += 1;
-                late += 1;
-            }
-            JournalEntry::Missed(_) if !store.completed(e.key()) => {
-                missed_keys.insert(e.key());
-            }
-            JournalEntry::Missed(_) => {}
-            JournalEntry::Pruned(_) | JournalEntry::Outage(_) => {}
-            _ => extra += 1,
-        }
-    }
+    let Tally {
+        stored,
+        late,
+        extra,
+        missed,
+    } = tally(inputs, &store);
     outln!("session {}", store.dir().display())?;
     outln!("  frames promised      {promised}")?;
     outln!("  frames stored        {stored} (of which late: {late})")?;
     outln!("  auto-bracket extras  {extra}")?;
-    let missed = missed_keys.len();
     outln!("  shots missed         {missed}")?;
     outln!(
         "  this run             {} frames, {} missed, {} retries, {} reconnects, {} metering captures, {} sun retakes",
@@ -404,114 +392,6 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
         return Ok(false);
     }
     Ok(stored == promised && missed == 0)
-}
-
-type RunResult = std::result::Result<RunReport, RunError>;
-
-/// The simulated station under paused time: the day passes as fast as the
-/// frames render.
-fn run_simulated<S: Storage>(
-    args: &CaptureArgs,
-    inputs: &Inputs,
-    store: &mut SessionStore<S>,
-    resumed: bool,
-    bars: &mut Bars,
-) -> Result<RunResult> {
-    let first = &inputs.timeline.occurrences[0];
-    // The simulated calendar begins a minute before the first occurrence,
-    // or, on resume, a second after the last journaled shot.
-    let last = store.entries().iter().map(JournalEntry::time);
-    let origin = match (resumed, last.max()) {
-        (true, Some(t)) => t + TimeDelta::seconds(1),
-        _ => first.start - TimeDelta::seconds(60),
-    };
-    let SimulatedWorld { world, home, seed } = simulated_world(inputs, args.sim_samples, args.sim_bounces)?;
-    let faults = FaultPlan {
-        link: (args.sim_drop_chance.is_some() || args.sim_corrupt_chance.is_some()).then(|| LinkFaults {
-            drop_chance: args.sim_drop_chance.unwrap_or(0.0),
-            corrupt_chance: args.sim_corrupt_chance.unwrap_or(0.0),
-        }),
-        outages: args.sim_outage.iter().map(|o| o.0).collect(),
-        ..FaultPlan::default()
-    };
-    let camera = CameraOptions {
-        faults: CameraFaultPlan {
-            seed,
-            timeout_chance: args.sim_camera_timeout_chance.unwrap_or(0.0),
-            error_chance: args.sim_camera_error_chance.unwrap_or(0.0),
-            ..CameraFaultPlan::none()
-        },
-        ..CameraOptions::default()
-    };
-    let options = SimOptions {
-        origin,
-        position_m: home,
-        faults,
-        camera,
-        ..SimOptions::default()
-    };
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_time()
-        .start_paused(true)
-        .build()
-        .context("starting the runtime")?;
-    runtime.block_on(async {
-        let mut sim = SimStation::start(&inputs.station, world, options)
-            .await
-            .context("starting the simulated station")?;
-        let clock = sim.clock();
-        Ok(controller::run(
-            &inputs.timeline,
-            &inputs.plan.plan.value,
-            &inputs.station,
-            store,
-            &mut sim,
-            &clock,
-            &RunOptions::default(),
-            bars,
-        )
-        .await)
-    })
-}
-
-/// The station's real devices on the wall clock: the camera its driver
-/// names, the serial devices on their ports, reopened with backoff when a
-/// link drops.
-fn run_real<S: Storage>(inputs: &Inputs, store: &mut SessionStore<S>, bars: &mut Bars) -> Result<RunResult> {
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .context("starting the runtime")?;
-    runtime.block_on(async {
-        let camera = open_camera(&inputs.station.camera)
-            .with_context(|| format!("opening the camera of station {}", inputs.station_label))?;
-        // Sequence numbers from the clock, so that a restarted program does
-        // not reuse numbers a campanile-link device still remembers.
-        let link_seq = (chrono::Utc::now().timestamp_subsec_micros() % 4096) as u16 + 1;
-        let options = StationOptions {
-            link_seq,
-            ..StationOptions::default()
-        };
-        let mut rig = StationRig::connect(&inputs.station, SerialOpener, camera, options)
-            .await
-            .with_context(|| {
-                format!(
-                    "connecting the devices of station {} (check the cables, the baud rates and the devices' power)",
-                    inputs.station_label
-                )
-            })?;
-        Ok(controller::run(
-            &inputs.timeline,
-            &inputs.plan.plan.value,
-            &inputs.station,
-            store,
-            &mut rig,
-            &SystemClock,
-            &RunOptions::default(),
-            bars,
-        )
-        .await)
-    })
 }
 
 fn seconds(d: Duration) -> String {
