@@ -17,10 +17,10 @@
 //! 0.5 stop per scan and do not oscillate.
 //!
 //! Each settled scan is processed as `campanile station run --process`
-//! does (the sky time series, through the binary: see
-//! [`process_each_scan`]), with the simulator's true response (the plan
-//! has no calibration bracket; see `sim_response`), and the days' time
-//! series are checked against the journal and the simulator's truth.
+//! does (the library's sky time series: see [`process_each_scan`]), with
+//! the simulator's true response (the plan has no calibration bracket; see
+//! `sim_response`), and the days' time series are checked against the
+//! journal and the simulator's truth.
 //!
 //! A second test sends a real SIGTERM to a `campanile station run` child
 //! and runs the same command again.
@@ -45,8 +45,10 @@ use campanile_capture::unattended::{
 use campanile_config::document::LoadedPlan;
 use campanile_config::{Station, load_plan, load_station};
 use campanile_process::pipeline::TRIPLET_AGREEMENT;
+use campanile_process::quality::{Quality, Verdict};
 use campanile_process::sky::{angle_between, direction};
 use campanile_process::sky_series::{SkySeries, read_scans, series_width};
+use campanile_session::scan_processor::{ScanProcessor, SkySeriesProcessor};
 use campanile_sim::faults::{Device, FaultPlan, Outage};
 use campanile_sim::station::{SimOptions, SimStation};
 use campanile_sim::world::{World, load_scene};
@@ -129,46 +131,41 @@ fn outage_from(origin: DateTime<Utc>, start: DateTime<Utc>, length: Duration) ->
     }]
 }
 
-/// The scan hook of `campanile station run --process --response CSV`
-/// (its `SkySeriesHook`: `process_scan` on the settled occurrence, then
-/// `recompute_day`), reached through the binary, whose code it is:
-/// `campanile process DAY --occurrence ID --response CSV` calls the same
-/// two functions (and then rewrites the day's report page). Failures are
-/// collected, so that the test can name them.
+/// The scan hook of `campanile station run --process --response CSV`:
+/// the library's sky-series [`ScanProcessor`] (the station's
+/// `StationHook` calls the same one) on the settled occurrence, under the
+/// plan's thresholds. Failures are collected, so that the test can name
+/// them.
 fn process_each_scan(
     response: &Path,
+    thresholds: Quality,
     failures: Arc<Mutex<Vec<String>>>,
 ) -> impl FnMut(&Path, &Occurrence) -> Result<(), String> + Send {
-    let response = response.to_path_buf();
+    let mut processor = SkySeriesProcessor {
+        response: response.to_path_buf(),
+        thresholds,
+    };
     move |dir: &Path, occurrence: &Occurrence| {
-        let out = Command::new(env!("CARGO_BIN_EXE_campanile"))
-            .arg("-q")
-            .arg("process")
-            .arg(dir)
-            .args(["--occurrence", &occurrence.key, "--response"])
-            .arg(&response)
-            .output()
-            .map_err(|e| e.to_string())?;
-        // Exit 3: the scan was processed, but a product failed its gate.
-        // Only a low sun's triplet may (below 8° it disagrees by 8–42% at
-        // these pixels, the README's false alarm); anything else is a failure.
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        let only_sun_failed = out.status.code() == Some(3)
-            && stdout
-                .lines()
-                .find_map(|l| l.strip_prefix("quality: "))
-                .and_then(|l| l.split(" — failed: ").nth(1))
-                .is_some_and(|f| {
-                    f.split("; ")
-                        .all(|p| p.starts_with("sun sky@") && p.contains("triplet spread"))
-                });
-        if out.status.success() || only_sun_failed {
-            Ok(())
-        } else {
-            let why = format!("{}: {}", occurrence.key, String::from_utf8_lossy(&out.stderr));
-            failures.lock().unwrap().push(why.clone());
-            Err(why)
-        }
+        let why = match processor.process(dir, &occurrence.key) {
+            // A failed verdict: the scan was processed, but a product
+            // failed its gate. Only a low sun's triplet may (below 8° it
+            // disagrees by 8–42% at these pixels, the README's false
+            // alarm); anything else is a failure.
+            Ok(q) if q.verdict == Verdict::Failed => {
+                let failed = q.failed_products();
+                if failed
+                    .iter()
+                    .all(|p| p.starts_with("sun sky@") && p.contains("triplet spread"))
+                {
+                    return Ok(());
+                }
+                format!("{}: {}", occurrence.key, q.summary_line())
+            }
+            Ok(_) => return Ok(()),
+            Err(e) => format!("{}: {e:#}", occurrence.key),
+        };
+        failures.lock().unwrap().push(why.clone());
+        Err(why)
     }
 }
 
@@ -228,7 +225,11 @@ async fn three_simulated_days_survive_a_stop_an_outage_and_a_budget() {
     let response = tmp.path().join("response.csv");
     sim_response::write_true_response(&response, i.station.camera.bit_depth);
     let failures = Arc::new(Mutex::new(Vec::new()));
-    let mut hook = process_each_scan(&response, failures.clone());
+    let mut hook = process_each_scan(
+        &response,
+        i.plan.plan.value.quality.clone().unwrap_or_default(),
+        failures.clone(),
+    );
     let first = unattended::run(
         &station_inputs,
         &store,

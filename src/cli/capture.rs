@@ -2,33 +2,25 @@
 //! or resume one after a crash.
 
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
-use campanile_capture::clock::SystemClock;
-use campanile_capture::controller::{self, Progress, RunError, RunOptions, RunReport, ShotOutcome};
-use campanile_capture::schedule::{Occurrence, PlannedShot, SceneGeometry, Timeline, TimelineOptions, timeline};
-use campanile_capture::station::{SerialOpener, StationOptions, StationRig, check_ports, open_camera};
+use campanile_capture::controller::{Progress, ShotOutcome};
+use campanile_capture::schedule::{Occurrence, PlannedShot};
+use campanile_capture::station::{check_ports, open_camera};
+use campanile_capture::store::SessionStore;
 use campanile_capture::store::fault::QuotaStorage;
 use campanile_capture::store::{FsStorage, Storage};
-use campanile_capture::store::{
-    JournalEntry, PLAN_FILE, Provenance, SCENE_FILE, STATION_FILE, SessionStore, Snapshot, SourcePaths,
-};
 use campanile_config::camera::CameraDriver;
-use campanile_config::document::{Document, load_text};
-use campanile_config::{Station, check_plan_on_station, load_plan, load_station};
 use campanile_firmware_link::link::soak::PROVEN_FAULT_CHANCE;
-use campanile_sim::camera::CameraOptions;
-use campanile_sim::faults::{CameraFaultPlan, Device, FaultPlan, LinkFaults, Outage};
-use campanile_sim::station::{SimOptions, SimStation};
-use campanile_sim::world::{World, load_scene};
-use chrono::TimeDelta;
+use campanile_sim::faults::{Device, Outage};
 use clap::Args;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
+use campanile_session::capture_inputs::Inputs;
+use campanile_session::capture_run::{SimFaults, Tally, run_real, run_simulated, tally};
 
 /// Run a plan on a station and store every frame in a session directory.
 ///
@@ -169,7 +161,12 @@ impl std::str::FromStr for OutageArg {
 }
 
 pub fn run(args: CaptureArgs) -> Result<u8> {
-    let inputs = match Inputs::load(&args) {
+    let inputs = match Inputs::load(
+        args.resume.as_deref(),
+        args.plan.as_deref(),
+        args.station.as_deref(),
+        args.days,
+    ) {
         Ok(i) => i,
         Err(e) => {
             eprintln!("error: {e:#}");
@@ -194,151 +191,6 @@ pub fn run(args: CaptureArgs) -> Result<u8> {
     } else {
         EXIT_FAILURE
     })
-}
-
-/// The plan, station and scene, as `plan check` reads them.
-pub(super) struct Inputs {
-    pub(super) plan: campanile_config::document::LoadedPlan,
-    pub(super) station: Station,
-    pub(super) timeline: Timeline,
-    pub(super) snapshot: Snapshot,
-    /// How to name the plan and station in messages.
-    plan_label: String,
-    pub(super) station_label: String,
-    /// Whether they were read from a session's snapshot.
-    from_session: bool,
-}
-
-impl Inputs {
-    fn load(args: &CaptureArgs) -> Result<Self> {
-        match (&args.resume, &args.plan, &args.station) {
-            (Some(dir), None, None) => Self::from_session(dir, args.days),
-            (_, Some(plan), Some(station)) => Self::from_files(plan, station, args.days),
-            (Some(_), _, _) => bail!(
-                "give both PLAN and --station STATION, or neither (to resume with the session's own plan.ron and station.ron)"
-            ),
-            (None, _, _) => bail!("give PLAN and --station STATION"),
-        }
-    }
-
-    /// Read PLAN and STATION (and the plan's scene) from their files.
-    pub(super) fn from_files(plan_path: &Path, station_path: &Path, days: Option<u32>) -> Result<Self> {
-        let plan = load_plan(plan_path).map_err(|e| anyhow::anyhow!("{e}"))?;
-        let loaded = load_station(station_path).map_err(|e| anyhow::anyhow!("{e}"))?;
-        let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
-        let snapshot = Snapshot {
-            plan_ron: plan.plan.source.text.clone(),
-            station_ron: loaded.source.text.clone(),
-            scene_ron: plan.scene.as_ref().map(|s| s.source.text.clone()),
-            provenance: Provenance {
-                campanile_version: env!("CARGO_PKG_VERSION").to_owned(),
-                created_utc: chrono::Utc::now(),
-                calibration: Vec::new(),
-                sources: Some(SourcePaths {
-                    plan: absolute(plan_path),
-                    station: absolute(station_path),
-                    scene: plan.scene.as_ref().map(|s| absolute(&s.source.path)),
-                }),
-            },
-        };
-        Self::new(
-            plan,
-            loaded.value,
-            snapshot,
-            plan_path.display().to_string(),
-            station_path.display().to_string(),
-            false,
-            days,
-        )
-    }
-
-    /// Read the plan, station and scene from the snapshot of the session
-    /// in `dir`. Their relative paths (the scene's OBJ geometry) resolve
-    /// against the files the session was created from; the scene file
-    /// there must still be the one snapshotted.
-    fn from_session(dir: &Path, days: Option<u32>) -> Result<Self> {
-        let snapshot = Snapshot::read_dir(dir)
-            .with_context(|| format!("reading the snapshot of the session in {}", dir.display()))?;
-        let sources = snapshot.provenance.sources.clone();
-        let plan_path = sources.as_ref().map_or_else(|| dir.join(PLAN_FILE), |s| s.plan.clone());
-        let station_path = sources
-            .as_ref()
-            .map_or_else(|| dir.join(STATION_FILE), |s| s.station.clone());
-        let plan = match load_text(&plan_path, snapshot.plan_ron.clone()) {
-            Ok(Document::Plan(p)) => *p,
-            Ok(_) => bail!(
-                "{}: the session's plan snapshot is not a `Plan(...)`",
-                dir.join(PLAN_FILE).display()
-            ),
-            Err(e) => bail!(
-                "{e}\nthe session's plan snapshot ({}) does not load as if at {}; give PLAN and --station again",
-                dir.join(PLAN_FILE).display(),
-                plan_path.display()
-            ),
-        };
-        if let (Some(scene), Some(snap)) = (&plan.scene, &snapshot.scene_ron)
-            && &scene.source.text != snap
-        {
-            bail!(
-                "the scene file {} has changed since the session in {} began (its snapshot is {}); restore it to resume",
-                scene.source.path.display(),
-                dir.display(),
-                dir.join(SCENE_FILE).display()
-            );
-        }
-        let station = match load_text(&station_path, snapshot.station_ron.clone()) {
-            Ok(Document::Station(s)) => s.value,
-            Ok(_) => bail!(
-                "{}: the session's station snapshot is not a `Station(...)`",
-                dir.join(STATION_FILE).display()
-            ),
-            Err(e) => bail!(
-                "{e}\nthe session's station snapshot ({}) does not load",
-                dir.join(STATION_FILE).display()
-            ),
-        };
-        Self::new(
-            plan,
-            station,
-            snapshot,
-            dir.join(PLAN_FILE).display().to_string(),
-            dir.join(STATION_FILE).display().to_string(),
-            true,
-            days,
-        )
-    }
-
-    fn new(
-        plan: campanile_config::document::LoadedPlan,
-        station: Station,
-        snapshot: Snapshot,
-        plan_label: String,
-        station_label: String,
-        from_session: bool,
-        days: Option<u32>,
-    ) -> Result<Self> {
-        check_plan_on_station(&plan, &station).map_err(|e| {
-            anyhow::anyhow!(
-                "{e}\nthe plan does not run on station {:?} ({station_label})",
-                station.name
-            )
-        })?;
-        let scene = match &plan.scene {
-            Some(s) => Some(SceneGeometry::load(&s.value, &s.source.base_dir()).context("reading the plan's scene")?),
-            None => None,
-        };
-        let t = timeline(&plan.plan.value, &station, scene.as_ref(), &TimelineOptions { days })
-            .with_context(|| format!("{plan_label}: cannot simulate the plan"))?;
-        Ok(Self {
-            plan,
-            station,
-            timeline: t,
-            snapshot,
-            plan_label,
-            station_label,
-            from_session,
-        })
-    }
 }
 
 /// Progress bars: the session, and the current occurrence's step.
@@ -429,6 +281,19 @@ fn capture(args: &CaptureArgs, inputs: &Inputs) -> Result<bool> {
     }
 }
 
+/// The `--sim-*` options of `args`.
+fn sim_faults(args: &CaptureArgs) -> SimFaults {
+    SimFaults {
+        samples: args.sim_samples,
+        bounces: args.sim_bounces,
+        drop_chance: args.sim_drop_chance,
+        corrupt_chance: args.sim_corrupt_chance,
+        camera_timeout_chance: args.sim_camera_timeout_chance,
+        camera_error_chance: args.sim_camera_error_chance,
+        outages: args.sim_outage.iter().map(|o| o.0).collect(),
+    }
+}
+
 /// Open the session (new or resumed) on `storage`, run the timeline on
 /// the station's devices, and report.
 fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> Result<bool> {
@@ -478,7 +343,7 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
     let mut bars = Bars::new(promised);
     let wall = Instant::now();
     let started = if inputs.station.uses_simulation() {
-        run_simulated(args, inputs, &mut store, resumed, &mut bars)
+        run_simulated(&sim_faults(args), inputs, &mut store, resumed, &mut bars)
     } else {
         run_real(inputs, &mut store, &mut bars)
     };
@@ -490,7 +355,7 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
             if let Err(d) = store.discard_unused() {
                 tracing::warn!(dir = %dir.display(), error = %d, "could not remove the unused session");
             }
-            return Err(e);
+            return Err(e.into());
         }
     };
     bars.session.finish_and_clear();
@@ -500,38 +365,16 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
         Ok(r) => (r, None),
         Err(e) => (*e.report.clone(), Some(e)),
     };
-    let promised_keys: std::collections::HashSet<&str> = inputs
-        .timeline
-        .occurrences
-        .iter()
-        .flat_map(|o| o.shots.iter())
-        .filter(|s| s.promised)
-        .map(|s| s.key.as_str())
-        .collect();
-    let (mut stored, mut late, mut extra) = (0, 0, 0);
-    // Shots, not lines: a journal from before one-line-per-shot may hold several.
-    let mut missed_keys = std::collections::HashSet::new();
-    for e in store.entries() {
-        let promised = promised_keys.contains(e.key());
-        match e {
-            JournalEntry::Done(_) if promised => stored += 1,
-            JournalEntry::Late(_) if promised => {
-                stored += 1;
-                late += 1;
-            }
-            JournalEntry::Missed(_) if !store.completed(e.key()) => {
-                missed_keys.insert(e.key());
-            }
-            JournalEntry::Missed(_) => {}
-            JournalEntry::Pruned(_) | JournalEntry::Outage(_) => {}
-            _ => extra += 1,
-        }
-    }
+    let Tally {
+        stored,
+        late,
+        extra,
+        missed,
+    } = tally(inputs, &store);
     outln!("session {}", store.dir().display())?;
     outln!("  frames promised      {promised}")?;
     outln!("  frames stored        {stored} (of which late: {late})")?;
     outln!("  auto-bracket extras  {extra}")?;
-    let missed = missed_keys.len();
     outln!("  shots missed         {missed}")?;
     outln!(
         "  this run             {} frames, {} missed, {} retries, {} reconnects, {} metering captures, {} sun retakes",
@@ -549,151 +392,6 @@ fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> 
         return Ok(false);
     }
     Ok(stored == promised && missed == 0)
-}
-
-type RunResult = std::result::Result<RunReport, RunError>;
-
-/// The simulated station under paused time: the day passes as fast as the
-/// frames render.
-fn run_simulated<S: Storage>(
-    args: &CaptureArgs,
-    inputs: &Inputs,
-    store: &mut SessionStore<S>,
-    resumed: bool,
-    bars: &mut Bars,
-) -> Result<RunResult> {
-    let first = &inputs.timeline.occurrences[0];
-    // The simulated calendar begins a minute before the first occurrence,
-    // or, on resume, a second after the last journaled shot.
-    let last = store.entries().iter().map(JournalEntry::time);
-    let origin = match (resumed, last.max()) {
-        (true, Some(t)) => t + TimeDelta::seconds(1),
-        _ => first.start - TimeDelta::seconds(60),
-    };
-    let SimulatedWorld { world, home, seed } = simulated_world(inputs, args.sim_samples, args.sim_bounces)?;
-    let faults = FaultPlan {
-        link: (args.sim_drop_chance.is_some() || args.sim_corrupt_chance.is_some()).then(|| LinkFaults {
-            drop_chance: args.sim_drop_chance.unwrap_or(0.0),
-            corrupt_chance: args.sim_corrupt_chance.unwrap_or(0.0),
-        }),
-        outages: args.sim_outage.iter().map(|o| o.0).collect(),
-        ..FaultPlan::default()
-    };
-    let camera = CameraOptions {
-        faults: CameraFaultPlan {
-            seed,
-            timeout_chance: args.sim_camera_timeout_chance.unwrap_or(0.0),
-            error_chance: args.sim_camera_error_chance.unwrap_or(0.0),
-            ..CameraFaultPlan::none()
-        },
-        ..CameraOptions::default()
-    };
-    let options = SimOptions {
-        origin,
-        position_m: home,
-        faults,
-        camera,
-        ..SimOptions::default()
-    };
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_time()
-        .start_paused(true)
-        .build()
-        .context("starting the runtime")?;
-    runtime.block_on(async {
-        let mut sim = SimStation::start(&inputs.station, world, options)
-            .await
-            .context("starting the simulated station")?;
-        let clock = sim.clock();
-        Ok(controller::run(
-            &inputs.timeline,
-            &inputs.plan.plan.value,
-            &inputs.station,
-            store,
-            &mut sim,
-            &clock,
-            &RunOptions::default(),
-            bars,
-        )
-        .await)
-    })
-}
-
-/// The simulated world a plan's scene makes, where the station stands in
-/// it (the scene's first pose), and the station's simulation seed.
-pub(super) struct SimulatedWorld {
-    pub(super) world: Arc<World>,
-    pub(super) home: [f64; 3],
-    pub(super) seed: u64,
-}
-
-/// Build the simulated world of `inputs` rendered with `samples` per pixel
-/// and `bounces`.
-pub(super) fn simulated_world(inputs: &Inputs, samples: u32, bounces: u32) -> Result<SimulatedWorld> {
-    let scene_path = inputs
-        .plan
-        .scene
-        .as_ref()
-        .map(|s| s.source.path.clone())
-        .context("a simulated station needs the plan's scene to photograph (the plan has no `scene`)")?;
-    let mut world = World::new(
-        &inputs.station,
-        load_scene(&scene_path).with_context(|| format!("loading {}", scene_path.display()))?,
-    );
-    world.quality.samples_per_pixel = samples.max(1);
-    world.quality.max_bounces = bounces;
-    let home = inputs
-        .plan
-        .scene
-        .as_ref()
-        .and_then(|s| s.value.poses.first())
-        .map_or([0.0; 3], |p| [p.position_m.0, p.position_m.1, p.position_m.2]);
-    let seed = inputs.station.simulation.as_ref().map_or(0, |s| s.seed);
-    Ok(SimulatedWorld {
-        world: Arc::new(world),
-        home,
-        seed,
-    })
-}
-
-/// The station's real devices on the wall clock: the camera its driver
-/// names, the serial devices on their ports, reopened with backoff when a
-/// link drops.
-fn run_real<S: Storage>(inputs: &Inputs, store: &mut SessionStore<S>, bars: &mut Bars) -> Result<RunResult> {
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .context("starting the runtime")?;
-    runtime.block_on(async {
-        let camera = open_camera(&inputs.station.camera)
-            .with_context(|| format!("opening the camera of station {}", inputs.station_label))?;
-        // Sequence numbers from the clock, so that a restarted program does
-        // not reuse numbers a campanile-link device still remembers.
-        let link_seq = (chrono::Utc::now().timestamp_subsec_micros() % 4096) as u16 + 1;
-        let options = StationOptions {
-            link_seq,
-            ..StationOptions::default()
-        };
-        let mut rig = StationRig::connect(&inputs.station, SerialOpener, camera, options)
-            .await
-            .with_context(|| {
-                format!(
-                    "connecting the devices of station {} (check the cables, the baud rates and the devices' power)",
-                    inputs.station_label
-                )
-            })?;
-        Ok(controller::run(
-            &inputs.timeline,
-            &inputs.plan.plan.value,
-            &inputs.station,
-            store,
-            &mut rig,
-            &SystemClock,
-            &RunOptions::default(),
-            bars,
-        )
-        .await)
-    })
 }
 
 fn seconds(d: Duration) -> String {

@@ -8,11 +8,9 @@
 //! | 3 | finished, but a product failed its quality gate (`quality.json` names it) |
 //!
 //! Subcommands return `anyhow::Result`. An error whose chain holds a
-//! [`BadInput`], or a library error that means bad input (see
-//! [`is_bad_input`]), exits 2; one that holds a [`QualityFailed`] exits 3;
-//! any other exits 1.
-
-use std::fmt;
+//! [`campanile_session::Error::Input`], or a library error that means bad
+//! input (see [`is_bad_input`]), exits 2; one that holds a
+//! [`campanile_session::Error::Quality`] exits 3; any other exits 1.
 
 /// Exit code for success.
 pub const EXIT_OK: u8 = 0;
@@ -23,42 +21,10 @@ pub const EXIT_USAGE: u8 = 2;
 /// Exit code for a command that finished but whose products failed a quality gate.
 pub const EXIT_QUALITY: u8 = 3;
 
-/// Bad input from the user: an argument, a file or a value. Exits 2.
-#[derive(Debug)]
-pub struct BadInput(pub String);
-
-impl fmt::Display for BadInput {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for BadInput {}
-
 /// An `anyhow` error that exits 2, with `message` as its text.
 pub fn bad_input(message: impl Into<String>) -> anyhow::Error {
-    anyhow::Error::new(BadInput(message.into()))
+    campanile_session::error::bad_input(message)
 }
-
-/// The command finished and wrote its products, but `failed` did not pass
-/// their quality gates. Exits 3.
-#[derive(Debug)]
-pub struct QualityFailed {
-    /// The products that failed, each with its figures.
-    pub failed: Vec<String>,
-}
-
-impl fmt::Display for QualityFailed {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "finished, but products failed their quality checks: {}",
-            self.failed.join("; ")
-        )
-    }
-}
-
-impl std::error::Error for QualityFailed {}
 
 /// The exit status for an error: 2 for bad input, 3 for a failed quality
 /// gate, 1 otherwise.
@@ -66,35 +32,15 @@ pub fn code_of(err: &anyhow::Error) -> u8 {
     if err.chain().any(is_bad_input) {
         return EXIT_USAGE;
     }
-    if err.chain().any(|c| c.is::<QualityFailed>()) {
+    if err.chain().any(campanile_session::error::is_quality_failure) {
         return EXIT_QUALITY;
     }
     EXIT_FAILURE
 }
 
-/// Whether `cause` means bad input: a [`BadInput`], or a library error
-/// about what the user gave: a configuration file, a table, a site, a
-/// session directory, a RON file, or an input path that does not exist.
+/// Whether `cause` means bad input (see [`campanile_session::error::is_bad_input`]).
 pub fn is_bad_input(cause: &(dyn std::error::Error + 'static)) -> bool {
-    use campanile_capture::store::StoreError;
-    use campanile_process::sun::{SunError, SunTableError};
-    cause.is::<BadInput>()
-        || cause.is::<campanile_config::ConfigError>()
-        || cause.is::<campanile_config::ConfigErrors>()
-        || cause.is::<SunError>()
-        || cause.is::<campanile_process::sky::SampleTableError>()
-        || cause.is::<campanile_process::csv_cell::TableError>()
-        || cause.is::<campanile_process::igi::scene_file::SceneFileError>()
-        || cause.is::<ron::error::SpannedError>()
-        || cause
-            .downcast_ref::<SunTableError>()
-            .is_some_and(|e| !matches!(e, SunTableError::Write(_)))
-        || cause
-            .downcast_ref::<StoreError>()
-            .is_some_and(|e| matches!(e, StoreError::NotASession { .. } | StoreError::InvalidKey { .. }))
-        || cause
-            .downcast_ref::<std::io::Error>()
-            .is_some_and(|e| e.kind() == std::io::ErrorKind::NotFound)
+    campanile_session::error::is_bad_input(cause)
 }
 
 /// A number as an error message shows it: the shortest text that reads
@@ -120,7 +66,7 @@ mod tests {
         let bad: anyhow::Result<()> = Err(bad_input("--lat 95: expected −90 to 90"));
         let bad = bad.context("reading the site").unwrap_err();
         assert_eq!(code_of(&bad), EXIT_USAGE);
-        let q = anyhow::Error::new(QualityFailed {
+        let q = anyhow::Error::new(campanile_session::Error::Quality {
             failed: vec!["response: condition 1e9 > 1e6".into()],
         });
         assert_eq!(code_of(&q), EXIT_QUALITY);

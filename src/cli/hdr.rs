@@ -329,7 +329,7 @@ fn load(args: &BracketArgs) -> Result<Bracket> {
 
 /// Reads `files` one frame at a time into `visit`, with a progress bar.
 fn scan<T>(files: &BracketFiles, what: &str, visit: impl FnOnce(&dyn Fn(usize)) -> Result<T, HdrError>) -> Result<T> {
-    let bar = super::process::bar(files.len() as u64, what);
+    let bar = campanile_session::progress::bar(files.len() as u64, what);
     let out = visit(&|k| bar.set_position(k as u64));
     bar.finish_and_clear();
     Ok(out?)

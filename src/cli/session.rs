@@ -162,14 +162,14 @@ fn import(args: ImportArgs) -> Result<()> {
         sky: args.sky,
         skip_single: args.skip_single,
     };
-    let bar = super::process::bar(0, "reading EXIF");
+    let bar = campanile_session::progress::bar(0, "reading EXIF");
     let plan = plan_import(&opts, &|i, n| {
         bar.set_length(n as u64);
         bar.set_position(i as u64);
     })
     .map_err(import_error)?;
     bar.finish_and_clear();
-    let bar = super::process::bar(0, "copying frames");
+    let bar = campanile_session::progress::bar(0, "copying frames");
     let record = write_session(&plan, &args.out, &|i, n| {
         bar.set_length(n as u64);
         bar.set_position(i as u64);

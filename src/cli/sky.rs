@@ -5,14 +5,10 @@ use std::io::{BufReader, Write};
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use campanile_process::exr_io::write_radiance_exr;
-use campanile_process::hdr::merge::RadianceMap;
 use campanile_process::quality::{ProductQuality, QualityReport, gates};
-use campanile_process::sky::{
-    ChannelSelection, ChannelSky, KnownSky, SkyFile, SkyFitOptions, angle_between, compare_with_samples, direction,
-    fit_sky_with, predict_sky, read_samples, render_latlong,
-};
+use campanile_process::sky::{ChannelSelection, SkyFile, SkyFitOptions, compare_with_samples, read_samples};
 use campanile_process::sun::Ephemeris;
+use campanile_session::sky_files;
 use chrono::{DateTime, Utc};
 use clap::{ArgGroup, Args, Subcommand};
 
@@ -298,49 +294,8 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
             };
             let q = super::verdicts::thresholds(thresholds.as_deref(), None)?;
             let (zs, az) = sun.resolve()?;
-            let file = File::open(&samples).with_context(|| format!("{}: cannot open", samples.display()))?;
             let selection = columns.map_or(ChannelSelection::Auto, ChannelSelection::Named);
-            let table =
-                read_samples(BufReader::new(file), &selection).with_context(|| format!("{}", samples.display()))?;
-            let sun_dir = direction(zs, az);
-            let mut channels = Vec::new();
-            for (c, name) in table.channels.iter().enumerate() {
-                let pts = table.sky_samples(c, sun_dir);
-                let robust = fit_sky_with(&pts, zs, &options)
-                    .with_context(|| format!("{}: channel {name}", samples.display()))?;
-                let fit = &robust.fit;
-                tracing::debug!(channel = %name, "{}", fit.reason);
-                tracing::info!(
-                    "{name}: {}, RMS residual {:.3}%, {}; {}",
-                    fit.kind.label(),
-                    100.0 * fit.rms_relative,
-                    robust.masked_summary(),
-                    fit.convergence.summary()
-                );
-                channels.push(ChannelSky::of_robust(name, &robust));
-            }
-            let sky = SkyFile {
-                sun_zenith_deg: zs.to_degrees(),
-                sun_azimuth_deg: az.to_degrees(),
-                channels,
-            };
-            if let Some(png) = residual_map {
-                let model = &sky.channels[0].model;
-                let pts: Vec<([f64; 3], f64)> = table
-                    .directions
-                    .iter()
-                    .zip(&table.values[0])
-                    .map(|(&(z, a), &v)| {
-                        let d = direction(z, a);
-                        (d, v / model.radiance(z, angle_between(d, sun_dir)) - 1.0)
-                    })
-                    .collect();
-                let size = 256;
-                let map = campanile_process::pipeline::fisheye_average(pts, size);
-                let bytes =
-                    campanile_process::report::false_colour_png("sky residuals", size, size, &map, (-0.1, 0.1))?;
-                std::fs::write(&png, bytes).with_context(|| format!("{}: cannot write", png.display()))?;
-            }
+            let sky = sky_files::fit(&samples, &selection, (zs, az), &options, residual_map.as_deref())?;
             super::ron_output::write_ron(&sky, out.as_deref())?;
             let name = samples
                 .file_name()
@@ -365,27 +320,7 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
                     )));
                 }
             }
-            let sun_dir = direction(zs, az);
-            let mut channels = Vec::new();
-            for (c, name) in names.iter().enumerate() {
-                let skies_c: Vec<KnownSky> = known
-                    .iter()
-                    .map(|k| KnownSky {
-                        sun: direction(k.sun_zenith_deg.to_radians(), k.sun_azimuth_deg.to_radians()),
-                        model: k.channels[c].model,
-                    })
-                    .collect();
-                let fit = predict_sky(&skies_c, sun_dir, 3.0).with_context(|| format!("channel {name}"))?;
-                channels.push(ChannelSky::new(name, &fit, 0, 0.0));
-            }
-            super::ron_output::write_ron(
-                &SkyFile {
-                    sun_zenith_deg: zs.to_degrees(),
-                    sun_azimuth_deg: az.to_degrees(),
-                    channels,
-                },
-                out.as_deref(),
-            )?;
+            super::ron_output::write_ron(&sky_files::predict(&known, (zs, az))?, out.as_deref())?;
             // The prediction carries the verdicts its skies were fitted
             // with (`NAME.quality.json` beside each): a failed fit is not
             // used in silence.
@@ -411,19 +346,7 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
                     sky_file.channels.len()
                 )));
             };
-            let sun = direction(
-                sky_file.sun_zenith_deg.to_radians(),
-                sky_file.sun_azimuth_deg.to_radians(),
-            );
-            let (w, h, rgb) = render_latlong(&[r.model, g.model, b.model], sun, width as usize);
-            let map = RadianceMap {
-                width: w,
-                height: h,
-                variance: vec![0.0; rgb.len()],
-                mask: vec![0; w * h],
-                rgb,
-            };
-            write_radiance_exr(&map, &out).with_context(|| format!("{}: cannot write", out.display()))?;
+            sky_files::write_map(&[r.model, g.model, b.model], &sky_file, width as usize, &out)?;
             Ok(())
         }
         SkyCommand::Eval {

@@ -18,14 +18,11 @@ use campanile_sim::station::{SimOptions, SimStation};
 use chrono::{DateTime, TimeDelta, Utc};
 use clap::{Args, Subcommand};
 
-use super::capture::{Inputs, SimulatedWorld, simulated_world};
-use super::process::sky_series::{SkySeriesOptions, process_scan, recompute_day, series_quality};
 use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
-use campanile_capture::schedule::Occurrence;
-use campanile_capture::store::PROCESSED_DIR;
 use campanile_capture::unattended::ScanHook;
-use campanile_process::hdr::debevec::DebevecOptions;
-use campanile_process::quality::{Quality, Verdict};
+use campanile_process::quality::Quality;
+use campanile_session::capture_inputs::{Inputs, SimulatedWorld, simulated_world};
+use campanile_session::scan_processor::{SkySeriesProcessor, StationHook};
 
 #[derive(Debug, Subcommand)]
 pub enum StationCommand {
@@ -323,44 +320,13 @@ fn run_simulated(args: &RunArgs, inputs: &Inputs, options: &StationOptions) -> R
     })
 }
 
-/// The sky time series of `campanile process`, run on each finished scan.
-struct SkySeriesHook {
-    response: PathBuf,
-    thresholds: Quality,
-}
-
-impl ScanHook for SkySeriesHook {
-    fn on_occurrence_done(&mut self, session_dir: &Path, occurrence: &Occurrence) -> std::result::Result<(), String> {
-        let opts = SkySeriesOptions {
-            out: session_dir.join(PROCESSED_DIR),
-            response: Some(self.response.clone()),
-            shard: None,
-            debevec: DebevecOptions::default(),
-        };
-        process_scan(session_dir, &occurrence.key, &opts).map_err(|e| format!("{e:#}"))?;
-        let series = recompute_day(&opts.out).map_err(|e| format!("{e:#}"))?;
-        // The day's verdicts beside its products; a scan that failed is
-        // logged (the station goes on: the next scan may be clear).
-        let day = series_quality(series.scans.iter(), &self.thresholds);
-        super::verdicts::write(&day, &opts.out.join("quality.json")).map_err(|e| format!("{e:#}"))?;
-        let this = series_quality(
-            series.scans.iter().filter(|s| s.occurrence == occurrence.key),
-            &self.thresholds,
-        );
-        if this.verdict != Verdict::Ok {
-            tracing::warn!(scan = %occurrence.key, "{}", this.summary_line());
-        }
-        Ok(())
-    }
-}
-
 /// The scan hook `args` ask for.
 fn hook(args: &RunArgs, thresholds: Quality) -> Box<dyn ScanHook> {
     match (&args.response, args.process) {
-        (Some(response), true) => Box::new(SkySeriesHook {
+        (Some(response), true) => Box::new(StationHook(SkySeriesProcessor {
             response: response.clone(),
             thresholds,
-        }),
+        })),
         _ => Box::new(NoProcessing),
     }
 }

@@ -7,17 +7,12 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use campanile_process::quality::{ProductQuality, Quality, QualityReport, Verdict};
 
-use super::exit::{QualityFailed, bad_input};
+use super::exit::bad_input;
 
 /// The thresholds: `--thresholds FILE` (a `Quality(...)` RON file), else
 /// the plan's `quality`, else the defaults.
 pub fn thresholds(file: Option<&Path>, plan: Option<&campanile_config::Plan>) -> Result<Quality> {
-    match file {
-        Some(path) => campanile_config::load_quality(path)
-            .map(|l| l.value)
-            .map_err(|e| bad_input(format!("--thresholds: {e}"))),
-        None => Ok(plan.and_then(|p| p.quality.clone()).unwrap_or_default()),
-    }
+    Ok(campanile_session::verdicts::thresholds(file, plan)?)
 }
 
 /// Where the verdicts of a one-file product go: `DIR/NAME.quality.json`
@@ -58,9 +53,7 @@ pub fn finish(report: &QualityReport, path: &Path) -> Result<()> {
 
 /// Writes the verdicts to `path` (through a temporary file and a rename).
 pub fn write(report: &QualityReport, path: &Path) -> Result<()> {
-    let tmp = path.with_extension("json.partial");
-    std::fs::write(&tmp, report.to_json()).with_context(|| format!("{}: cannot write", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot write", path.display()))
+    Ok(campanile_session::verdicts::write(report, path)?)
 }
 
 /// For a product written to standard output: the one-line summary on
@@ -82,7 +75,7 @@ fn gate(report: &QualityReport, see: &str) -> Result<()> {
             failed.push(format!("{inherited} more through what they inherited"));
         }
         failed.push(format!("see {see}"));
-        return Err(QualityFailed { failed }.into());
+        return Err(campanile_session::Error::Quality { failed }.into());
     }
     Ok(())
 }

@@ -1,213 +1,33 @@
-//! `campanile process`: a captured session to radiance, light and
-//! reflectance, with a machine-readable summary of every figure.
+//! A captured session to radiance, light and reflectance, with a
+//! machine-readable summary of every figure (what `campanile process`
+//! does on an outdoor or room session).
 
 pub mod outdoor_report;
 pub mod outdoor_stage;
 pub mod report_sections;
 pub mod room;
 mod session_frames;
-pub mod sky_series;
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::Context;
 use campanile_process::hdr::curve_plot::curve_plot_svg;
 use campanile_process::hdr::debevec::DebevecOptions;
 use campanile_process::pipeline::{
     MergedGroup, OccurrenceLight, Purpose, StationOptics, calibrate_response, group_frames, illumination, merge_groups,
 };
-use campanile_process::quality::{ProductQuality, Quality, QualityReport, gates};
+use campanile_process::quality::{ProductQuality, Quality, gates};
 
-use crate::cli::verdicts;
 use campanile_process::report::{Report, Section};
 use campanile_process::sky::{ChannelSky, SkyFile};
-use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
+use crate::progress::bar;
+use crate::verdicts::thresholds;
+use crate::{Error, Result};
+
 pub use session_frames::SessionInputs;
-
-/// Process a captured session: response and HDR, then sun, sky and environment.
-///
-/// Reads the session directory that `campanile capture` wrote (its journal,
-/// frames and the plan, station and scene snapshots) and runs:
-///   1. the camera response (Debevec–Malik) from the session's own brackets,
-///      and the HDR merge of every bracket (filters and lens falloff undone);
-///   2. per occurrence: the sun's irradiance from its filtered frames
-///      (triplet agreement checked), the sky model per channel fitted to the
-///      sky scan (model choice by BIC, reason given), the environment map.
-///
-/// Outputs, in OUT (default SESSION/processed):
-///   response.csv, response.svg     the curve with its uncertainty
-///   radiance/<group>.exr           HDR views (RGB, variance, mask)
-///   light/<occurrence>.ron         the sky per channel (eq. 5.9 parameters, model and why)
-///   light/<occurrence>-environment.exr   the environment's lat-long region map
-///   summary.json                   every figure and diagnostic, with stage times
-///   quality.json                   every product's verdict (ok, poor, failed), its figures and thresholds
-///   report.html                    the same as a page with plots (self-contained), the verdicts in a banner
-///
-/// A sky-only session (only sun shots, sky scans and brackets aimed at head
-/// angles) is processed as a sky time series instead: per scan the sun's
-/// irradiance, the sky per channel (model and why, residuals), a profile
-/// and quality flags; per day the extinction β per channel, a CSV, plots
-/// and a keogram. It is incremental (scans with products are skipped;
-/// scans still being captured wait) and shardable:
-///   scans/<occurrence>.ron         one scan's products (the source of every per-day product)
-///   sky-series.csv                 one row per scan, every column documented in its header
-///   extinction.csv                 β and E₀ per day and channel (Langley)
-///   plots/*.svg, keogram.png, keogram-residual.png, report.html
-///   response.csv                   the response used (given, or from the calibration bracket)
-/// and, when OUT is SESSION/processed and no --shard is given, each scan's
-/// occurrence is added to SESSION/processed/products.ron once its file is
-/// on disk (the station may then delete its raw frames).
-///
-/// Exit status: 0 every product ok or poor; 1 failure while working; 2 bad
-/// input (no such session, a bad option or thresholds file); 3 finished,
-/// but a product failed its quality gate (quality.json and the summary
-/// line name it; products made from it inherit its verdict).
-///
-/// Examples:
-///   campanile process campanile-day-session --scene examples/campanile-scene.ron
-///   campanile process sky-day --response other-day/processed/response.csv
-///   campanile process sky-day --shard 2/8 --out shard-2     (one of 8 array jobs)
-///   campanile process sky-day --merge-shards shard-1 shard-2 … shard-8
-#[derive(Debug, Args)]
-#[command(verbatim_doc_comment)]
-pub struct ProcessArgs {
-    /// The session directory.
-    #[arg(value_name = "SESSION")]
-    session: PathBuf,
-    /// Output directory (created; existing files in it are replaced).
-    #[arg(long, value_name = "DIR")]
-    out: Option<PathBuf>,
-    /// The scene file, when the session's scene snapshot cannot find its OBJ geometry.
-    #[arg(long, value_name = "FILE")]
-    scene: Option<PathBuf>,
-    /// Response recovery: smoothness weight λ (Debevec–Malik; unit-free, see `hdr calibrate --help`).
-    #[arg(long, value_name = "λ", default_value_t = campanile_process::hdr::debevec::DEFAULT_LAMBDA)]
-    lambda: f64,
-    /// Response recovery: pixels sampled per channel.
-    #[arg(long, value_name = "N", default_value_t = 4000)]
-    samples: usize,
-    /// Environment map elevation bands (−90° to 90°).
-    #[arg(long, value_name = "N", default_value_t = 18)]
-    env_rows: usize,
-    /// Environment map azimuth sectors.
-    #[arg(long, value_name = "N", default_value_t = 36)]
-    env_cols: usize,
-    /// Sky-only sessions: the response curve (CSV from `campanile hdr
-    /// calibrate` or a session's processed/response.csv), for a day without
-    /// a calibration bracket. Default: OUT/response.csv of an earlier run,
-    /// else the session's own calibration bracket.
-    #[arg(long, value_name = "FILE.csv")]
-    response: Option<PathBuf>,
-    /// Sky-only sessions: process only share K of N of the scans, chosen by
-    /// a stable hash of the occurrence id (1 ≤ K ≤ N). Shards do not write
-    /// the products list; merge them with --merge-shards.
-    #[arg(long, value_name = "K/N")]
-    shard: Option<campanile_process::sky_series::Shard>,
-    /// Sky-only sessions: copy the per-scan files of these shard output
-    /// directories into OUT (none: use what OUT holds), list them in the
-    /// products list (if OUT is SESSION/processed) and recompute the day.
-    /// No scan is processed.
-    #[arg(long, value_name = "DIR", num_args = 0.., conflicts_with = "shard")]
-    merge_shards: Option<Vec<PathBuf>>,
-    /// Sky-only sessions: process this one occurrence (e.g. sky@2026-08-28#3)
-    /// again or for the first time, whether or not it has products, then
-    /// recompute the day (what the station does after each scan).
-    #[arg(long, value_name = "ID", conflicts_with_all = ["shard", "merge_shards"])]
-    occurrence: Option<String>,
-    /// Room sessions: size of the rectified views handed to inverse global
-    /// illumination, relative to the camera's frames (box-filtered
-    /// radiance; 1 keeps every pixel, smaller is faster).
-    #[arg(long, value_name = "S", default_value_t = 0.5, value_parser = room_scale)]
-    room_scale: f64,
-    /// Room sessions: the solver's faster, coarser settings (fewer
-    /// radiosity cells, rays and ΔS iterations).
-    #[arg(long)]
-    quick: bool,
-    /// Outdoor sessions: the side of the pseudo-albedo grid's cells on the
-    /// scene's surfaces, metres (thesis §5.4). Finer cells see fewer pixels
-    /// of each photo (noisier); coarser ones average light that varies
-    /// over the cell. BENCHMARKS.md sweeps it.
-    #[arg(long, value_name = "M", default_value_t = campanile_process::outdoor::ReflectanceSettings::default().spacing_m, value_parser = grid_spacing)]
-    grid_spacing: f64,
-    /// Quality thresholds (a `Quality(...)` RON file; any subset of the
-    /// gates, the rest keep the plan's or the defaults). Every product
-    /// gets a verdict, ok, poor or failed, in OUT/quality.json and the
-    /// report's banner; a failed one makes the command exit 3.
-    #[arg(long, value_name = "FILE.ron")]
-    thresholds: Option<PathBuf>,
-}
-
-fn grid_spacing(s: &str) -> Result<f64, String> {
-    let v: f64 = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
-    if (0.1..=50.0).contains(&v) {
-        Ok(v)
-    } else {
-        Err(format!("{v} m: expected a cell side in [0.1, 50] m"))
-    }
-}
-
-fn room_scale(s: &str) -> Result<f64, String> {
-    let v: f64 = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
-    if (0.05..=1.0).contains(&v) {
-        Ok(v)
-    } else {
-        Err(format!("{v}: expected a scale in [0.05, 1]"))
-    }
-}
-
-/// `process` on a room session: the response and HDR, then the room stage.
-fn run_room(args: &ProcessArgs, out: &Path, debevec: &DebevecOptions) -> Result<()> {
-    let processed = process_session(
-        &args.session,
-        args.scene.as_deref(),
-        debevec,
-        None,
-        args.thresholds.as_deref(),
-    )?;
-    write_outputs(&processed, out)?;
-    let opts = room::RoomOptions {
-        scale: args.room_scale,
-        quick: args.quick,
-    };
-    let products = room::room_stage(&processed, out, &opts)?;
-    let mut sections = stage_sections(&processed, None)?;
-    let mut speed = sections.pop().unwrap_or_default();
-    sections.truncate(1); // the response; indoors there is no sun, sky or environment
-    sections.push(room::room_section(&products)?);
-    for (stage, s) in &products.seconds {
-        speed.tables[0].rows.push(vec![stage.clone(), format!("{s:.2}")]);
-    }
-    sections.push(speed);
-    let quality = QualityReport::new(room::room_quality(&processed, &products), &processed.thresholds);
-    super::igi::write_products(&products.recovered, &out.join("room").join("igi"), &quality)?;
-    let report = Report {
-        title: format!("Campanile: {}", args.session.display()),
-        summary: Vec::new(),
-        intro: vec![format!(
-            "Room session {}, processed by campanile {}.",
-            args.session.display(),
-            env!("CARGO_PKG_VERSION")
-        )],
-        quality: Some(quality.clone()),
-        sections,
-    };
-    write_report(&report, &out.join("report.html"))?;
-    outln!(
-        "processed {} → {} (scene file {})",
-        args.session.display(),
-        out.display(),
-        products.scene_file.display()
-    )?;
-    for (stage, s) in processed.summary.stage_seconds.iter().chain(&products.seconds) {
-        outln!("  {stage:<44} {s:>7.2} s")?;
-    }
-    verdicts::finish(&quality, &out.join("quality.json"))
-}
 
 /// What `process` measured, for `summary.json` and the report.
 #[derive(Debug, Serialize)]
@@ -256,119 +76,13 @@ pub struct Processed {
     pub quality: Vec<ProductQuality>,
 }
 
-pub fn run(args: ProcessArgs) -> Result<()> {
-    let out = args.out.clone().unwrap_or_else(|| args.session.join("processed"));
-    let mut debevec = DebevecOptions {
-        lambda: args.lambda,
-        ..DebevecOptions::default()
-    };
-    debevec.sampling.samples = args.samples;
-    if !args.session.is_dir() {
-        return Err(crate::cli::exit::bad_input(format!(
-            "{}: no such session directory (give the directory `campanile capture --out` wrote)",
-            args.session.display()
-        )));
-    }
-    let inputs = SessionInputs::open(&args.session, args.scene.as_deref())?;
-    if sky_series::is_sky_only(&inputs.plan) {
-        let q = verdicts::thresholds(args.thresholds.as_deref(), Some(&inputs.plan))?;
-        drop(inputs);
-        return run_sky_series(&args, out, debevec, &q);
-    }
-    if args.response.is_some() || args.shard.is_some() || args.merge_shards.is_some() || args.occurrence.is_some() {
-        return Err(super::exit::bad_input(format!(
-            "{}: --response, --shard, --merge-shards and --occurrence are for sky-only sessions (sun shots, sky scans and brackets at head angles); this session's plan has views of a scene",
-            args.session.display()
-        )));
-    }
-    let room = room::is_room_session(&inputs.plan);
-    drop(inputs);
-    if room {
-        return run_room(&args, &out, &debevec);
-    }
-    let processed = process_session(
-        &args.session,
-        args.scene.as_deref(),
-        &debevec,
-        Some((args.env_rows, args.env_cols)),
-        args.thresholds.as_deref(),
-    )?;
-    write_outputs(&processed, &out)?;
-    let settings = campanile_process::outdoor::ReflectanceSettings {
-        spacing_m: args.grid_spacing,
-        ..Default::default()
-    };
-    let outdoor = outdoor_stages(&processed, &settings)?;
-    let mut sections = stage_sections(&processed, None)?;
-    if let Some(o) = &outdoor {
-        write_outdoor(o, &out)?;
-        let speed = sections.pop();
-        sections.extend(outdoor_sections(&processed, o, None, 6)?.0);
-        if let Some(mut speed) = speed {
-            for (stage, s) in &o.products.seconds {
-                speed.tables[0].rows.push(vec![stage.clone(), format!("{s:.2}")]);
-            }
-            sections.push(speed);
-        }
-        for v in &o.products.held_out {
-            outln!(
-                "  held out {:<32} relative RMSE {:.2}% per pixel, {:.2}% per 4×4 block ({} training photos' texture; grid alone {:.2}%)",
-                v.label,
-                100.0 * v.rmse_pixel,
-                100.0 * v.rmse_block,
-                v.references,
-                100.0 * v.rmse_block_grid
-            )?;
-        }
-    }
-    let mut quality = processed.quality.clone();
-    if let Some(o) = &outdoor {
-        quality.push(outdoor_quality(&processed, o));
-    }
-    note_import_estimates(&args.session, &mut quality)?;
-    let quality = QualityReport::new(quality, &processed.thresholds);
-    let report = Report {
-        title: format!("Campanile: {}", args.session.display()),
-        summary: Vec::new(),
-        intro: vec![format!(
-            "Session {}, processed by campanile {}.",
-            args.session.display(),
-            env!("CARGO_PKG_VERSION")
-        )],
-        quality: Some(quality.clone()),
-        sections,
-    };
-    write_report(&report, &out.join("report.html"))?;
-    outln!("processed {} → {}", args.session.display(), out.display())?;
-    for (stage, s) in &processed.summary.stage_seconds {
-        outln!("  {stage:<28} {s:>7.2} s")?;
-    }
-    for o in &processed.summary.occurrences {
-        let sky = o.sky.as_ref().map_or("no sky".to_owned(), |s| {
-            format!(
-                "sky {} (rms {:.1}%)",
-                s.channels[1].chosen,
-                100.0 * s.channels.iter().map(|c| c.rms_relative).fold(0.0, f64::max)
-            )
-        });
-        let sun = o.sun_irradiance.map_or("no sun".to_owned(), |e| {
-            format!("sun {:.0}/{:.0}/{:.0} W·m⁻²", e[0], e[1], e[2])
-        });
-        outln!("  {:<28} {sun}; {sky}", o.occurrence)?;
-        for n in &o.notes {
-            outln!("    note: {n}")?;
-        }
-    }
-    verdicts::finish(&quality, &out.join("quality.json"))
-}
-
 /// For a session made by `campanile session import`: each product's notes
 /// say what it rests on that was estimated or stated rather than measured
 /// (the camera from EXIF, the time from a stated clock offset, no sky
 /// frames), from the session's import record.
-fn note_import_estimates(session: &Path, quality: &mut Vec<ProductQuality>) -> Result<()> {
+pub fn note_import_estimates(session: &Path, quality: &mut Vec<ProductQuality>) -> Result<()> {
     let Some(record) =
-        campanile_capture::import::record::ImportRecord::read(session).map_err(super::exit::bad_input)?
+        campanile_capture::import::record::ImportRecord::read(session).map_err(|e| Error::input(e.to_string()))?
     else {
         return Ok(());
     };
@@ -451,121 +165,6 @@ pub fn outdoor_quality(p: &Processed, o: &Outdoor) -> ProductQuality {
     q
 }
 
-fn run_sky_series(args: &ProcessArgs, out: PathBuf, debevec: DebevecOptions, q: &Quality) -> Result<()> {
-    let opts = sky_series::SkySeriesOptions {
-        out: out.clone(),
-        response: args.response.clone(),
-        shard: args.shard,
-        debevec,
-    };
-    std::fs::create_dir_all(&out).with_context(|| format!("{}: cannot create", out.display()))?;
-    if let Some(occurrence) = &args.occurrence {
-        let scan = sky_series::process_scan(&args.session, occurrence, &opts)?;
-        outln!(
-            "processed {occurrence} → {}: flags [{}]",
-            campanile_process::sky_series::scan_path(&out, occurrence).display(),
-            scan.quality.names()
-        )?;
-    }
-    let (series, run) = match &args.merge_shards {
-        _ if args.occurrence.is_some() => (sky_series::recompute_day(&out)?, None),
-        Some(dirs) => {
-            let (copied, series) = sky_series::merge_shards(&args.session, dirs, &opts)?;
-            outln!(
-                "merged {} shard directories ({copied} scan files copied): {} scans in {}",
-                dirs.len(),
-                series.scans.len(),
-                out.display()
-            )?;
-            (series, None)
-        }
-        None => {
-            let run = sky_series::process_new_scans(&args.session, &opts)?;
-            let rate = if run.scan_seconds > 0.0 {
-                run.processed.len() as f64 / run.scan_seconds
-            } else {
-                0.0
-            };
-            outln!(
-                "sky series {} → {}{}",
-                args.session.display(),
-                out.display(),
-                args.shard.map_or(String::new(), |s| format!(" (shard {s})"))
-            )?;
-            outln!(
-                "  processed {} scans in {:.2} s ({rate:.2} scans/s); {} already done, {} in other shards, {} still being captured",
-                run.processed.len(),
-                run.scan_seconds,
-                run.already_done,
-                run.other_shards,
-                run.incomplete.len()
-            )?;
-            outln!("  response: {}", run.response)?;
-            (run.series.clone(), Some(run))
-        }
-    };
-    for d in &series.days {
-        let beta: Vec<String> = d
-            .fit
-            .iter()
-            .map(|f| {
-                f.as_ref()
-                    .map_or_else(|e| format!("none ({e})"), |e| format!("{:.4}", e.beta))
-            })
-            .collect();
-        outln!(
-            "  {}: β r/g/b {} from {} scans ({} left out)",
-            d.date,
-            beta.join(" / "),
-            d.points.len(),
-            d.left_out
-        )?;
-    }
-    let flagged = series.scans.iter().filter(|s| !s.quality.names().is_empty()).count();
-    outln!("  {} scans in the series, {flagged} flagged", series.scans.len())?;
-    // With --occurrence, the verdicts (and the exit status) are that scan's;
-    // otherwise the whole series'.
-    let judged = series
-        .scans
-        .iter()
-        .filter(|s| args.occurrence.as_ref().is_none_or(|o| &s.occurrence == o));
-    let quality = sky_series::series_quality(judged, q);
-    let report = sky_series::report(&args.session, &series, run.as_ref(), Some(quality.clone()))?;
-    write_report(&report, &out.join("report.html"))?;
-    if let Some(run) = &run
-        && !run.failed.is_empty()
-    {
-        for (occ, why) in &run.failed {
-            eprintln!("  failed {occ}: {why}");
-        }
-        let message = format!(
-            "{} scans failed (listed above); they were not marked processed",
-            run.failed.len()
-        );
-        // Every failure a damaged or unreadable input: bad input (exit 2).
-        if run.failed_on_input == run.failed.len() {
-            return Err(crate::cli::exit::bad_input(message));
-        }
-        anyhow::bail!(message);
-    }
-    verdicts::finish(&quality, &out.join("quality.json"))
-}
-
-pub fn bar(len: u64, what: &str) -> ProgressBar {
-    let bar = ProgressBar::new(len);
-    if std::io::stderr().is_terminal() {
-        bar.set_style(
-            ProgressStyle::with_template("{msg:>24} [{bar:40}] {pos}/{len} {elapsed}")
-                .unwrap_or_else(|_| ProgressStyle::default_bar())
-                .progress_chars("=> "),
-        );
-    } else {
-        bar.set_draw_target(ProgressDrawTarget::hidden());
-    }
-    bar.set_message(what.to_owned());
-    bar
-}
-
 /// Stages 1 and 2 on the session in `dir` (stage 2, the sun, sky and
 /// environment, only with `env` = its map's rows and columns).
 pub fn process_session(
@@ -578,7 +177,7 @@ pub fn process_session(
     let mut stages = Vec::new();
     let t = Instant::now();
     let inputs = SessionInputs::open(dir, scene)?;
-    let q = verdicts::thresholds(thresholds_file, Some(&inputs.plan))?;
+    let q = thresholds(thresholds_file, Some(&inputs.plan))?;
     let optics = StationOptics::of_station(&inputs.station);
     let b = bar(0, "reading frames");
     let frames = inputs.frames(&b)?;
@@ -815,7 +414,7 @@ pub fn outdoor_sections(
 
 /// Writes a report page (through a temporary file).
 pub fn write_report(report: &Report, path: &Path) -> Result<()> {
-    super::partial_file::write(path, report.to_html().as_bytes())
+    crate::partial_file::write(path, report.to_html().as_bytes())
 }
 
 /// The sky fits of an occurrence as a sky file.
@@ -844,7 +443,7 @@ pub fn write_outputs(p: &Processed, out: &Path) -> Result<()> {
     mkdir(out)?;
     mkdir(&out.join("radiance"))?;
     mkdir(&out.join("light"))?;
-    let write = |path: PathBuf, bytes: &[u8]| super::partial_file::write(&path, bytes);
+    let write = |path: PathBuf, bytes: &[u8]| crate::partial_file::write(&path, bytes);
     write(
         out.join("response.csv"),
         p.calibration.curve.to_csv(&p.calibration.method).as_bytes(),
@@ -891,7 +490,7 @@ pub fn write_outputs(p: &Processed, out: &Path) -> Result<()> {
     for o in &p.summary.occurrences {
         if let Some(sky) = &o.sky {
             let path = out.join("light").join(format!("{}.ron", file_name(&o.occurrence)));
-            super::ron_output::write_ron(sky, Some(&path))?;
+            crate::partial_file::write_ron(sky, &path)?;
         }
     }
     let json = serde_json::to_vec_pretty(&p.summary)?;

@@ -22,7 +22,8 @@
 //!   interpolation, one bounce, the grid's irradiance);
 //! - the re-render at 4 × 4 rays per pixel: its own sampling.
 
-use anyhow::{Result, anyhow};
+use crate::Result;
+use anyhow::anyhow;
 use campanile_process::camera::image::RadianceImage;
 use campanile_process::outdoor::{CellStatus, Illumination, Reflectance, RerenderSettings, rerender};
 use campanile_process::pipeline::{measured_sky, predicted_sky};
@@ -31,8 +32,8 @@ use campanile_process::report::{Section, Table};
 use campanile_process::sun::sun_position;
 use campanile_sim::world::World;
 
-use super::super::process::outdoor_stage::rig_of;
-use super::super::process::{Outdoor, Processed};
+use crate::process::outdoor_stage::rig_of;
+use crate::process::{Outdoor, Processed};
 use campanile_process::outdoor::novel_view::block_rmse;
 
 /// One term of the budget for one view: relative RMSE per pixel and per 4 × 4 block.
@@ -161,7 +162,7 @@ fn group_of<'a>(p: &'a Processed, label: &str) -> Result<&'a campanile_process::
     p.merged
         .iter()
         .find(|g| g.key == label)
-        .ok_or_else(|| anyhow!("held-out view {label} not among the merged groups"))
+        .ok_or_else(|| anyhow!("held-out view {label} not among the merged groups").into())
 }
 
 /// Per view, the least-squares gauge of the HDR map against the simulator's radiance.

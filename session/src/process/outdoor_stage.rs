@@ -8,7 +8,8 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use anyhow::{Context, Result, anyhow};
+use crate::Result;
+use anyhow::{Context, anyhow};
 use campanile_config::scene::MaterialModel;
 use campanile_process::camera::image::RadianceImage;
 use campanile_process::outdoor::novel_view::{compare_view, render_view};
@@ -89,7 +90,7 @@ pub fn targets(p: &Processed, scene: &Scene) -> Result<Vec<usize>> {
         .map(|s| {
             scene
                 .surface_index(&s.name)
-                .ok_or_else(|| anyhow!("surface {:?} is not in the scene's geometry", s.name))
+                .ok_or_else(|| anyhow!("surface {:?} is not in the scene's geometry", s.name).into())
         })
         .collect()
 }
@@ -226,7 +227,7 @@ pub fn outdoor(p: &Processed, scene: &Scene, settings: &ReflectanceSettings) -> 
                 predicted_from_model.push(g.key.clone());
                 predicted_estimated_light(&from_model, sun.direction(), &Atmosphere::clear())
             }
-            Err(e) => return Err(anyhow!(e).context(format!("predicting the light of {}", g.key))),
+            Err(e) => return Err(anyhow!(e).context(format!("predicting the light of {}", g.key)).into()),
         };
         let rig = rig_of(p, g);
         let light = Illumination {

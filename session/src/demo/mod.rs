@@ -8,53 +8,50 @@ mod room;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
+use anyhow::Context;
+use campanile_process::quality::QualityReport;
 use campanile_process::report::Report;
 use campanile_sim::world::{World, examples_dir, load_scene};
-use clap::{Args, Parser};
 
-use super::capture::CaptureArgs;
-use super::process::{self, report_sections::Truth};
+use crate::process::{self, report_sections::Truth};
+use crate::{Error, Result};
 
-/// Run the whole station on simulated hardware and write a report.
-///
-/// With no hardware and no arguments, it:
-///   1. builds the simulated station (examples/sim-station.ron);
-///   2. captures a simulated day at the campanile (examples/campanile-day.ron:
-///      four training times and one held-out time; --quick: two and one);
-///   3. processes it (response, HDR, sun, sky, environment, pseudo-albedos,
-///      the held-out time re-rendered under the predicted light);
-///   4. recovers the BRDFs of the thesis's simulated cube (inverse global
-///      illumination, §4.7.1);
-///   5. photographs the simulated room under its lamps, triangulates the
-///      lamps, recovers its BRDFs and albedo maps and relights it under new
-///      lamps (§4.7.2), beside the simulator's render;
-///   6. writes OUT/report.html, with every figure beside the simulator's truth.
-///
-/// The session directories and every product stay in OUT.
-///
-/// Example:
-///   campanile demo --out campanile-demo
-///   campanile demo --quick --out demo-quick
-#[derive(Debug, Args)]
-#[command(verbatim_doc_comment)]
-pub struct DemoArgs {
+/// What the demo runs.
+#[derive(Debug, Clone)]
+pub struct DemoOptions {
     /// Where to write the sessions, the products and report.html.
-    #[arg(long, value_name = "DIR", default_value = "campanile-demo")]
-    out: PathBuf,
-    /// A smaller, faster run (two training times, fewer views): what the tests use.
-    #[arg(long)]
-    quick: bool,
-    /// Diagnostic: after the held-out comparison, measure where its error
-    /// comes from, term by term, against the simulator (renders the held-out
-    /// views again at many samples per pixel; adds a report section and
-    /// OUT/held-out-budget.json).
-    #[arg(long)]
-    held_out_budget: bool,
-    /// Development: reuse OUT/campanile-session if it is there instead of
-    /// capturing the day again (the capture is most of the demo's time).
-    #[arg(long)]
-    reuse_session: bool,
+    pub out: PathBuf,
+    /// A smaller, faster run (two training times, fewer views).
+    pub quick: bool,
+    /// After the held-out comparison, measure where its error comes from,
+    /// term by term, against the simulator.
+    pub held_out_budget: bool,
+    /// Reuse OUT/campanile-session if it is there instead of capturing the
+    /// day again.
+    pub reuse_session: bool,
+}
+
+/// What the demo needs from its caller: the simulated capture (the command
+/// line runs `campanile capture` for it) and somewhere to say what it is
+/// doing.
+pub trait DemoHost {
+    /// Captures `plan` on the simulated `station` into `session` (cleared
+    /// first), with `extra` arguments of `campanile capture`.
+    fn capture(&self, plan: &Path, station: &Path, session: &Path, extra: &[&str]) -> Result<()>;
+    /// A line about the demo's progress, for a person watching.
+    fn note(&self, line: &str);
+}
+
+/// What a finished demo wrote: its report page and its verdicts.
+pub struct DemoRun {
+    /// `OUT/report.html`.
+    pub report: PathBuf,
+    /// The report's figures.
+    pub figures: usize,
+    /// Every product's verdict (to go to `OUT/quality.json`).
+    pub quality: QualityReport,
+    /// Wall time, seconds.
+    pub seconds: f64,
 }
 
 /// The demo's headline figures (besides campanile-processed/summary.json), for tests.
@@ -76,39 +73,9 @@ struct Figures {
     held_out_floor_pixel_block: Vec<(f64, f64)>,
 }
 
-/// Parses a `capture` command line, as the user would type it.
-#[derive(Debug, Parser)]
-struct CaptureLine {
-    #[command(flatten)]
-    args: CaptureArgs,
-}
-
-/// Captures `plan` on the simulated `station` into `session` (cleared
-/// first) through `campanile capture`, with `extra` arguments.
-pub fn capture_simulated(plan: &Path, station: &Path, session: &Path, extra: &[&str]) -> Result<()> {
-    if session.exists() {
-        std::fs::remove_dir_all(session).with_context(|| format!("{}: cannot clear", session.display()))?;
-    }
-    let mut line: Vec<&std::ffi::OsStr> = vec![
-        "capture".as_ref(),
-        plan.as_os_str(),
-        "--station".as_ref(),
-        station.as_os_str(),
-        "--out".as_ref(),
-        session.as_os_str(),
-    ];
-    line.extend(extra.iter().map(std::ffi::OsStr::new));
-    let line = CaptureLine::try_parse_from(line)?;
-    if super::capture::run(line.args)? != super::EXIT_OK {
-        bail!(
-            "the simulated capture of {} did not complete (see above)",
-            plan.display()
-        );
-    }
-    Ok(())
-}
-
-pub fn run(args: DemoArgs) -> Result<()> {
+/// Captures, processes and reports the simulated day, the cube and the
+/// room into `args.out`.
+pub fn run(args: &DemoOptions, host: &dyn DemoHost) -> Result<DemoRun> {
     let wall = Instant::now();
     let examples = examples_dir();
     if !examples.join("sim-station.ron").is_file() {
@@ -119,7 +86,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
     }
     let session = args.out.join("campanile-session");
     if args.reuse_session && !session.join("journal.jsonl").is_file() {
-        return Err(super::exit::bad_input(format!(
+        return Err(Error::input(format!(
             "--reuse-session: {} holds no captured session ({} is missing); run the demo once without \
              --reuse-session to capture one",
             args.out.display(),
@@ -136,7 +103,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
     let scene = examples.join("campanile-scene.ron");
 
     // 1–2. Capture.
-    eprintln!("capturing {} on the simulated station …", plan.display());
+    host.note(&format!("capturing {} on the simulated station …", plan.display()));
     let t = Instant::now();
     // Three bounces: the light the ground reflects onto shaded walls,
     // which the pseudo-albedo model includes (one bounce would omit it).
@@ -147,12 +114,12 @@ pub fn run(args: DemoArgs) -> Result<()> {
     // 1.9 % / 2.0 % against 2.3 % / 2.2 %, for 14 s more of a 133 s demo).
     let spp = if args.quick { "4" } else { "8" };
     if !(args.reuse_session && session.is_dir()) {
-        capture_simulated(&plan, &station, &session, &["--sim-samples", spp, "--sim-bounces", "3"])?;
+        host.capture(&plan, &station, &session, &["--sim-samples", spp, "--sim-bounces", "3"])?;
     }
     let capture_s = t.elapsed().as_secs_f64();
 
     // 3. Process.
-    eprintln!("processing {} …", session.display());
+    host.note(&format!("processing {} …", session.display()));
     let processed = process::process_session(
         &session,
         Some(&scene),
@@ -176,7 +143,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
     let mut speed = sections.pop().unwrap_or_default();
 
     // Outdoors: pseudo-albedos, the held-out time, the day.
-    eprintln!("recovering pseudo-albedos and re-rendering the held-out time …");
+    host.note("recovering pseudo-albedos and re-rendering the held-out time …");
     let outdoor = process::outdoor_stages(&processed, &Default::default())?;
     let mut quality = processed.quality.clone();
     let mut albedo_figures = None;
@@ -204,15 +171,18 @@ pub fn run(args: DemoArgs) -> Result<()> {
             let t = Instant::now();
             let (terms, gauges) = held_out_budget::budget(&processed, o, &world, spp.parse()?, 3, 64)?;
             for term in &terms {
-                eprintln!(
+                host.note(&format!(
                     "held-out budget {:>12} {:<70} pixel {:6.2}%  block {:5.2}%",
                     term.view,
                     term.term,
                     100.0 * term.pixel,
                     100.0 * term.block
-                );
+                ));
             }
-            eprintln!("held-out budget gauges {gauges:?} ({:.1} s)", t.elapsed().as_secs_f64());
+            host.note(&format!(
+                "held-out budget gauges {gauges:?} ({:.1} s)",
+                t.elapsed().as_secs_f64()
+            ));
             std::fs::write(
                 args.out.join("held-out-budget.json"),
                 serde_json::to_vec_pretty(&serde_json::json!({"terms": terms, "gauges": gauges}))?,
@@ -226,12 +196,12 @@ pub fn run(args: DemoArgs) -> Result<()> {
     }
 
     // Indoors: the thesis's cube.
-    eprintln!("recovering the cube's BRDFs (inverse global illumination) …");
+    host.note("recovering the cube's BRDFs (inverse global illumination) …");
     let (px, samples) = if args.quick { (64, 16) } else { (96, 32) };
     let cube = indoor::cube(px, samples, &args.out)?;
     sections.push(cube.section);
-    eprintln!("the room: lamps, BRDFs, albedo maps, relit under new lamps …");
-    let room = room::room(&args.out, args.quick)?;
+    host.note("the room: lamps, BRDFs, albedo maps, relit under new lamps …");
+    let room = room::room(&args.out, args.quick, host)?;
     sections.push(room.section);
     quality.extend(room.quality);
     let quality = campanile_process::quality::QualityReport::new(quality, &processed.thresholds);
@@ -294,13 +264,12 @@ pub fn run(args: DemoArgs) -> Result<()> {
     };
     let path = args.out.join("report.html");
     process::write_report(&report, &path)?;
-    outln!(
-        "demo finished in {:.1} s: {} ({} figures)",
-        wall.elapsed().as_secs_f64(),
-        path.display(),
-        report.figure_count()
-    )?;
-    crate::cli::verdicts::finish(&quality, &args.out.join("quality.json"))
+    Ok(DemoRun {
+        report: path,
+        figures: report.figure_count(),
+        quality,
+        seconds: wall.elapsed().as_secs_f64(),
+    })
 }
 
 fn display(p: &Path) -> String {

@@ -10,7 +10,8 @@
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::{Result, anyhow};
+use crate::Result;
+use anyhow::anyhow;
 use campanile_process::igi::format_table;
 use campanile_process::igi::table::errors;
 use campanile_process::report::{Figure, Section, Table, false_colour_png, tonemapped_png};
@@ -18,8 +19,8 @@ use campanile_sim::world::examples_dir;
 use campanile_sim::world::igi_photograph::PhotoSettings;
 use campanile_sim::world::room_igi::{ROOM_BOUNCES, RoomIgi, igi_lights_of, new_lamps, relit_block_error};
 
-use crate::cli::igi::{write_albedo_maps, write_exr};
-use crate::cli::process;
+use crate::igi::{write_albedo_maps, write_exr};
+use crate::process;
 
 /// The camera the room is relit from.
 pub const RELIT_CAMERA: &str = "wide-sw";
@@ -55,7 +56,7 @@ fn rel(got: f64, truth: f64) -> f64 {
 }
 
 /// Runs the room into `dir/room` (`quick`: smaller images, fewer rays).
-pub fn room(dir: &Path, quick: bool) -> Result<RoomRun> {
+pub fn room(dir: &Path, quick: bool, host: &dyn super::DemoHost) -> Result<RoomRun> {
     let out = dir.join("room");
     let station = campanile_config::document::load_station(&examples_dir().join("sim-station.ron"))
         .map_err(|e| anyhow!("{e}"))?
@@ -72,7 +73,7 @@ pub fn room(dir: &Path, quick: bool) -> Result<RoomRun> {
     let bounces = ROOM_BOUNCES.to_string();
     let (samples, scale) = if quick { ("8", 0.25) } else { ("16", 0.5) };
     let t = Instant::now();
-    crate::cli::demo::capture_simulated(
+    host.capture(
         &plan,
         &examples_dir().join("sim-station.ron"),
         &session,
@@ -90,6 +91,9 @@ pub fn room(dir: &Path, quick: bool) -> Result<RoomRun> {
     let processed_dir = out.join("processed");
     process::write_outputs(&processed, &processed_dir)?;
     let products = process::room::room_stage(&processed, &processed_dir, &process::room::RoomOptions { scale, quick })?;
+    for w in &products.recovered.loaded.warnings {
+        host.note(&format!("warning: {w}"));
+    }
     let r = &products.recovered;
     let recover_s = t.elapsed().as_secs_f64();
     let quality = process::room::room_quality(&processed, &products)
@@ -196,9 +200,9 @@ pub fn room(dir: &Path, quick: bool) -> Result<RoomRun> {
         .find(|(n, _)| n == RELIT_CAMERA)
         .ok_or_else(|| anyhow!("no camera {RELIT_CAMERA}"))?;
     // The reference with as many stratified paths per pixel as the relit
-    // image (crate::cli::igi::settings), so that the two renders' noise
+    // image (crate::igi::settings), so that the two renders' noise
     // (the floor) stays well below the relit error.
-    let samples = crate::cli::igi::settings(quick).2.indirect_samples;
+    let samples = crate::igi::settings(quick).2.indirect_samples;
     let sim = world.photograph(
         &bulbs,
         &[],

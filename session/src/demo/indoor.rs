@@ -5,7 +5,8 @@ use std::time::Instant;
 
 use std::path::Path;
 
-use anyhow::{Result, anyhow};
+use crate::Result;
+use anyhow::anyhow;
 use campanile_process::brdf::WardMaterial;
 use campanile_process::igi::{IgiOptions, IgiResult, recover};
 use campanile_process::report::{Section, Table};
@@ -164,7 +165,7 @@ pub fn cube(wide_px: usize, indirect_samples: u32, out_dir: &Path) -> Result<Cub
 /// Mitsuba 3 XML into `out_dir`; each wall's frame is its inward face's
 /// normal and texture tangent (the side the cameras see, γ's reference).
 fn write_materials(room: &CubeRoom, result: &IgiResult, out_dir: &Path) -> Result<Vec<String>> {
-    crate::cli::igi::write_material_files(
+    crate::igi::write_material_files(
         room.scene.triangles(),
         &CubeRoom::centre(),
         result,

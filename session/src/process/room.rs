@@ -17,7 +17,8 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{Context, Result, anyhow, bail};
+use crate::Result;
+use anyhow::{Context, anyhow};
 use campanile_config::Plan;
 use campanile_config::plan::Step;
 use campanile_process::igi::scene_file::{BulbImageEntry, CameraEntry, IgiScene, ImageEntry, LightEntry, SurfaceGroup};
@@ -29,7 +30,7 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use super::Processed;
-use crate::cli::igi::{Recovered, recover_scene, write_exr};
+use crate::igi::{Recovered, recover_scene, write_exr};
 
 /// Radius around a lamp's configured position cut out as its bulb's
 /// image, metres: the bulb plus the uncertainty of a measured position.
@@ -174,7 +175,8 @@ fn write_mask(valid: &[bool], (w, h): (usize, usize), path: &Path) -> Result<()>
     image::GrayImage::from_raw(w as u32, h as u32, bytes)
         .ok_or_else(|| anyhow!("{}: mask size", path.display()))?
         .save(path)
-        .with_context(|| format!("writing {}", path.display()))
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(())
 }
 
 /// Writes `OUT/room/scene.ron` (with the OBJ, `images/` and masks) from

@@ -3,7 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, anyhow, bail};
+use crate::Result;
+use anyhow::{Context, anyhow};
 use campanile_capture::device::FrameFormat;
 use campanile_capture::store::{FrameEntry, JournalEntry, SessionReader, ShotKind};
 use campanile_config::plan::Step;
@@ -120,7 +121,7 @@ impl SessionInputs {
                 let mut codes = self
                     .reader
                     .read_frame(e)
-                    .map_err(|err| crate::cli::exit::bad_input(err.to_string()))?;
+                    .map_err(|err| crate::error::bad_input(err.to_string()))?;
                 if e.format == FrameFormat::Jpeg {
                     clip_lossy_top(&mut codes);
                 }
@@ -210,7 +211,7 @@ impl SessionInputs {
     /// What a frame was for, from its key `"{session}@{date}/s{step}/t{target}/f{frame}"`,
     /// and for a view the position it was taken from.
     fn purpose(&self, e: &FrameEntry) -> Result<(Purpose, Option<[f64; 3]>)> {
-        let bad = |why: &str| anyhow!("frame key {:?}: {why}", e.key);
+        let bad = |why: &str| crate::Error::from(anyhow!("frame key {:?}: {why}", e.key));
         let parts: Vec<&str> = e.key.split('/').collect();
         let [occurrence, step, target, _frame] = parts[..] else {
             return Err(bad("expected SESSION@DATE/sSTEP/tTARGET/fFRAME"));

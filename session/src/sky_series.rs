@@ -15,7 +15,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::Instant;
 
-use anyhow::{Context, Result, anyhow, bail};
+use crate::Result;
+use anyhow::{Context, anyhow};
 use campanile_capture::schedule::{ShotKind as PlannedKind, TimelineOptions, timeline};
 use campanile_capture::store::{FrameEntry, JournalEntry, PROCESSED_DIR, ProcessedProducts};
 use campanile_config::Plan;
@@ -29,7 +30,7 @@ use campanile_process::report::{Report, Section, Table};
 use campanile_process::sky_series::{ScanProducts, Shard, SkySeries, scan_path, scan_products, store, write_scan};
 use rayon::prelude::*;
 
-use super::SessionInputs;
+use crate::process::SessionInputs;
 
 /// How to process a sky-only session.
 #[derive(Debug, Clone)]
@@ -184,7 +185,7 @@ fn response(inputs: &SessionInputs, opts: &SkySeriesOptions) -> Result<(Response
     let saved = opts.out.join("response.csv");
     let read = |p: &Path| -> Result<ResponseCurve> {
         let text = std::fs::read_to_string(p).with_context(|| format!("{}: cannot read the response", p.display()))?;
-        ResponseCurve::from_csv(&text, p).map_err(|e| anyhow!("{e}"))
+        ResponseCurve::from_csv(&text, p).map_err(|e| anyhow!("{e}").into())
     };
     if let Some(p) = &opts.response {
         let curve = read(p)?;
@@ -197,7 +198,7 @@ fn response(inputs: &SessionInputs, opts: &SkySeriesOptions) -> Result<(Response
         return Ok((read(&saved)?, format!("{} (an earlier run's)", saved.display())));
     }
     let is_bracket = |e: &FrameEntry| matches!(step_of(inputs, &e.key), Some(Step::Bracket { .. }));
-    let bar = super::bar(0, "calibration bracket");
+    let bar = crate::progress::bar(0, "calibration bracket");
     let frames = inputs.frames_where(&bar, is_bracket)?;
     bar.finish_and_clear();
     if frames.is_empty() {
@@ -301,7 +302,7 @@ pub fn process_new_scans(session: &Path, opts: &SkySeriesOptions) -> Result<Scan
         (Some(c), s)
     };
     let lock = Mutex::new(());
-    let bar = super::bar(todo.len() as u64, "sky scans");
+    let bar = crate::progress::bar(todo.len() as u64, "sky scans");
     let outcomes: Vec<(String, Result<()>)> = match &curve {
         None => Vec::new(),
         Some(curve) => todo
@@ -330,7 +331,7 @@ pub fn process_new_scans(session: &Path, opts: &SkySeriesOptions) -> Result<Scan
         match r {
             Ok(()) => processed.push(occ),
             Err(e) => {
-                failed_on_input += usize::from(crate::cli::exit::code_of(&e) == 2);
+                failed_on_input += usize::from(e.is_bad_input());
                 failed.push((occ, format!("{e:#}")));
             }
         }
@@ -368,13 +369,13 @@ pub fn merge_shards(session: &Path, shards: &[PathBuf], opts: &SkySeriesOptions)
     Ok((copied, series))
 }
 
-/// The report page of the series.
 /// The verdicts of these scans of a series: each one's sun and sky.
 pub fn series_quality<'a>(scans: impl Iterator<Item = &'a ScanProducts>, thresholds: &Quality) -> QualityReport {
     let products = scans.flat_map(|s| gates::scan(s, thresholds)).collect();
     QualityReport::new(products, thresholds)
 }
 
+/// The report page of the series.
 pub fn report(
     session: &Path,
     series: &SkySeries,

@@ -1,0 +1,52 @@
+//! Processing a captured session end to end, and its report.
+//!
+//! What `campanile process` and `campanile demo` do, as a library that
+//! tests and other programs can call (the binary parses arguments, prints
+//! and maps [`Error`]s to exit statuses):
+//!
+//! - [`run`]: a whole `process` run: the kind of session, its stages in
+//!   order, its products and report page;
+//! - [`process`]: a session's response and HDR, sun, sky and environment
+//!   (stages 1–2), the outdoor stages (pseudo-albedos, held-out views) and
+//!   the room stage (inverse global illumination), their products on disk
+//!   and their report sections;
+//! - [`sky_series`]: a sky-only session as a time series of scans;
+//! - [`scan_processor`]: the [`ScanProcessor`](scan_processor::ScanProcessor)
+//!   the station calls after each scan, and the sky series' one;
+//! - [`igi`]: inverse global illumination on a scene file and its products;
+//! - [`outdoor_files`]: outdoor reflectance on plain files (recover, render);
+//! - [`sky_files`]: sky models on plain files (fit, predict, map);
+//! - [`scene_render`]: the scene at new times from recovered pseudo-albedos;
+//! - [`capture_inputs`]: a capture's plan, station, scene and timeline, and
+//!   a simulated station's world;
+//! - [`capture_run`]: a capture's timeline run on the simulated or the real
+//!   station, and the session's tally;
+//! - [`demo`]: the simulated station's day, cube and room, with every
+//!   figure beside the simulator's truth;
+//! - [`verdicts`], [`partial_file`], [`progress`], [`error`].
+
+/// Returns early with an `anyhow` error made from a message (this crate's
+/// `bail!`: the error converts into [`Error::Work`]).
+macro_rules! bail {
+    ($($arg:tt)*) => {
+        return Err(anyhow::anyhow!($($arg)*).into())
+    };
+}
+
+pub mod capture_inputs;
+pub mod capture_run;
+pub mod demo;
+pub mod error;
+pub mod igi;
+pub mod outdoor_files;
+pub mod partial_file;
+pub mod process;
+pub mod progress;
+pub mod run;
+pub mod scan_processor;
+pub mod scene_render;
+pub mod sky_files;
+pub mod sky_series;
+pub mod verdicts;
+
+pub use error::{Error, Result};
