@@ -23,6 +23,7 @@
 //!   station, and the session's tally;
 //! - [`demo`]: the simulated station's day, cube and room, with every
 //!   figure beside the simulator's truth;
+//! - [`report_summary`]: the summary at the top of every report page;
 //! - [`verdicts`], [`partial_file`], [`progress`], [`error`].
 
 /// Returns early with an `anyhow` error made from a message (this crate's
@@ -42,6 +43,7 @@ pub mod outdoor_files;
 pub mod partial_file;
 pub mod process;
 pub mod progress;
+pub mod report_summary;
 pub mod run;
 pub mod scan_processor;
 pub mod scene_render;

@@ -137,7 +137,7 @@ pub fn outdoor(opts: &ProcessOptions) -> Result<OutdoorRun> {
     let quality = QualityReport::new(quality, &processed.thresholds);
     let report = Report {
         title: format!("Campanile: {}", opts.session.display()),
-        summary: Vec::new(),
+        summary: crate::report_summary::from_quality(&quality),
         intro: vec![format!(
             "Session {}, processed by campanile {}.",
             opts.session.display(),
@@ -192,7 +192,7 @@ pub fn room(opts: &ProcessOptions) -> Result<RoomRun> {
     let written = crate::igi::write_products(&products.recovered, &out.join("room").join("igi"), &quality)?;
     let report = Report {
         title: format!("Campanile: {}", opts.session.display()),
-        summary: Vec::new(),
+        summary: crate::report_summary::from_quality(&quality),
         intro: vec![format!(
             "Room session {}, processed by campanile {}.",
             opts.session.display(),

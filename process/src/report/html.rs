@@ -186,7 +186,7 @@ th{background:#eee}td:first-child,th:first-child{text-align:left}caption{text-al
 td.flag{background:#fdd;color:#900;font-weight:bold}\
 p,li,figcaption,caption{overflow-wrap:anywhere}\
 .figs{display:flex;flex-wrap:wrap;gap:1em;align-items:flex-start}figure{margin:0;max-width:100%}\
-figure img{max-width:100%;border:1px solid #ddd;image-rendering:pixelated}\
+figure img{max-width:100%;border:1px solid #ddd;image-rendering:pixelated}.figs figure img{min-width:360px}\
 .row{display:flex;flex-wrap:nowrap;gap:.8em;width:100%;margin:.6em 0}.row figure{flex:1 1 0;min-width:0}.row figure img{width:100%}\
 figcaption{font-size:.85em;color:#444;max-width:640px}.row figcaption{max-width:none}\
 svg.bar{display:block;margin-top:2px}nav{line-height:1.8}nav a{margin-right:1em;white-space:nowrap}\
@@ -356,9 +356,9 @@ fn summary(rows: &[SummaryRow], sections: &[Section]) -> String {
             .position(|s| !r.section.is_empty() && s.title == r.section)
             .map_or_else(String::new, |i| format!("<a href=\"#s{i}\">{}</a>", escape(&r.section)));
         h.push_str(&format!(
-            "<tr class=\"product\"><td>{}</td><td class=\"{class}\">{verdict}</td><td>{}</td><td>{}</td><td>{link}</td></tr>\n",
+            "<tr class=\"product\"><td>{}</td><td class=\"{class}\">{verdict}</td>{}<td>{}</td><td>{link}</td></tr>\n",
             escape(&r.product),
-            escape(&r.figure),
+            cell(&r.figure),
             escape(&r.goal)
         ));
     }
@@ -417,17 +417,22 @@ impl Report {
                 }
                 h.push_str("</table>\n");
             }
-            let (rows, loose): (Vec<&Figure>, Vec<&Figure>) =
-                s.figures.iter().partition(|f| matches!(f, Figure::Row(_)));
-            if !loose.is_empty() {
-                h.push_str("<div class=\"figs\">\n");
-                for f in loose {
+            // In order: rows as they come, the figures between them
+            // together in one block that wraps.
+            let mut loose = String::new();
+            for f in &s.figures {
+                if matches!(f, Figure::Row(_)) {
+                    if !loose.is_empty() {
+                        h.push_str(&format!("<div class=\"figs\">\n{loose}</div>\n"));
+                        loose.clear();
+                    }
                     h.push_str(&figure_html(f));
+                } else {
+                    loose.push_str(&figure_html(f));
                 }
-                h.push_str("</div>\n");
             }
-            for f in rows {
-                h.push_str(&figure_html(f));
+            if !loose.is_empty() {
+                h.push_str(&format!("<div class=\"figs\">\n{loose}</div>\n"));
             }
             h.push_str("</section>\n");
         }

@@ -3,7 +3,7 @@
 use super::day::SkySeries;
 use super::keogram::{RESIDUAL_RANGE, keogram_png, keogram_residual_png};
 use super::plots::{irradiance_svg, langley_svg, shape_parameters_svg, zenith_scale_svg};
-use crate::report::{Figure, ReportError, Section, Table};
+use crate::report::{ColourScale, Figure, ReportError, Section, Table};
 
 fn opt(v: Option<f64>, scale: f64, digits: usize) -> String {
     v.map_or("–".into(), |v| format!("{:.*}", digits, v * scale))
@@ -96,12 +96,14 @@ pub fn sky_series_sections(series: &SkySeries) -> Result<Vec<Section>, ReportErr
             bytes: keogram_png(&series.scans)?,
             caption: "keogram: profiles in the sun's vertical plane, one column per scan (sun-side horizon at the top, zenith in the middle); measured above, fitted below".into(),
         });
-        figures.push(Figure::Png {
+        figures.push(Figure::Map {
             bytes: keogram_residual_png(&series.scans)?,
-            caption: format!(
-                "fitted/measured − 1 (green) per scan and profile bin, blue −{0:.0}% to red +{0:.0}%; grey: no pixel",
-                100.0 * RESIDUAL_RANGE
-            ),
+            caption: "fitted / measured − 1 (green) per scan and profile bin; grey: no pixel".into(),
+            scale: ColourScale::Diverging {
+                low: -RESIDUAL_RANGE,
+                high: RESIDUAL_RANGE,
+                unit: "relative residual".into(),
+            },
         });
     }
     let plots = Section {

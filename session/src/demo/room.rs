@@ -14,7 +14,7 @@ use crate::Result;
 use anyhow::anyhow;
 use campanile_process::igi::format_table;
 use campanile_process::igi::table::errors;
-use campanile_process::report::{Figure, Section, Table, false_colour_png, tonemapped_png};
+use campanile_process::report::{ColourScale, Figure, Section, Table, false_colour_png, flagged, tonemapped_png};
 use campanile_sim::world::examples_dir;
 use campanile_sim::world::igi_photograph::PhotoSettings;
 use campanile_sim::world::room_igi::{ROOM_BOUNCES, RoomIgi, igi_lights_of, new_lamps, relit_block_error};
@@ -26,6 +26,11 @@ use crate::process;
 pub const RELIT_CAMERA: &str = "wide-sw";
 
 /// What the room run measured.
+/// Table cells more than this far from the truth are flagged (percent;
+/// γ in degrees).
+const FLAG_PCT: f64 = 10.0;
+const FLAG_DEG: f64 = 2.0;
+
 pub struct RoomRun {
     /// The report section.
     pub section: Section,
@@ -150,7 +155,9 @@ pub fn room(dir: &Path, quick: bool, host: &dyn super::DemoHost) -> Result<RoomR
 
     // Materials beside the truth.
     let mut table = Table {
-        caption: "The room's materials (thesis Table 4.1 format): true / recovered (error); channel R for ρd and ρs, as in the thesis's table".into(),
+        caption: format!(
+            "The room's materials (thesis Table 4.1 format): true / recovered (error); channel R for ρd and ρs, as in the thesis's table; ⚠ more than {FLAG_PCT} % (γ: {FLAG_DEG}°) off"
+        ),
         header: ["surface", "model (why)", "ρd", "ρs", "αx", "αy", "γ"].map(String::from).to_vec(),
         rows: Vec::new(),
     };
@@ -161,8 +168,13 @@ pub fn room(dir: &Path, quick: bool, host: &dyn super::DemoHost) -> Result<RoomR
             .lobe
             .map(|l| campanile_process::igi::table::nearest_representation(&l, t.lobe.map_or(0.0, |l| l.gamma_rad)));
         let cell = |tv: Option<f64>, g: Option<f64>, e: Option<f64>, unit: &str| match (tv, g) {
-            (Some(tv), Some(g)) => format!("{tv:.3} / {g:.3} ({:.1}{unit})", e.unwrap_or(f64::NAN)),
-            (Some(tv), None) => format!("{tv:.3} / —"),
+            (Some(tv), Some(g)) => {
+                let text = format!("{tv:.3} / {g:.3} ({:.1}{unit})", e.unwrap_or(f64::NAN));
+                let bound = if unit == "°" { FLAG_DEG } else { FLAG_PCT };
+                if e.is_none_or(|e| !(e <= bound)) { flagged(text) } else { text }
+            }
+            // A true parameter the fit has none of (a lobe not recovered).
+            (Some(tv), None) => flagged(format!("{tv:.3} / —")),
             (None, Some(g)) => format!("— / {g:.3}"),
             (None, None) => "—".into(),
         };
@@ -240,25 +252,40 @@ pub fn room(dir: &Path, quick: bool, host: &dyn super::DemoHost) -> Result<RoomR
             if b > 0.0 && b < 60.0 { a / b - 1.0 } else { f64::NAN }
         })
         .collect();
+    // The headline result: the relit room beside the simulator's render,
+    // full width, then the error map.
+    let radiance = ColourScale::Radiance {
+        white,
+        unit: "radiance, W·m⁻²·sr⁻¹ (one exposure for both)".into(),
+    };
     let figures = vec![
-        Figure::Png {
-            bytes: tonemapped_png("relit", w, h, &relit.data, 1.0 / white)?,
-            caption: format!("Relit with the recovered materials ({RELIT_CAMERA}, two new lamps)"),
-        },
-        Figure::Png {
-            bytes: tonemapped_png("simulator", w, h, &sim.data, 1.0 / white)?,
-            caption: "The simulator's render of the same lamps (true materials)".into(),
-        },
-        Figure::Png {
+        Figure::Row(vec![
+            Figure::Map {
+                bytes: tonemapped_png("relit", w, h, &relit.data, 1.0 / white)?,
+                caption: format!("Relit with the recovered materials ({RELIT_CAMERA}, two new lamps)"),
+                scale: radiance.clone(),
+            },
+            Figure::Map {
+                bytes: tonemapped_png("simulator", w, h, &sim.data, 1.0 / white)?,
+                caption: "The simulator's render of the same lamps (true materials)".into(),
+                scale: radiance,
+            },
+        ]),
+        Figure::Map {
             bytes: false_colour_png("relit error", w, h, &err, (-0.3, 0.3))?,
-            caption: "Relit / simulator − 1 per pixel (blue −30 %, red +30 %)".into(),
+            caption: "Relit / simulator − 1 per pixel".into(),
+            scale: ColourScale::Diverging {
+                low: -0.3,
+                high: 0.3,
+                unit: "relative error (relit / simulator − 1)".into(),
+            },
         },
     ];
     let section = Section {
         title: "Indoor: the room relit (inverse global illumination, §4.7.2)".into(),
         paragraphs: vec![
             format!(
-                "The simulated room ({} surfaces sharing specular parameters) captured on the simulated station ({}: each pose under each lamp alone and all on, a calibration bracket, metered brackets up at the bulbs; {} frames) and processed as `campanile process` does: response from the session's bracket, HDR merge, {} views with every lamp on rectified to {}×{} px, each lamp triangulated from its bulb in the views that hold it unclipped (§4.7.2): worst position error {worst_mm:.2} mm, intensity {:.2} % once the camera's gauge error ({:+.2} / {:+.2} / {:+.2} %, the response's) is divided out, {:.2} % in the camera's units.",
+                "The simulated room ({} surfaces sharing specular parameters) captured on the simulated station ({}: each pose under each lamp alone and all on, a calibration bracket, metered brackets up at the bulbs; {} frames stored, the auto-brackets' extra exposures included) and processed as `campanile process` does: response from the session's bracket, HDR merge, {} views with every lamp on rectified to {}×{} px, each lamp triangulated from its bulb in the views that hold it unclipped (§4.7.2): worst position error {worst_mm:.2} mm, intensity {:.2} % once the camera's gauge error ({:+.2} / {:+.2} / {:+.2} %, the response's) is divided out, {:.2} % in the camera's units.",
                 r.loaded.input.surfaces.len(),
                 plan.file_name().and_then(|n| n.to_str()).unwrap_or_default(),
                 processed.summary.frames,

@@ -7,7 +7,7 @@ use campanile_process::camera::sensor::CameraModel;
 use campanile_process::hdr::curve_plot::curve_plot_svg;
 use campanile_process::pipeline::sky_fisheye;
 use campanile_process::report::{
-    Figure, ReportError, Section, Series, Table, false_colour_png, line_plot_svg, tonemapped_png,
+    ColourScale, Figure, ReportError, Section, Series, Table, false_colour_png, line_plot_svg, tonemapped_png,
 };
 use campanile_process::sky::angle_between;
 use campanile_process::sun::{air_mass, fit_extinction};
@@ -123,12 +123,17 @@ pub fn sky(p: &Processed, truth: Option<&Truth>) -> Result<Section, ReportError>
         let residual = sky_fisheye(&p.merged, &p.optics, &l.occurrence, 1, SKY_MAP_PX, |d, measured| {
             measured / model.radiance(d[2].acos(), angle_between(d, sun)) - 1.0
         });
-        figures.push(Figure::Png {
+        figures.push(Figure::Map {
             bytes: false_colour_png("sky residual", SKY_MAP_PX, SKY_MAP_PX, &residual, (-0.1, 0.1))?,
             caption: format!(
-                "{}: measured/fitted − 1, green, from −10% (blue) to +10% (red); fisheye, zenith at the centre, north up, east right",
+                "{}: measured / fitted − 1, green channel; fisheye, zenith at the centre, north up, east right",
                 l.occurrence
             ),
+            scale: ColourScale::Diverging {
+                low: -0.1,
+                high: 0.1,
+                unit: "relative residual".into(),
+            },
         });
         if let Some(t) = truth
             && let Ok(Some(daylight)) = t.world.daylight(l.time)
@@ -171,7 +176,7 @@ pub fn sky(p: &Processed, truth: Option<&Truth>) -> Result<Section, ReportError>
 /// The sun section: irradiance per time and the Langley extinction fit.
 pub fn sun(p: &Processed, truth: Option<&Truth>) -> Result<Section, ReportError> {
     let mut table = Table {
-        caption: "Sun irradiance normal to the sun (W·m⁻², r/g/b)".into(),
+        caption: "Sun irradiance normal to the sun, r/g/b, in W·m⁻² of the camera's full-well gauge (the top code is full well): not calibrated W·m⁻², which would need the camera's absolute calibration; the true column is the simulator's sun in the same gauge".into(),
         header: vec![
             "occurrence".into(),
             "air mass".into(),
@@ -301,12 +306,16 @@ pub fn environment(p: &Processed) -> Result<Section, ReportError> {
                 }
             }
         }
-        figures.push(Figure::Png {
+        figures.push(Figure::Map {
             bytes: tonemapped_png("environment", w, h, &rgb, 1.0 / white)?,
             caption: format!(
                 "{}: environment regions ({}×{}, elevation 90° at the top to −90° at the bottom, azimuth 0° north at the left, east next); black where no tile looked",
                 l.occurrence, map.rows, map.cols
             ),
+            scale: ColourScale::Radiance {
+                white,
+                unit: "mean radiance, W·m⁻²·sr⁻¹ (full-well gauge)".into(),
+            },
         });
     }
     Ok(Section {
