@@ -13,6 +13,7 @@
 //! - [`sky_series`]: a sky-only session as a time series of scans;
 //! - [`scan_processor`]: the [`ScanProcessor`](scan_processor::ScanProcessor)
 //!   the station calls after each scan, and the sky series' one;
+//! - [`station_run`]: the unattended station's run, simulated or real;
 //! - [`igi`]: inverse global illumination on a scene file and its products;
 //! - [`outdoor_files`]: outdoor reflectance on plain files (recover, render);
 //! - [`sky_files`]: sky models on plain files (fit, predict, map);
@@ -49,6 +50,7 @@ pub mod scan_processor;
 pub mod scene_render;
 pub mod sky_files;
 pub mod sky_series;
+pub mod station_run;
 pub mod verdicts;
 
 pub use error::{Error, Result};

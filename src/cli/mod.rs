@@ -12,7 +12,6 @@ mod hdr;
 mod igi;
 mod logging;
 mod outdoor;
-mod partial_file;
 mod plan;
 mod process;
 mod render;

@@ -10,7 +10,7 @@ use serde::Serialize;
 pub fn write_ron<T: Serialize>(value: &T, out: Option<&Path>) -> Result<()> {
     let text = ron::ser::to_string_pretty(value, ron::ser::PrettyConfig::default())?;
     match out {
-        Some(path) => super::partial_file::write(path, (text + "\n").as_bytes())?,
+        Some(path) => campanile_session::partial_file::write(path, (text + "\n").as_bytes())?,
         None => outln!("{text}")?,
     }
     Ok(())

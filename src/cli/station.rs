@@ -3,26 +3,21 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result, bail};
-use campanile_capture::clock::SystemClock;
-use campanile_capture::controller::NoProgress;
-use campanile_capture::station::{SerialOpener, StationOptions as RigOptions, StationRig, check_ports, open_camera};
-use campanile_capture::store::{JournalEntry, SessionReader};
-use campanile_capture::unattended::day_rollover::existing_days;
+use anyhow::{Context, Result};
 use campanile_capture::unattended::{
-    self, DeviceState, Heartbeat, Liveness, NoProcessing, StationEnd, StationInputs, StationOptions, StationReport,
-    StopHandle, StorageBudget, parse_bytes,
+    self, DeviceState, Heartbeat, Liveness, NoProcessing, StationEnd, StationOptions, StationReport, StopHandle,
+    StorageBudget, parse_bytes,
 };
-use campanile_sim::faults::{Device, FaultPlan, Outage};
-use campanile_sim::station::{SimOptions, SimStation};
-use chrono::{DateTime, TimeDelta, Utc};
+use campanile_sim::faults::Device;
+use chrono::{DateTime, Utc};
 use clap::{Args, Subcommand};
 
 use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
 use campanile_capture::unattended::ScanHook;
 use campanile_process::quality::Quality;
-use campanile_session::capture_inputs::{Inputs, SimulatedWorld, simulated_world};
+use campanile_session::capture_inputs::Inputs;
 use campanile_session::scan_processor::{SkySeriesProcessor, StationHook};
+use campanile_session::station_run::{StationRun, TimedOutage, run_real, run_simulated};
 
 #[derive(Debug, Subcommand)]
 pub enum StationCommand {
@@ -206,10 +201,26 @@ fn run_station(args: &RunArgs) -> Result<u8> {
         ..StationOptions::default()
     };
     let wall = Instant::now();
+    let run = StationRun {
+        store: args.store.clone(),
+        options,
+        samples: args.sim_samples,
+        bounces: args.sim_bounces,
+        outages: args
+            .sim_outage
+            .iter()
+            .map(|o| TimedOutage {
+                device: o.device,
+                start: o.start,
+                duration: o.duration,
+            })
+            .collect(),
+    };
+    let mut hook = hook(args, inputs.plan.plan.value.quality.clone().unwrap_or_default());
     let result = if inputs.station.uses_simulation() {
-        run_simulated(args, &inputs, &options)
+        run_simulated(&run, &inputs, hook.as_mut(), &stop_on_signals)
     } else {
-        run_real(args, &inputs, &options)
+        run_real(&run, &inputs, hook.as_mut(), &stop_on_signals)
     };
     match result {
         Ok(Ok(report)) => {
@@ -229,8 +240,6 @@ fn run_station(args: &RunArgs) -> Result<u8> {
     }
 }
 
-type StationResult = std::result::Result<StationReport, unattended::StationFailure>;
-
 /// SIGTERM and SIGINT ask `stop` to stop.
 fn stop_on_signals(stop: &StopHandle) -> Result<()> {
     use tokio::signal::unix::{SignalKind, signal};
@@ -247,79 +256,6 @@ fn stop_on_signals(stop: &StopHandle) -> Result<()> {
     Ok(())
 }
 
-/// The station time of the last line journaled in any day session of `store`.
-fn last_journaled(store: &Path) -> Result<Option<DateTime<Utc>>> {
-    let mut last = None;
-    for day in existing_days(store).with_context(|| format!("reading {}", store.display()))? {
-        let dir = unattended::day_rollover::day_dir(store, day);
-        let reader = SessionReader::open(&dir).with_context(|| format!("reading {}", dir.display()))?;
-        last = last.max(reader.entries().iter().map(JournalEntry::time).max());
-    }
-    Ok(last)
-}
-
-fn run_simulated(args: &RunArgs, inputs: &Inputs, options: &StationOptions) -> Result<StationResult> {
-    let Some(first) = inputs.timeline.occurrences.first() else {
-        bail!("the plan has no occurrences: nothing to run");
-    };
-    // The simulated calendar begins a minute before the first occurrence,
-    // or, after a stop, a second after the last journaled line.
-    let origin = match last_journaled(&args.store)? {
-        Some(t) => t + TimeDelta::seconds(1),
-        None => first.start - TimeDelta::seconds(60),
-    };
-    let SimulatedWorld { world, home, seed: _ } = simulated_world(inputs, args.sim_samples, args.sim_bounces)?;
-    let outages = args
-        .sim_outage
-        .iter()
-        .filter_map(|o| {
-            let end = o.start + TimeDelta::from_std(o.duration).ok()?;
-            if end <= origin {
-                return None;
-            }
-            let start = o.start.max(origin);
-            Some(Outage {
-                device: o.device,
-                after: (start - origin).to_std().ok()?,
-                duration: (end - start).to_std().ok()?,
-            })
-        })
-        .collect();
-    let sim_options = SimOptions {
-        origin,
-        position_m: home,
-        faults: FaultPlan {
-            outages,
-            ..FaultPlan::default()
-        },
-        ..SimOptions::default()
-    };
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .start_paused(true)
-        .build()
-        .context("starting the runtime")?;
-    runtime.block_on(async {
-        let stop = StopHandle::new();
-        stop_on_signals(&stop)?;
-        let mut sim = SimStation::start(&inputs.station, world, sim_options)
-            .await
-            .context("starting the simulated station")?;
-        let clock = sim.clock();
-        Ok(unattended::run(
-            &station_inputs(inputs),
-            &args.store,
-            &mut sim,
-            &clock,
-            options,
-            hook(args, inputs.plan.plan.value.quality.clone().unwrap_or_default()).as_mut(),
-            &stop,
-            &mut NoProgress,
-        )
-        .await)
-    })
-}
-
 /// The scan hook `args` ask for.
 fn hook(args: &RunArgs, thresholds: Quality) -> Box<dyn ScanHook> {
     match (&args.response, args.process) {
@@ -329,48 +265,6 @@ fn hook(args: &RunArgs, thresholds: Quality) -> Box<dyn ScanHook> {
         })),
         _ => Box::new(NoProcessing),
     }
-}
-
-fn station_inputs(inputs: &Inputs) -> StationInputs<'_> {
-    StationInputs {
-        timeline: &inputs.timeline,
-        plan: &inputs.plan.plan.value,
-        station: &inputs.station,
-        snapshot: &inputs.snapshot,
-    }
-}
-
-fn run_real(args: &RunArgs, inputs: &Inputs, options: &StationOptions) -> Result<StationResult> {
-    check_ports(&inputs.station).with_context(|| format!("station {}", inputs.station_label))?;
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .context("starting the runtime")?;
-    runtime.block_on(async {
-        let stop = StopHandle::new();
-        stop_on_signals(&stop)?;
-        let camera = open_camera(&inputs.station.camera)
-            .with_context(|| format!("opening the camera of station {}", inputs.station_label))?;
-        let link_seq = (Utc::now().timestamp_subsec_micros() % 4096) as u16 + 1;
-        let rig_options = RigOptions {
-            link_seq,
-            ..RigOptions::default()
-        };
-        let mut rig = StationRig::connect(&inputs.station, SerialOpener, camera, rig_options)
-            .await
-            .with_context(|| format!("connecting the devices of station {}", inputs.station_label))?;
-        Ok(unattended::run(
-            &station_inputs(inputs),
-            &args.store,
-            &mut rig,
-            &SystemClock,
-            options,
-            hook(args, inputs.plan.plan.value.quality.clone().unwrap_or_default()).as_mut(),
-            &stop,
-            &mut NoProgress,
-        )
-        .await)
-    })
 }
 
 fn summary(store: &Path, r: &StationReport, wall: Duration) -> Result<()> {

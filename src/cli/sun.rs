@@ -71,8 +71,8 @@ pub fn run(args: SunArgs) -> Result<()> {
     if let Some(input) = &args.csv {
         let file = File::open(input).with_context(|| format!("{}: cannot open", input.display()))?;
         let n = match &args.out {
-            Some(out) => super::partial_file::write_with(out, |w| {
-                sun_table(BufReader::new(file), w).with_context(|| format!("{}", input.display()))
+            Some(out) => campanile_session::partial_file::write_with(out, |w| {
+                Ok(sun_table(BufReader::new(file), w).with_context(|| format!("{}", input.display()))?)
             })?,
             None => sun_table(BufReader::new(file), std::io::stdout().lock())
                 .with_context(|| format!("{}", input.display()))?,
