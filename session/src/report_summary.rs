@@ -14,11 +14,31 @@ const GROUPS: &[(&str, &str, &str)] = &[
     ("environment", "Environment", "Environment"),
     ("pseudo-albedos", "Pseudo-albedos (ch. 5)", "Pseudo-albedos"),
     ("outdoor", "Outdoor re-rendering", "Held-out time"),
-    ("room: response", "Room: camera response", "Indoor: the room relit (inverse global illumination, §4.7.2)"),
-    ("room: radiance ", "Room: HDR views", "Indoor: the room relit (inverse global illumination, §4.7.2)"),
-    ("room: brdf ", "Room: BRDFs (ch. 4)", "Indoor: the room relit (inverse global illumination, §4.7.2)"),
-    ("brdf ", "BRDFs (ch. 4)", "Indoor: the room (inverse global illumination, §4.7.2)"),
-    ("lamp", "Lamps", "Indoor: the room (inverse global illumination, §4.7.2)"),
+    (
+        "room: response",
+        "Room: camera response",
+        "Indoor: the room relit (inverse global illumination, §4.7.2)",
+    ),
+    (
+        "room: radiance ",
+        "Room: HDR views",
+        "Indoor: the room relit (inverse global illumination, §4.7.2)",
+    ),
+    (
+        "room: brdf ",
+        "Room: BRDFs (ch. 4)",
+        "Indoor: the room relit (inverse global illumination, §4.7.2)",
+    ),
+    (
+        "brdf ",
+        "BRDFs (ch. 4)",
+        "Indoor: the room (inverse global illumination, §4.7.2)",
+    ),
+    (
+        "lamp",
+        "Lamps",
+        "Indoor: the room (inverse global illumination, §4.7.2)",
+    ),
 ];
 
 /// One row per product group present in `quality`, in [`GROUPS`]'s order,
@@ -67,7 +87,15 @@ mod tests {
         );
         let rows = from_quality(&q);
         let names: Vec<&str> = rows.iter().map(|r| r.product.as_str()).collect();
-        assert_eq!(names, ["Camera response", "HDR radiance maps", "Sun irradiance", "igi interreflection"]);
+        assert_eq!(
+            names,
+            [
+                "Camera response",
+                "HDR radiance maps",
+                "Sun irradiance",
+                "igi interreflection"
+            ]
+        );
         assert_eq!(rows[2].verdict, Some(Verdict::Failed));
         assert_eq!(rows[2].section, "Sun and extinction");
     }

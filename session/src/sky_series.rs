@@ -410,7 +410,10 @@ pub fn report(
     }
     Ok(Report {
         title: format!("Campanile sky time series: {}", session.display()),
-        summary: quality.as_ref().map(crate::report_summary::from_quality).unwrap_or_default(),
+        summary: quality
+            .as_ref()
+            .map(crate::report_summary::from_quality)
+            .unwrap_or_default(),
         intro: vec![format!(
             "Sky-only session {}, processed by campanile {}: every figure below is recomputed from the per-scan products in scans/.",
             session.display(),

@@ -37,14 +37,17 @@ pub fn curve_plot_svg(curve: &ResponseCurve, title: &str) -> Result<String, HdrE
         let mut chart = ChartBuilder::on(&root)
             .caption(title, ("sans-serif", 22))
             .margin(16)
-            .x_label_area_size(40)
-            .y_label_area_size(56)
+            .x_label_area_size(48)
+            .y_label_area_size(80)
             .build_cartesian_2d(xmin..xmax, 0.0..ymax)
             .map_err(|e| err(e.to_string()))?;
         chart
             .configure_mesh()
             .x_desc("g(z) = ln relative exposure")
             .y_desc("code z")
+            // Readable in the report at 100 % zoom (crate::report::LABEL_PX).
+            .label_style(("sans-serif", crate::report::LABEL_PX))
+            .axis_desc_style(("sans-serif", crate::report::LABEL_PX + 1))
             .draw()
             .map_err(|e| err(e.to_string()))?;
         let colours = [RED, GREEN, BLUE];
@@ -80,6 +83,7 @@ pub fn curve_plot_svg(curve: &ResponseCurve, title: &str) -> Result<String, HdrE
             .configure_series_labels()
             .background_style(WHITE.mix(0.8))
             .border_style(BLACK)
+            .label_font(("sans-serif", crate::report::LABEL_PX))
             .draw()
             .map_err(|e| err(e.to_string()))?;
         root.present().map_err(|e| err(e.to_string()))?;
@@ -114,5 +118,20 @@ mod tests {
         for label in ["red", "green", "blue", "code z"] {
             assert!(svg.contains(label), "{label}");
         }
+        // Every text readable at the plot's natural size (at least 11 px;
+        // the report showed its tick labels at about 8 px).
+        let smallest = svg
+            .split("font-size=\"")
+            .skip(1)
+            .map(|rest| {
+                rest.split('"')
+                    .next()
+                    .unwrap()
+                    .trim_end_matches("px")
+                    .parse::<f64>()
+                    .unwrap()
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(smallest >= 11.0, "smallest text {smallest} px");
     }
 }

@@ -181,19 +181,19 @@ fn escape(s: &str) -> String {
 
 const STYLE: &str = "body{font-family:sans-serif;font-size:16px;max-width:1360px;margin:2em auto;padding:0 1em;color:#222}\
 h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:2em}\
-table{border-collapse:collapse;margin:1em 0;font-size:.9em;max-width:100%}td,th{border:1px solid #bbb;padding:.25em .6em;text-align:right;overflow-wrap:anywhere}\
+table{border-collapse:collapse;margin:1em 0;font-size:.9em;max-width:100%}td,th{border:1px solid #bbb;padding:.25em .6em;text-align:right}td{overflow-wrap:anywhere}\
 th{background:#eee}td:first-child,th:first-child{text-align:left}caption{text-align:left;font-weight:bold;padding:.3em 0}\
 td.flag{background:#fdd;color:#900;font-weight:bold}\
 p,li,figcaption,caption{overflow-wrap:anywhere}\
 .figs{display:flex;flex-wrap:wrap;gap:1em;align-items:flex-start}figure{margin:0;max-width:100%}\
 figure img{max-width:100%;border:1px solid #ddd;image-rendering:pixelated}.figs figure img{min-width:360px}\
-.row{display:flex;flex-wrap:nowrap;gap:.8em;width:100%;margin:.6em 0}.row figure{flex:1 1 0;min-width:0}.row figure img{width:100%}\
+.row{display:flex;flex-wrap:nowrap;gap:.8em;width:100%;margin:.6em 0}.row figure{flex:1 1 0;min-width:0}.row figure svg.bar{max-width:100%}.row figure img{width:100%}\
 figcaption{font-size:.85em;color:#444;max-width:640px}.row figcaption{max-width:none}\
-svg.bar{display:block;margin-top:2px}nav{line-height:1.8}nav a{margin-right:1em;white-space:nowrap}\
+svg.bar{display:block;margin-top:2px}nav{display:flex;flex-wrap:wrap;gap:.3em 1.2em;line-height:1.6}nav a{white-space:nowrap}\
 .quality{border:2px solid;padding:.5em 1em;margin:1em 0}.quality ul{margin:.3em 0}\
 .quality.ok{border-color:#2a7;background:#eefaf3}.quality.poor{border-color:#d90;background:#fff8e6}\
 .quality.failed{border-color:#c22;background:#fdeeee}\
-#summary{font-size:1em}#summary td.ok{background:#dff3e6}#summary td.poor{background:#ffefc2}#summary td.failed{background:#f8d0d0;font-weight:bold}";
+#summary{font-size:1em}#summary td{text-align:left}#summary th{white-space:nowrap;text-align:left}#summary td.ok{background:#dff3e6}#summary td.poor{background:#ffefc2}#summary td.failed{background:#f8d0d0;font-weight:bold}";
 
 /// Run once the page has loaded: writes on `<body>` what a headless
 /// browser's DOM dump can check: images decoded (`data-images-loaded`,
@@ -294,13 +294,13 @@ fn colour_bar(scale: &ColourScale) -> String {
         h
     });
     format!(
-        "<svg class=\"bar\" width=\"320\" height=\"40\" viewBox=\"0 0 320 40\" role=\"img\" aria-label=\"colour scale\">\
+        "<svg class=\"bar\" width=\"320\" height=\"46\" viewBox=\"0 0 320 46\" role=\"img\" aria-label=\"colour scale\">\
 <defs><linearGradient id=\"{id}\">{stops}</linearGradient></defs>\
 <rect x=\"10\" y=\"2\" width=\"300\" height=\"12\" fill=\"url(#{id})\" stroke=\"#888\"/>\
 <text x=\"10\" y=\"29\" font-size=\"12\" text-anchor=\"start\">{}</text>\
 <text x=\"160\" y=\"29\" font-size=\"12\" text-anchor=\"middle\">{}</text>\
 <text x=\"310\" y=\"29\" font-size=\"12\" text-anchor=\"end\">{}</text>\
-<text x=\"160\" y=\"40\" font-size=\"11\" text-anchor=\"middle\" fill=\"#444\">{}</text></svg>",
+<text x=\"160\" y=\"42\" font-size=\"11\" text-anchor=\"middle\" fill=\"#444\">{}</text></svg>",
         escape(&ticks[0]),
         escape(&ticks[1]),
         escape(&ticks[2]),
@@ -330,11 +330,29 @@ fn figure_html(f: &Figure) -> String {
         ),
         Figure::Map { bytes, caption, scale } => img(png_uri(bytes), caption, colour_bar(scale)),
         Figure::Row(figures) => {
+            // Maps that share one scale get one colour bar, under the row.
+            let scales: Vec<&ColourScale> = figures
+                .iter()
+                .filter_map(|f| match f {
+                    Figure::Map { scale, .. } => Some(scale),
+                    _ => None,
+                })
+                .collect();
+            let shared = (scales.len() == figures.len() && scales.len() > 1 && scales.windows(2).all(|w| w[0] == w[1]))
+                .then(|| scales[0]);
             let mut h = String::from("<div class=\"row\">\n");
             for f in figures {
-                h.push_str(&figure_html(f));
+                match (f, shared) {
+                    (Figure::Map { bytes, caption, .. }, Some(_)) => {
+                        h.push_str(&img(png_uri(bytes), caption, String::new()));
+                    }
+                    _ => h.push_str(&figure_html(f)),
+                }
             }
             h.push_str("</div>\n");
+            if let Some(scale) = shared {
+                h.push_str(&colour_bar(scale));
+            }
             h
         }
     }

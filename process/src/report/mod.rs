@@ -12,7 +12,7 @@ mod plot;
 
 pub use html::{ColourScale, Figure, Report, Section, SummaryRow, Table, flagged};
 pub use image_encode::{false_colour_png, tonemapped_png};
-pub use plot::{Series, line_plot_svg};
+pub use plot::{LABEL_PX, Series, line_plot_svg};
 
 /// Why a figure could not be made.
 #[derive(Debug, thiserror::Error)]

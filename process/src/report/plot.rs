@@ -21,7 +21,7 @@ pub struct Series {
 /// report shows plots at their natural 640 px width, so this is what a
 /// reader sees at 100 % zoom, less the backend's 0.81 (plotters writes a 16
 /// px font as font-size="12.9"): the issue asked for at least 11 px.
-const LABEL_PX: u32 = 16;
+pub const LABEL_PX: u32 = 16;
 
 /// A plot of `series` with axis labels, sized to fit every finite point.
 pub fn line_plot_svg(title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Result<String, ReportError> {

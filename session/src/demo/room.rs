@@ -158,7 +158,9 @@ pub fn room(dir: &Path, quick: bool, host: &dyn super::DemoHost) -> Result<RoomR
         caption: format!(
             "The room's materials (thesis Table 4.1 format): true / recovered (error); channel R for ρd and ρs, as in the thesis's table; ⚠ more than {FLAG_PCT} % (γ: {FLAG_DEG}°) off"
         ),
-        header: ["surface", "model (why)", "ρd", "ρs", "αx", "αy", "γ"].map(String::from).to_vec(),
+        header: ["surface", "model (why)", "ρd", "ρs", "αx", "αy", "γ"]
+            .map(String::from)
+            .to_vec(),
         rows: Vec::new(),
     };
     for (s, t) in r.result.surfaces.iter().zip(&truth) {
@@ -171,7 +173,11 @@ pub fn room(dir: &Path, quick: bool, host: &dyn super::DemoHost) -> Result<RoomR
             (Some(tv), Some(g)) => {
                 let text = format!("{tv:.3} / {g:.3} ({:.1}{unit})", e.unwrap_or(f64::NAN));
                 let bound = if unit == "°" { FLAG_DEG } else { FLAG_PCT };
-                if e.is_none_or(|e| !(e <= bound)) { flagged(text) } else { text }
+                if e.is_none_or(|e| e.is_nan() || e > bound) {
+                    flagged(text)
+                } else {
+                    text
+                }
             }
             // A true parameter the fit has none of (a lobe not recovered).
             (Some(tv), None) => flagged(format!("{tv:.3} / —")),
