@@ -295,7 +295,17 @@ pub fn process_new_scans(session: &Path, opts: &SkySeriesOptions) -> Result<Scan
         }
     }
     let t = Instant::now();
-    let (curve, response_source) = if todo.is_empty() {
+    // A session that holds only a calibration bracket (no scan at all)
+    // still gets its response: that is what it was captured for (a
+    // station's curve, before `station run --process --response`).
+    let calibration_only = already_done + other_shards + incomplete.len() == 0
+        && opts.response.is_none()
+        && !opts.out.join("response.csv").is_file()
+        && inputs
+            .reader
+            .frames()
+            .any(|f| matches!(step_of(&inputs, &f.key), Some(Step::Bracket { .. })));
+    let (curve, response_source) = if todo.is_empty() && !calibration_only {
         (None, "not needed (no new scan)".to_owned())
     } else {
         let (c, s) = response(&inputs, opts)?;

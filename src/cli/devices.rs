@@ -235,7 +235,12 @@ fn test_real(station: &Station, head_options: conformance::pan_tilt::Options) ->
             ));
         }
         let cam = &station.camera;
-        let camera_label = format!("camera ({:?} {:?})", cam.driver, cam.device);
+        // "camera (V4l on /dev/video0)", like the serial devices' labels.
+        let camera_label = match &cam.device {
+            Some(campanile_config::camera::DeviceRef::Path(p)) => format!("camera ({:?} on {p})", cam.driver),
+            Some(campanile_config::camera::DeviceRef::Index(i)) => format!("camera ({:?} number {i})", cam.driver),
+            None => format!("camera ({:?}, its first device)", cam.driver),
+        };
         let built = match cam.driver {
             CameraDriver::V4l => cfg!(feature = "v4l"),
             CameraDriver::Nokhwa => cfg!(feature = "nokhwa"),
