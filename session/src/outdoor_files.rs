@@ -6,9 +6,6 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, anyhow};
-use campanile_process::camera::image::RadianceImage;
-use campanile_process::exr_io::write_radiance_exr;
-use campanile_process::hdr::merge::RadianceMap;
 use campanile_process::outdoor::light_file::{TimeLight, load_light};
 use campanile_process::outdoor::novel_view::{ViewComparison, compare_view, render_view};
 use campanile_process::outdoor::photo_file::{PosedView, load_photos};
@@ -427,7 +424,7 @@ pub fn render(args: &RenderOptions) -> Result<Rendered> {
         };
         let view = render_view(&scene.scene, &refl, &v.rig, &light, &sources, &settings);
         let path = args.out.join(format!("{}.exr", file_name(&v.label)));
-        write_exr(&view.rendered, &path)?;
+        crate::igi::write_exr(&view.rendered, &path)?;
         let mut entry = serde_json::json!({
             "view": v.label,
             "file": path.file_name().map(|f| f.to_string_lossy().into_owned()),
@@ -466,16 +463,4 @@ pub fn render(args: &RenderOptions) -> Result<Rendered> {
         views: views_out,
         quality: QualityReport::new(products, q),
     })
-}
-
-fn write_exr(image: &RadianceImage, path: &Path) -> Result<()> {
-    let map = RadianceMap {
-        width: image.width,
-        height: image.height,
-        rgb: image.data.clone(),
-        variance: vec![0.0; image.data.len()],
-        mask: vec![0; image.width * image.height],
-    };
-    write_radiance_exr(&map, path).with_context(|| format!("{}: cannot write", path.display()))?;
-    Ok(())
 }

@@ -48,19 +48,16 @@ pub fn from_quality(quality: &QualityReport) -> Vec<SummaryRow> {
         .iter()
         .filter_map(|(prefix, product, section)| SummaryRow::from_quality(quality, prefix, product, section))
         .collect();
-    let others: Vec<&str> = quality
-        .products
-        .iter()
-        .map(|p| p.product.as_str())
-        .filter(|name| !GROUPS.iter().any(|(prefix, _, _)| name.starts_with(prefix)))
-        .collect();
-    for name in others {
-        // A product of its own kind: its own row (its whole name as the
-        // prefix; a longer name it prefixes would share the row).
-        if !rows.iter().any(|r| name.starts_with(r.product.as_str()))
+    // A product of a kind no group names gets a row of its own (its name
+    // as the prefix, which also takes any product whose name extends it).
+    let mut taken: Vec<&str> = GROUPS.iter().map(|(prefix, _, _)| *prefix).collect();
+    for p in &quality.products {
+        let name = p.product.as_str();
+        if !taken.iter().any(|prefix| name.starts_with(prefix))
             && let Some(row) = SummaryRow::from_quality(quality, name, name, "")
         {
             rows.push(row);
+            taken.push(name);
         }
     }
     rows

@@ -8,10 +8,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use campanile_process::camera::image::RadianceImage;
-use campanile_process::exr_io::{read_radiance_exr, read_rgb_exr, write_radiance_exr};
+use campanile_process::exr_io::{read_radiance_exr, read_rgb_exr};
 use campanile_process::hdr::curve::ResponseCurve;
 use campanile_process::hdr::image_file::write_png;
-use campanile_process::hdr::merge::RadianceMap;
 use campanile_process::outdoor::atlas::read_materials;
 use campanile_process::outdoor::photograph::photograph;
 use campanile_process::outdoor::zoom_albedo::ZoomReport;
@@ -139,19 +138,6 @@ fn albedo_image(rho: &[[f64; 3]], rig: &CameraRig) -> RadianceImage {
     }
 }
 
-fn write_exr(image: &RadianceImage, path: &Path) -> Result<()> {
-    let n = image.width * image.height;
-    let map = RadianceMap {
-        width: image.width,
-        height: image.height,
-        rgb: image.data.clone(),
-        variance: vec![0.0; n * 3],
-        mask: vec![0; n],
-    };
-    write_radiance_exr(&map, path).with_context(|| format!("writing {}", path.display()))?;
-    Ok(())
-}
-
 /// Renders what `opts` ask for into `opts.out`, calling `on` after each
 /// file (the frames of a sequence in time order).
 pub fn render(opts: &SceneRenderOptions, on: &mut dyn FnMut(Rendered<'_>) -> Result<()>) -> Result<()> {
@@ -247,7 +233,7 @@ pub fn render(opts: &SceneRenderOptions, on: &mut dyn FnMut(Rendered<'_>) -> Res
             on(Rendered::Zoom(&z.report))?;
             for (name, rho) in [("zoom-albedo-sun", &z.rho_sun), ("zoom-albedo-se", &z.rho_se)] {
                 let exr = opts.out.join(format!("{name}.exr"));
-                write_exr(&albedo_image(rho, &z.rig), &exr)?;
+                crate::igi::write_exr(&albedo_image(rho, &z.rig), &exr)?;
                 on(Rendered::ZoomAlbedo(&exr))?;
             }
             Some(z)
@@ -272,7 +258,7 @@ pub fn render(opts: &SceneRenderOptions, on: &mut dyn FnMut(Rendered<'_>) -> Res
         };
         let stem = format!("{prefix}-{}", t.format("%Y%m%dT%H%M%SZ"));
         let exr = opts.out.join(format!("{stem}.exr"));
-        write_exr(&image, &exr)?;
+        crate::igi::write_exr(&image, &exr)?;
         on(Rendered::Frame {
             time: t,
             sun_elevation_rad: elevation,

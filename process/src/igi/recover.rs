@@ -243,35 +243,18 @@ pub fn recover_with_progress(
                 step,
             })
         };
-        let seed = options.seed.wrapping_add(u64::from(it) * 0x9e37_79b9);
-        // (1) Diffuse radiance per cell: measured minus the specular estimate.
-        let indirect_known = it > 0 || !options.interreflection;
-        estimate_diffuse(&mut field, &geometry, &obs, &materials, &kind_ind, indirect_known);
-        // (2) Indirect irradiance per cell and (3) ΔS at every sample, both
-        // none in direct-only images.
-        let (mut gather_seconds, mut delta_s_seconds) = (0.0, 0.0);
-        if options.interreflection {
-            let tt = Instant::now();
-            report("indirect light");
-            let albedos = specular_albedos(&materials);
-            field.gather(&geometry, input, &materials, &albedos, options.gather_rays, seed);
-            gather_seconds = tt.elapsed().as_secs_f64();
-            let tt = Instant::now();
-            report("ΔS");
-            kind_ind = indirect_specular(
-                &geometry,
-                input,
-                &field,
-                &materials,
-                &albedos,
-                &obs,
-                &shapes,
-                options.lobe_rays,
-                options.lobe_ray_factor_max,
-                seed ^ 0x5555,
-            );
-            delta_s_seconds = tt.elapsed().as_secs_f64();
-        }
+        let (gather_seconds, delta_s_seconds) = light_pass(
+            &mut field,
+            &geometry,
+            input,
+            &obs,
+            &materials,
+            &shapes,
+            &mut kind_ind,
+            it,
+            options,
+            &mut report,
+        );
         let tt = Instant::now();
         report("fitting");
         // Highlights are detected again on every pass, against the
@@ -521,32 +504,19 @@ pub fn predict(
     let (geometry, obs, _, mut field) = setup(input, options)?;
     let shapes: Vec<Option<WardLobe>> = materials.iter().map(|m| m.and_then(|m| m.lobe)).collect();
     let mut kind_ind: Vec<[f64; 3]> = vec![[0.0; 3]; obs.len()];
-    let albedos = specular_albedos(materials);
     for it in 0..options.passes() {
-        let seed = options.seed.wrapping_add(u64::from(it) * 0x9e37_79b9);
-        estimate_diffuse(
+        light_pass(
             &mut field,
             &geometry,
+            input,
             &obs,
             materials,
-            &kind_ind,
-            it > 0 || !options.interreflection,
+            &shapes,
+            &mut kind_ind,
+            it,
+            options,
+            &mut |_| {},
         );
-        if options.interreflection {
-            field.gather(&geometry, input, materials, &albedos, options.gather_rays, seed);
-            kind_ind = indirect_specular(
-                &geometry,
-                input,
-                &field,
-                materials,
-                &albedos,
-                &obs,
-                &shapes,
-                options.lobe_rays,
-                options.lobe_ray_factor_max,
-                seed ^ 0x5555,
-            );
-        }
     }
     Ok(obs
         .iter()
@@ -649,6 +619,52 @@ fn specular_radiance(o: &Observation, m: Option<&WardMaterial>, kind: [f64; 3]) 
 /// radiance per unit irradiance, the same weighted means' ratio with each
 /// observation's own direct irradiance
 /// ([`RadiosityField::reflectance`]).
+/// One pass's light under `materials` (Fig. 4.6): (1) each cell's
+/// diffuse radiance, measured minus the specular estimate `kind_ind`;
+/// then, in interreflected images only, (2) the indirect irradiance per
+/// cell and (3) ΔS at every sample, written to `kind_ind`. `recover`
+/// refits after it, `predict` does not. Returns the seconds of (2) and (3).
+#[allow(clippy::too_many_arguments)]
+fn light_pass(
+    field: &mut RadiosityField,
+    geometry: &Geometry,
+    input: &IgiInput,
+    obs: &[Observation],
+    materials: &[Option<WardMaterial>],
+    shapes: &[Option<WardLobe>],
+    kind_ind: &mut Vec<[f64; 3]>,
+    pass: u32,
+    options: &IgiOptions,
+    report: &mut dyn FnMut(&'static str),
+) -> (f64, f64) {
+    let seed = options.seed.wrapping_add(u64::from(pass) * 0x9e37_79b9);
+    let indirect_known = pass > 0 || !options.interreflection;
+    estimate_diffuse(field, geometry, obs, materials, kind_ind, indirect_known);
+    if !options.interreflection {
+        return (0.0, 0.0);
+    }
+    let t = Instant::now();
+    report("indirect light");
+    let albedos = specular_albedos(materials);
+    field.gather(geometry, input, materials, &albedos, options.gather_rays, seed);
+    let gather_seconds = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    report("ΔS");
+    *kind_ind = indirect_specular(
+        geometry,
+        input,
+        field,
+        materials,
+        &albedos,
+        obs,
+        shapes,
+        options.lobe_rays,
+        options.lobe_ray_factor_max,
+        seed ^ 0x5555,
+    );
+    (gather_seconds, t.elapsed().as_secs_f64())
+}
+
 fn estimate_diffuse(
     field: &mut RadiosityField,
     geometry: &Geometry,

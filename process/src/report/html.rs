@@ -285,14 +285,13 @@ fn colour_bar(scale: &ColourScale) -> String {
             unit,
         ),
     };
-    let id = format!("g{:x}", {
-        // A stable id per bar content, so that gradients do not collide.
-        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-        for b in format!("{scale:?}").bytes() {
-            h = (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3);
-        }
-        h
-    });
+    // An id per scale, so that the page's gradients do not collide.
+    let id = {
+        use std::hash::{DefaultHasher, Hash, Hasher};
+        let mut h = DefaultHasher::new();
+        format!("{scale:?}").hash(&mut h);
+        format!("g{:x}", h.finish())
+    };
     format!(
         "<svg class=\"bar\" width=\"320\" height=\"46\" viewBox=\"0 0 320 46\" role=\"img\" aria-label=\"colour scale\">\
 <defs><linearGradient id=\"{id}\">{stops}</linearGradient></defs>\

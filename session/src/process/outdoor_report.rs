@@ -10,6 +10,8 @@ use campanile_process::report::{
 };
 use campanile_process::sun::{SolarDay, solar_day, sun_position};
 
+use campanile_process::camera::image::RadianceImage;
+
 use super::Processed;
 use super::outdoor_stage::OutdoorProducts;
 
@@ -237,6 +239,18 @@ pub fn held_out_section(out: &OutdoorProducts) -> Result<Section, ReportError> {
     })
 }
 
+/// One exposure for a strip of images: the brightest image's 97th
+/// percentile, so that none of them is blown out.
+fn strip_white<'a>(images: impl Iterator<Item = &'a RadianceImage>) -> f64 {
+    images
+        .map(|img| {
+            let mut v: Vec<f64> = img.data.iter().map(|&x| f64::from(x)).collect();
+            quantile(&mut v, 0.97)
+        })
+        .fold(0.0f64, f64::max)
+        .max(1e-9)
+}
+
 /// A strip of re-renders from an hour after sunrise to an hour before
 /// sunset on the session's day, under the predicted light, from `rig`.
 pub fn day_strip(
@@ -278,14 +292,7 @@ pub fn day_strip(
                         Err(e) => notes.push(format!("{}: {e}", t.format("%H:%M UTC"))),
                     }
                 }
-                let white = images
-                    .iter()
-                    .map(|(_, img)| {
-                        let mut v: Vec<f64> = img.data.iter().map(|&x| f64::from(x)).collect();
-                        quantile(&mut v, 0.97)
-                    })
-                    .fold(0.0f64, f64::max)
-                    .max(1e-9);
+                let white = strip_white(images.iter().map(|(_, img)| img));
                 for (t, img) in images {
                     figures.push(Figure::Png {
                         bytes: tonemapped_png("strip", img.width, img.height, &img.data, 1.0 / white)?,
@@ -343,13 +350,7 @@ pub fn overcast_strip(
                 }
                 // One exposure for the strip, set by its brightest image
                 // (the clear one's left the overcast sky blown out).
-                let white = images
-                    .iter()
-                    .map(|(_, img)| {
-                        let mut v: Vec<f64> = img.data.iter().map(|&x| f64::from(x)).collect();
-                        quantile(&mut v, 0.97)
-                    })
-                    .fold(1e-9, f64::max);
+                let white = strip_white(images.iter().map(|(_, img)| img));
                 let mut row = Vec::new();
                 for (blocked, img) in images {
                     row.push(Figure::Map {
