@@ -84,7 +84,19 @@ work_from!(
     campanile_process::pipeline::PipelineError,
     campanile_process::report::ReportError,
     campanile_process::sky_series::SkySeriesError,
+    campanile_process::sun::SunError,
 );
+
+/// A number as an error message shows it: the shortest text that reads
+/// back as `x`, in scientific notation when huge or tiny (`1e308`, not
+/// 309 digits).
+pub fn shown(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e15).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
 
 /// An `anyhow` error that is bad input, with `message` as its text.
 pub fn bad_input(message: impl Into<String>) -> anyhow::Error {

@@ -4,6 +4,7 @@
 //! table in Table 4.1's layout, each surface's model and why, RADIANCE and
 //! Mitsuba files, albedo maps as EXR, a summary JSON).
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, anyhow};
@@ -430,4 +431,83 @@ pub fn quality(r: &Recovered, q: &campanile_process::quality::Quality) -> Qualit
     let mut products: Vec<_> = r.result.surfaces.iter().map(|s| gates::brdf(s, q)).collect();
     products.push(gates::interreflection(&r.result.interreflection, q));
     QualityReport::new(products, q)
+}
+
+/// Writes what an IGI run made to `out`: the materials table, the Ward
+/// normalization chosen, the interreflection check, each triangulated light,
+/// exports refused and why, and the files written.
+pub fn write_summary(r: &Recovered, w: &Written, out: &mut dyn Write) -> Result<()> {
+    write!(out, "{}", w.table)?;
+    if r.variants.len() > 1 {
+        writeln!(
+            out,
+            "Ward normalization chosen: {}",
+            describe(&r.variants.iter().collect::<Vec<_>>())
+        )?;
+    }
+    writeln!(out, "{}", r.result.interreflection.message)?;
+    for (n, t) in &r.loaded.triangulated {
+        writeln!(
+            out,
+            "light {n:?} triangulated from {} images: position ({:.4}, {:.4}, {:.4}) m, radius {:.4} m, intensity {:.3?} W/sr, ray rms {:.2} mm",
+            t.sightings.len(),
+            t.light.position.x,
+            t.light.position.y,
+            t.light.position.z,
+            t.light.radius,
+            t.light.intensity,
+            t.ray_rms_m * 1e3
+        )?;
+    }
+    for why in &w.refused {
+        writeln!(out, "{why}")?;
+    }
+    writeln!(
+        out,
+        "wrote {}, materials.json, {}materials.xml (Mitsuba 3), {}, {} albedo maps under {}",
+        w.materials.display(),
+        if w.refused.is_empty() {
+            "materials.rad (RADIANCE), "
+        } else {
+            ""
+        },
+        w.summary.display(),
+        w.albedo.len(),
+        w.materials.with_file_name("albedo").display()
+    )?;
+    Ok(())
+}
+
+/// The lights of a lights file (RON, as the scene file's `lights`).
+pub fn lights_file(path: &Path) -> Result<Vec<IgiLight>> {
+    Ok(campanile_process::igi::scene_file::load_lights(path)
+        .map_err(|e| anyhow!("{e}"))?
+        .into_iter()
+        .map(|(_, l)| l)
+        .collect())
+}
+
+/// Renders the view `camera` (`None`: every photographed view) of the
+/// recovered scene under `lights` into `DIR/relit-VIEW.exr`, one line per
+/// view to `out`.
+pub fn relight_views(
+    r: &Recovered,
+    lights: &[IgiLight],
+    camera: Option<&str>,
+    dir: &Path,
+    quick: bool,
+    out: &mut dyn Write,
+) -> Result<()> {
+    let cameras = camera.map_or_else(|| r.image_cameras(), |c| vec![c.to_owned()]);
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let bar = bar(cameras.len() as u64, "relighting");
+    for cam in cameras {
+        let img = r.relight(lights, &cam, quick)?;
+        let path = dir.join(format!("relit-{cam}.exr"));
+        write_exr(&img, &path)?;
+        bar.inc(1);
+        bar.suspend(|| writeln!(out, "relit {}", path.display()))?;
+    }
+    bar.finish_and_clear();
+    Ok(())
 }

@@ -14,14 +14,25 @@
 //! - [`scan_processor`]: the [`ScanProcessor`](scan_processor::ScanProcessor)
 //!   the station calls after each scan, and the sky series' one;
 //! - [`station_run`]: the unattended station's run, simulated or real;
+//! - [`station_status`]: the station's heartbeat read back;
 //! - [`igi`]: inverse global illumination on a scene file and its products;
 //! - [`outdoor_files`]: outdoor reflectance on plain files (recover, render);
+//! - [`env_files`]: environment regions on plain files (fit, predict);
+//! - [`sun_files`]: solar positions for an instant or a table;
+//! - [`hdr_files`]: the camera response, HDR merges and lens models on
+//!   plain files;
+//! - [`site`]: the sun given as angles or from the ephemeris at a site;
 //! - [`sky_files`]: sky models on plain files (fit, predict, map);
 //! - [`scene_render`]: the scene at new times from recovered pseudo-albedos;
 //! - [`capture_inputs`]: a capture's plan, station, scene and timeline, and
 //!   a simulated station's world;
 //! - [`capture_run`]: a capture's timeline run on the simulated or the real
 //!   station, and the session's tally;
+//! - [`device_checks`]: the devices a computer offers, and the
+//!   conformance suites run against a station's;
+//! - [`plan_check`]: a plan simulated forward on a station;
+//! - [`photo_import`]: sessions from hand-taken photographs, and
+//!   checking a session's frames;
 //! - [`demo`]: the simulated station's day, cube and room, with every
 //!   figure beside the simulator's truth;
 //! - [`report_summary`]: the summary at the top of every report page;
@@ -38,19 +49,27 @@ macro_rules! bail {
 pub mod capture_inputs;
 pub mod capture_run;
 pub mod demo;
+pub mod device_checks;
+pub mod env_files;
 pub mod error;
+pub mod hdr_files;
 pub mod igi;
 pub mod outdoor_files;
 pub mod partial_file;
+pub mod photo_import;
+pub mod plan_check;
 pub mod process;
 pub mod progress;
 pub mod report_summary;
 pub mod run;
 pub mod scan_processor;
 pub mod scene_render;
+pub mod site;
 pub mod sky_files;
 pub mod sky_series;
 pub mod station_run;
+pub mod station_status;
+pub mod sun_files;
 pub mod verdicts;
 
 pub use error::{Error, Result};

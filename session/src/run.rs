@@ -3,6 +3,7 @@
 //! products and its report page. What the run measured comes back for the
 //! caller to print; the verdicts for it to write (`quality.json`) and act on.
 
+use std::io::Write;
 use std::path::PathBuf;
 
 use anyhow::Context;
@@ -294,5 +295,156 @@ impl SkyRun {
         } else {
             Error::Work(anyhow::anyhow!(message))
         })
+    }
+}
+
+impl RoomRun {
+    /// Writes the run to `out`: the materials and files (as `campanile
+    /// igi`), then the stages' seconds; the scene file's warnings to `err`.
+    pub fn write_lines(&self, opts: &ProcessOptions, out: &mut dyn Write, err: &mut dyn Write) -> Result<()> {
+        for w in &self.products.recovered.loaded.warnings {
+            writeln!(err, "warning: {w}")?;
+        }
+        crate::igi::write_summary(&self.products.recovered, &self.written, out)?;
+        writeln!(
+            out,
+            "processed {} → {} (scene file {})",
+            opts.session.display(),
+            opts.out.display(),
+            self.products.scene_file.display()
+        )?;
+        for (stage, s) in self
+            .processed
+            .summary
+            .stage_seconds
+            .iter()
+            .chain(&self.products.seconds)
+        {
+            writeln!(out, "  {stage:<44} {s:>7.2} s")?;
+        }
+        Ok(())
+    }
+}
+
+impl OutdoorRun {
+    /// Writes the run to `out`: the held-out views' errors, the stages'
+    /// seconds, and per occurrence the sun, the sky and any notes.
+    pub fn write_lines(&self, opts: &ProcessOptions, out: &mut dyn Write) -> Result<()> {
+        for v in self.outdoor.iter().flat_map(|o| &o.products.held_out) {
+            writeln!(
+                out,
+                "  held out {:<32} relative RMSE {:.2}% per pixel, {:.2}% per 4×4 block ({} training photos' texture; grid alone {:.2}%)",
+                v.label,
+                100.0 * v.rmse_pixel,
+                100.0 * v.rmse_block,
+                v.references,
+                100.0 * v.rmse_block_grid
+            )?;
+        }
+        writeln!(out, "processed {} → {}", opts.session.display(), opts.out.display())?;
+        for (stage, s) in &self.processed.summary.stage_seconds {
+            writeln!(out, "  {stage:<28} {s:>7.2} s")?;
+        }
+        for o in &self.processed.summary.occurrences {
+            let sky = o.sky.as_ref().map_or("no sky".to_owned(), |s| {
+                format!(
+                    "sky {} (rms {:.1}%)",
+                    s.channels[1].chosen,
+                    100.0 * s.channels.iter().map(|c| c.rms_relative).fold(0.0, f64::max)
+                )
+            });
+            let sun = o.sun_irradiance.map_or("no sun".to_owned(), |e| {
+                format!("sun {:.0}/{:.0}/{:.0} W·m⁻²", e[0], e[1], e[2])
+            });
+            writeln!(out, "  {:<28} {sun}; {sky}", o.occurrence)?;
+            for n in &o.notes {
+                writeln!(out, "    note: {n}")?;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl SkyRun {
+    /// Writes the run to `out`: what was processed or merged, each day's
+    /// extinction β and how many scans are flagged; the scans that failed
+    /// to `err`.
+    pub fn write_lines(&self, opts: &ProcessOptions, out: &mut dyn Write, err: &mut dyn Write) -> Result<()> {
+        let dir = &opts.out;
+        match &self.work {
+            SkyWork::Scan(occurrence, scan) => writeln!(
+                out,
+                "processed {occurrence} → {}: flags [{}]",
+                campanile_process::sky_series::scan_path(dir, occurrence).display(),
+                scan.quality.names()
+            )?,
+            SkyWork::Merged(dirs, copied) => writeln!(
+                out,
+                "merged {dirs} shard directories ({copied} scan files copied): {} scans in {}",
+                self.series.scans.len(),
+                dir.display()
+            )?,
+            SkyWork::New(run) => {
+                let rate = if run.scan_seconds > 0.0 {
+                    run.processed.len() as f64 / run.scan_seconds
+                } else {
+                    0.0
+                };
+                writeln!(
+                    out,
+                    "sky series {} → {}{}",
+                    opts.session.display(),
+                    dir.display(),
+                    opts.shard.map_or(String::new(), |s| format!(" (shard {s})"))
+                )?;
+                writeln!(
+                    out,
+                    "  processed {} scans in {:.2} s ({rate:.2} scans/s); {} already done, {} in other shards, {} still being captured",
+                    run.processed.len(),
+                    run.scan_seconds,
+                    run.already_done,
+                    run.other_shards,
+                    run.incomplete.len()
+                )?;
+                writeln!(out, "  response: {}", run.response)?;
+            }
+        }
+        for d in &self.series.days {
+            let beta: Vec<String> = d
+                .fit
+                .iter()
+                .map(|f| {
+                    f.as_ref()
+                        .map_or_else(|e| format!("none ({e})"), |e| format!("{:.4}", e.beta))
+                })
+                .collect();
+            writeln!(
+                out,
+                "  {}: β r/g/b {} from {} scans ({} left out)",
+                d.date,
+                beta.join(" / "),
+                d.points.len(),
+                d.left_out
+            )?;
+        }
+        let flagged = self
+            .series
+            .scans
+            .iter()
+            .filter(|s| !s.quality.names().is_empty())
+            .count();
+        writeln!(
+            out,
+            "  {} scans in the series, {flagged} flagged",
+            self.series.scans.len()
+        )?;
+        if self.failure().is_some()
+            && let SkyWork::New(run) = &self.work
+        {
+            for (occ, why) in &run.failed {
+                writeln!(err, "  failed {occ}: {why}")?;
+            }
+        }
+        Ok(())
     }
 }

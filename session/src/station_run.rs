@@ -3,8 +3,9 @@
 //! (with device outages injected) or on the real devices, each settled
 //! scan handed to a [`ScanHook`].
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use campanile_capture::clock::SystemClock;
@@ -12,13 +13,17 @@ use campanile_capture::controller::NoProgress;
 use campanile_capture::station::{SerialOpener, StationOptions as RigOptions, StationRig, check_ports, open_camera};
 use campanile_capture::store::{JournalEntry, SessionReader};
 use campanile_capture::unattended::day_rollover::existing_days;
-use campanile_capture::unattended::{self, ScanHook, StationInputs, StationOptions, StationReport, StopHandle};
+use campanile_capture::unattended::{
+    self, NoProcessing, ScanHook, StationEnd, StationInputs, StationOptions, StationReport, StopHandle,
+};
+use campanile_process::quality::Quality;
 use campanile_sim::faults::{Device, FaultPlan, Outage};
 use campanile_sim::station::{SimOptions, SimStation};
 use chrono::{DateTime, TimeDelta, Utc};
 
-use crate::Result;
 use crate::capture_inputs::{Inputs, SimulatedWorld, simulated_world};
+use crate::scan_processor::{SkySeriesProcessor, StationHook};
+use crate::{Error, Result};
 
 /// A device outage at a station time.
 #[derive(Debug, Clone, Copy)]
@@ -178,4 +183,107 @@ pub fn run_real(
         )
         .await)
     })
+}
+
+/// The station's run as `campanile station run` makes it: on the simulated
+/// station or the real one, stopping at the next frame boundary on SIGTERM
+/// or SIGINT, each scan processed into the sky series when `response` is
+/// given (with the plan's thresholds). The summary goes to `out`; a run
+/// that stopped on a failure writes it and how to go on to `err` and
+/// returns `Ok(false)`.
+pub fn run_station(
+    run: &StationRun,
+    inputs: &Inputs,
+    response: Option<&Path>,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<bool> {
+    if !inputs.station.uses_simulation() && !run.outages.is_empty() {
+        return Err(Error::input(format!(
+            "--sim-outage is for simulated stations; station {:?} ({}) has real devices",
+            inputs.station.name, inputs.station_label
+        )));
+    }
+    let wall = Instant::now();
+    let thresholds: Quality = inputs.plan.plan.value.quality.clone().unwrap_or_default();
+    let mut hook: Box<dyn ScanHook> = match response {
+        Some(response) => Box::new(StationHook(SkySeriesProcessor {
+            response: response.to_path_buf(),
+            thresholds,
+        })),
+        None => Box::new(NoProcessing),
+    };
+    let result = if inputs.station.uses_simulation() {
+        run_simulated(run, inputs, hook.as_mut(), &stop_on_signals)
+    } else {
+        run_real(run, inputs, hook.as_mut(), &stop_on_signals)
+    }?;
+    match result {
+        Ok(report) => {
+            write_summary(&run.store, &report, wall.elapsed(), out)?;
+            Ok(true)
+        }
+        Err(failure) => {
+            write_summary(&run.store, &failure.report, wall.elapsed(), out)?;
+            writeln!(err, "error: {:#}", anyhow::Error::new(failure.error))?;
+            writeln!(err, "continue with the same command once it is fixed")?;
+            Ok(false)
+        }
+    }
+}
+
+/// Requests a stop at the next frame boundary on SIGTERM or SIGINT.
+fn stop_on_signals(stop: &StopHandle) -> anyhow::Result<()> {
+    use tokio::signal::unix::{SignalKind, signal};
+    let mut term = signal(SignalKind::terminate()).context("listening for SIGTERM")?;
+    let mut int = signal(SignalKind::interrupt()).context("listening for SIGINT")?;
+    let stop = stop.clone();
+    tokio::spawn(async move {
+        tokio::select! {
+            _ = term.recv() => tracing::warn!("SIGTERM: stopping at the next frame boundary"),
+            _ = int.recv() => tracing::warn!("SIGINT: stopping at the next frame boundary"),
+        }
+        stop.request();
+    });
+    Ok(())
+}
+
+/// The run's summary: how it ended, its day sessions, scans, frames,
+/// outages, pruning and wall time.
+pub fn write_summary(store: &Path, r: &StationReport, wall: Duration, out: &mut dyn Write) -> Result<()> {
+    writeln!(out, "store {}", store.display())?;
+    let ended = match r.end {
+        StationEnd::Finished => "every occurrence of the plan's days is settled",
+        StationEnd::Stopped => "stopped on request (run the same command to continue)",
+    };
+    writeln!(out, "  ended                {ended}")?;
+    let days: Vec<String> = r.days.iter().map(|d| d.to_string()).collect();
+    writeln!(out, "  day sessions         {}", days.join(", "))?;
+    writeln!(
+        out,
+        "  scans                {} run, {} settled earlier",
+        r.occurrences_run, r.occurrences_skipped
+    )?;
+    writeln!(
+        out,
+        "  this run             {} frames, {} missed, {} missed in outages, {} metering captures",
+        r.frames, r.missed, r.missed_in_outages, r.metering_captures
+    )?;
+    for o in &r.outages {
+        writeln!(
+            out,
+            "  outage               {} from {} to {} ({:.1} min)",
+            o.device,
+            o.start.format("%Y-%m-%d %H:%M:%S UTC"),
+            o.end.format("%Y-%m-%d %H:%M:%S UTC"),
+            (o.end - o.start).num_seconds() as f64 / 60.0
+        )?;
+    }
+    writeln!(
+        out,
+        "  pruned               {} frames, {} bytes",
+        r.pruned_frames, r.pruned_bytes
+    )?;
+    writeln!(out, "  wall time            {:.1} s", wall.as_secs_f64())?;
+    Ok(())
 }

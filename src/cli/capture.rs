@@ -1,26 +1,17 @@
 //! `campanile capture`: run a plan on a station into a session directory,
 //! or resume one after a crash.
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-use anyhow::{Context, Result, bail};
-use campanile_capture::controller::{Progress, ShotOutcome};
-use campanile_capture::schedule::{Occurrence, PlannedShot};
-use campanile_capture::station::{check_ports, open_camera};
-use campanile_capture::store::SessionStore;
-use campanile_capture::store::fault::QuotaStorage;
-use campanile_capture::store::{FsStorage, Storage};
-use campanile_config::camera::CameraDriver;
+use anyhow::Result;
 use campanile_firmware_link::link::soak::PROVEN_FAULT_CHANCE;
 use campanile_sim::faults::{Device, Outage};
 use clap::Args;
-use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
+use super::{EXIT_FAILURE, EXIT_OK};
 use campanile_session::capture_inputs::Inputs;
-use campanile_session::capture_run::{SimFaults, Tally, run_real, run_simulated, tally};
+use campanile_session::capture_run::{self, CaptureRequest, SimFaults};
 
 /// Run a plan on a station and store every frame in a session directory.
 ///
@@ -160,240 +151,30 @@ impl std::str::FromStr for OutageArg {
     }
 }
 
+/// Runs `capture`: 0 when every promised frame is stored, 1 when some
+/// were missed or the run stopped, 2 for bad input.
 pub fn run(args: CaptureArgs) -> Result<u8> {
-    let inputs = match Inputs::load(
+    let inputs = Inputs::load(
         args.resume.as_deref(),
         args.plan.as_deref(),
         args.station.as_deref(),
         args.days,
-    ) {
-        Ok(i) => i,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            return Ok(EXIT_USAGE);
-        }
+    )
+    .map_err(|e| campanile_session::Error::input(format!("{e:#}")))?;
+    let request = CaptureRequest {
+        out: args.out,
+        resume: args.resume,
+        sim: SimFaults {
+            samples: args.sim_samples,
+            bounces: args.sim_bounces,
+            drop_chance: args.sim_drop_chance,
+            corrupt_chance: args.sim_corrupt_chance,
+            camera_timeout_chance: args.sim_camera_timeout_chance,
+            camera_error_chance: args.sim_camera_error_chance,
+            outages: args.sim_outage.iter().map(|o| o.0).collect(),
+        },
+        disk_quota: args.sim_disk_quota,
     };
-    let sim_flags = args.sim_drop_chance.is_some()
-        || args.sim_corrupt_chance.is_some()
-        || args.sim_camera_timeout_chance.is_some()
-        || args.sim_camera_error_chance.is_some()
-        || !args.sim_outage.is_empty()
-        || args.sim_disk_quota.is_some();
-    if !inputs.station.uses_simulation() && sim_flags {
-        eprintln!(
-            "error: the --sim-* fault flags are for simulated stations; station {:?} ({}) has real devices",
-            inputs.station.name, inputs.station_label
-        );
-        return Ok(EXIT_USAGE);
-    }
-    Ok(if capture(&args, &inputs)? {
-        EXIT_OK
-    } else {
-        EXIT_FAILURE
-    })
-}
-
-/// Progress bars: the session, and the current occurrence's step.
-struct Bars {
-    session: ProgressBar,
-    step: ProgressBar,
-    _multi: MultiProgress,
-}
-
-impl Bars {
-    fn new(promised: usize) -> Self {
-        let target = if std::io::stderr().is_terminal() {
-            ProgressDrawTarget::stderr()
-        } else {
-            ProgressDrawTarget::hidden()
-        };
-        let multi = MultiProgress::with_draw_target(target);
-        let style = ProgressStyle::with_template("{prefix:>24} [{bar:40}] {pos}/{len} {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> ");
-        let session = multi.add(ProgressBar::new(promised as u64).with_style(style.clone()));
-        session.set_prefix("session");
-        let step = multi.add(ProgressBar::new(0).with_style(style));
-        Self {
-            session,
-            step,
-            _multi: multi,
-        }
-    }
-}
-
-impl Progress for Bars {
-    fn occurrence(&mut self, occurrence: &Occurrence) {
-        self.session.set_message(occurrence.key.clone());
-    }
-
-    fn step(&mut self, occurrence: &Occurrence, step: usize, kind: &str, shots: usize) {
-        self.step.reset();
-        self.step.set_length(shots as u64);
-        self.step.set_prefix(format!("{} s{step} {kind}", occurrence.name));
-    }
-
-    fn shot(&mut self, shot: &PlannedShot, outcome: ShotOutcome) {
-        self.step.inc(1);
-        if shot.promised && outcome != ShotOutcome::NotNeeded {
-            self.session.inc(1);
-        }
-    }
-}
-
-fn capture(args: &CaptureArgs, inputs: &Inputs) -> Result<bool> {
-    let dir = args
-        .out
-        .as_ref()
-        .or(args.resume.as_ref())
-        .context("give --out DIR or --resume DIR")?;
-    if !inputs.station.uses_simulation() {
-        // Before any session directory is made: the ports are real and
-        // distinct, and this build has the camera's driver.
-        check_ports(&inputs.station).with_context(|| format!("station {}", inputs.station_label))?;
-        let driver = inputs.station.camera.driver;
-        let built = match driver {
-            CameraDriver::V4l => cfg!(feature = "v4l"),
-            CameraDriver::Nokhwa => cfg!(feature = "nokhwa"),
-            CameraDriver::Sim => true,
-        };
-        if !built {
-            let why = open_camera(&inputs.station.camera)
-                .err()
-                .map(|e| e.to_string())
-                .unwrap_or_default();
-            bail!("opening the camera of station {}: {why}", inputs.station_label);
-        }
-    }
-    match args.sim_disk_quota {
-        Some(quota) => {
-            if inputs.station.uses_simulation() {
-                // The quota counts what is already in the directory (none
-                // if absent: the session store creates it).
-                let storage = QuotaStorage::open(FsStorage, dir, quota)
-                    .with_context(|| format!("measuring {} for the disk quota", dir.display()))?;
-                capture_into(args, inputs, storage)
-            } else {
-                bail!("--sim-disk-quota is for simulated stations")
-            }
-        }
-        None => capture_into(args, inputs, FsStorage),
-    }
-}
-
-/// The `--sim-*` options of `args`.
-fn sim_faults(args: &CaptureArgs) -> SimFaults {
-    SimFaults {
-        samples: args.sim_samples,
-        bounces: args.sim_bounces,
-        drop_chance: args.sim_drop_chance,
-        corrupt_chance: args.sim_corrupt_chance,
-        camera_timeout_chance: args.sim_camera_timeout_chance,
-        camera_error_chance: args.sim_camera_error_chance,
-        outages: args.sim_outage.iter().map(|o| o.0).collect(),
-    }
-}
-
-/// Open the session (new or resumed) on `storage`, run the timeline on
-/// the station's devices, and report.
-fn capture_into<S: Storage>(args: &CaptureArgs, inputs: &Inputs, storage: S) -> Result<bool> {
-    let (mut store, resumed) = match (&args.out, &args.resume) {
-        (Some(dir), _) => (
-            SessionStore::create_with(storage, dir, inputs.snapshot.clone())
-                .with_context(|| format!("creating the session in {}", dir.display()))?,
-            false,
-        ),
-        (None, Some(dir)) => {
-            let (store, report) = SessionStore::resume_with(storage, dir)
-                .with_context(|| format!("resuming the session in {}", dir.display()))?;
-            if store.snapshot().plan_ron != inputs.snapshot.plan_ron
-                || store.snapshot().station_ron != inputs.snapshot.station_ron
-            {
-                bail!(
-                    "{} began with another plan or station than {} and {}; resume with `campanile capture --resume {}` alone to use its own plan.ron and station.ron",
-                    dir.display(),
-                    inputs.plan_label,
-                    inputs.station_label,
-                    dir.display()
-                );
-            }
-            // The repairs themselves, not "see the log": -q hides the log.
-            let repairs: String = report.repairs().iter().map(|r| format!("\n  repaired: {r}")).collect();
-            eprintln!(
-                "resuming {}{}: {} frames and {} missed shots journaled{repairs}",
-                dir.display(),
-                if inputs.from_session {
-                    " with its own plan.ron and station.ron"
-                } else {
-                    ""
-                },
-                report.frames,
-                report.missed,
-            );
-            tracing::info!(%report, "resumed");
-            (store, true)
-        }
-        (None, None) => bail!("give --out DIR or --resume DIR"),
-    };
-    if inputs.timeline.occurrences.is_empty() {
-        outln!("the plan has no occurrences: nothing to capture")?;
-        return Ok(true);
-    }
-    let promised = inputs.timeline.frames_promised();
-    let mut bars = Bars::new(promised);
-    let wall = Instant::now();
-    let started = if inputs.station.uses_simulation() {
-        run_simulated(&sim_faults(args), inputs, &mut store, resumed, &mut bars)
-    } else {
-        run_real(inputs, &mut store, &mut bars)
-    };
-    let result = match started {
-        Ok(r) => r,
-        Err(e) => {
-            // A run that could not start leaves no new session behind.
-            let dir = store.dir().to_path_buf();
-            if let Err(d) = store.discard_unused() {
-                tracing::warn!(dir = %dir.display(), error = %d, "could not remove the unused session");
-            }
-            return Err(e.into());
-        }
-    };
-    bars.session.finish_and_clear();
-    bars.step.finish_and_clear();
-    let elapsed = wall.elapsed();
-    let (report, stopped) = match result {
-        Ok(r) => (r, None),
-        Err(e) => (*e.report.clone(), Some(e)),
-    };
-    let Tally {
-        stored,
-        late,
-        extra,
-        missed,
-    } = tally(inputs, &store);
-    outln!("session {}", store.dir().display())?;
-    outln!("  frames promised      {promised}")?;
-    outln!("  frames stored        {stored} (of which late: {late})")?;
-    outln!("  auto-bracket extras  {extra}")?;
-    outln!("  shots missed         {missed}")?;
-    outln!(
-        "  this run             {} frames, {} missed, {} retries, {} reconnects, {} metering captures, {} sun retakes",
-        report.frames,
-        report.missed,
-        report.retries,
-        report.reconnects,
-        report.metering_captures,
-        report.saturation_retakes
-    )?;
-    outln!("  wall time            {}", seconds(elapsed))?;
-    if let Some(e) = stopped {
-        eprintln!("error: {e:#}");
-        eprintln!("resume with: campanile capture --resume {}", store.dir().display());
-        return Ok(false);
-    }
-    Ok(stored == promised && missed == 0)
-}
-
-fn seconds(d: Duration) -> String {
-    format!("{:.1} s", d.as_secs_f64())
+    let complete = capture_run::capture(&request, &inputs, &mut std::io::stdout(), &mut std::io::stderr())?;
+    Ok(if complete { EXIT_OK } else { EXIT_FAILURE })
 }

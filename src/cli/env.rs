@@ -1,13 +1,10 @@
 //! `campanile env`: fit environment region models, and predict regions
 //! under new light.
 
-use std::fs::File;
-use std::io::{BufReader, Write};
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use campanile_process::environment::{EnvironmentFile, RegionRecord, fit_region, read_observations};
-use campanile_process::quality::{QualityReport, gates};
+use campanile_session::env_files;
 use clap::Subcommand;
 
 use super::sky::SunArgs;
@@ -85,26 +82,8 @@ pub fn run(cmd: EnvCommand) -> Result<()> {
             thresholds,
         } => {
             let q = super::verdicts::thresholds(thresholds.as_deref(), None)?;
-            let file = File::open(&observations).with_context(|| format!("{}: cannot open", observations.display()))?;
-            let groups =
-                read_observations(BufReader::new(file)).with_context(|| format!("{}", observations.display()))?;
-            let mut regions = Vec::new();
-            for (label, obs) in &groups {
-                let fit = fit_region(obs).with_context(|| format!("{}: region {label}", observations.display()))?;
-                tracing::info!(region = %label, model = ?fit.kind, rms = fit.rms_relative, "{}", fit.reason);
-                regions.push(RegionRecord {
-                    region: label.clone(),
-                    fit,
-                });
-            }
-            let quality = QualityReport::new(
-                regions
-                    .iter()
-                    .map(|r| gates::environment_region(&r.region, &r.fit, &q))
-                    .collect(),
-                &q,
-            );
-            super::ron_output::write_ron(&EnvironmentFile { regions }, out.as_deref())?;
+            let (models, quality) = env_files::fit(&observations, &q)?;
+            super::ron_output::write_ron(&models, out.as_deref())?;
             match &out {
                 Some(path) => super::verdicts::finish(&quality, &super::verdicts::beside(path)),
                 None => super::verdicts::finish_on_stderr(&quality),
@@ -118,19 +97,14 @@ pub fn run(cmd: EnvCommand) -> Result<()> {
         } => {
             let e_sky = rgb("sky-irradiance", &sky_irradiance)?;
             let e_sun = rgb("sun-irradiance", &sun_irradiance)?;
-            let (z, a) = sun.resolve_any()?;
-            let l = campanile_process::sky::direction(z, a);
-            let text =
-                std::fs::read_to_string(&models).with_context(|| format!("{}: cannot read", models.display()))?;
-            let env: EnvironmentFile = ron::from_str(&text)
-                .map_err(|e| anyhow::anyhow!("{}:{}: {}", models.display(), e.span.start, e.code))?;
-            let mut o = std::io::stdout().lock();
-            writeln!(o, "region,r,g,b")?;
-            for r in &env.regions {
-                let v = r.fit.radiance(e_sky, e_sun, l);
-                writeln!(o, "{},{:.9e},{:.9e},{:.9e}", r.region, v[0], v[1], v[2])?;
-            }
-            Ok(())
+            let sun = sun.given().resolve_any()?;
+            Ok(env_files::predict(
+                &models,
+                e_sky,
+                e_sun,
+                sun,
+                &mut std::io::stdout().lock(),
+            )?)
         }
     }
 }

@@ -43,16 +43,7 @@ pub fn is_bad_input(cause: &(dyn std::error::Error + 'static)) -> bool {
     campanile_session::error::is_bad_input(cause)
 }
 
-/// A number as an error message shows it: the shortest text that reads
-/// back as `x`, in scientific notation when huge or tiny (`1e308`, not
-/// 309 digits).
-pub fn shown(x: f64) -> String {
-    if x != 0.0 && x.is_finite() && !(1e-4..1e15).contains(&x.abs()) {
-        format!("{x:e}")
-    } else {
-        format!("{x}")
-    }
-}
+pub use campanile_session::error::shown;
 
 #[cfg(test)]
 mod tests {

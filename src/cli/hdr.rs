@@ -1,40 +1,19 @@
 //! `campanile hdr calibrate|merge|lens`: camera response recovery, HDR
-//! merging and lens calibration on plain files. The science lives in
-//! `campanile_process::hdr`; this module parses arguments, reads and writes
-//! files, and maps errors to exit codes.
+//! merging and lens calibration on plain files. The work is
+//! `campanile_session::hdr_files` (the science `campanile_process::hdr`);
+//! this module parses arguments.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::{Context, Result, anyhow};
-use campanile_process::camera::image::max_code;
-use campanile_process::exr_io::{ExrPrecision, read_rgb_exr, write_radiance_exr, write_rgb_exr};
-use campanile_process::hdr::HdrError;
-use campanile_process::hdr::bracket::Bracket;
-use campanile_process::hdr::bracket_files::BracketFiles;
-use campanile_process::hdr::bracket_list::{
-    FrameRecord, TimeSource, load_bracket_files, parse_time_s, read_bracket_list,
+use anyhow::Result;
+use campanile_process::hdr::debevec::DEFAULT_LAMBDA;
+use campanile_process::hdr::merge::NoiseModel;
+use campanile_session::hdr_files::{
+    self, BracketSource, CalibrateOptions, LensRequest, MapFormat, MergeRequest, RawColor, ResponseMethod,
 };
-use campanile_process::hdr::curve::ResponseCurve;
-use campanile_process::hdr::curve_plot::curve_plot_svg;
-use campanile_process::hdr::debevec::{DEFAULT_LAMBDA, DebevecOptions, Smoothness, calibrate_debevec};
-use campanile_process::hdr::deghost::{DeghostOptions, merge_deghosted};
-use campanile_process::hdr::exposure_codes::ExposureCodes;
-use campanile_process::hdr::lens::{LensModel, fit_distortion, fit_falloff, undistort_map};
-use campanile_process::hdr::merge::{MergeOptions, NoiseModel, RadianceMap, merge};
-use campanile_process::hdr::merge_stream::merge_files;
-use campanile_process::hdr::robertson::{RobertsonOptions, calibrate_robertson};
-use campanile_process::hdr::sampled_bracket::SampledBracket;
-use campanile_process::hdr::sampling::SampleOptions;
-use campanile_process::hdr::white_point::WhitePoint;
-use campanile_process::rgbe_file::write_rgbe;
 use clap::{Args, Subcommand, ValueEnum};
 
-mod align;
-mod raw;
-
 use super::verdicts;
-use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
-use campanile_process::quality::{ProductQuality, Quality, QualityReport, gates};
 
 #[derive(Debug, Subcommand)]
 pub enum HdrCommand {
@@ -175,8 +154,8 @@ pub struct MergeArgs {
     curve: Option<PathBuf>,
     /// Colour space of a merged RAW bracket (camera: the sensor's own
     /// channels, as everywhere in the project).
-    #[arg(long, value_enum, default_value_t = raw::RawColor::Camera)]
-    raw_color: raw::RawColor,
+    #[arg(long, value_enum, default_value_t = RawColorArg::Camera)]
+    raw_color: RawColorArg,
     /// Output radiance map: .exr (OpenEXR) or .hdr (Radiance RGBE).
     #[arg(long, short)]
     out: PathBuf,
@@ -245,409 +224,85 @@ pub struct LensArgs {
     out: PathBuf,
 }
 
-/// Runs an `hdr` subcommand; returns the exit code (0 ok, 1 failure, 2 bad input or usage, 3 a failed product).
-pub fn run(cmd: HdrCommand) -> u8 {
-    let result = match cmd {
-        HdrCommand::Calibrate(a) => calibrate(&a),
-        HdrCommand::Merge(a) => merge_cmd(&a),
-        HdrCommand::Lens(a) => lens(&a),
-    };
-    match result {
-        Ok(()) => EXIT_OK,
-        Err(e) if super::output::is_broken_pipe(&e) => EXIT_OK,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            exit_code(&e)
-        }
-    }
+/// Colour space of a merged RAW bracket.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RawColorArg {
+    /// The camera's own channels, no white balance (radiance per camera channel).
+    Camera,
+    /// White-balanced linear sRGB through the file's colour matrix.
+    Srgb,
+    /// White-balanced CIE XYZ (D65).
+    Xyz,
 }
 
-/// 2 for problems with the input (files, values, options), 3 for a
-/// product that failed its quality gate, 1 for failures while working.
-fn exit_code(e: &anyhow::Error) -> u8 {
-    let code = super::exit::code_of(e);
-    if code != EXIT_FAILURE {
-        return code;
-    }
-    match e.chain().find_map(|c| c.downcast_ref::<HdrError>()) {
-        Some(HdrError::Singular { .. }) => EXIT_FAILURE,
-        Some(HdrError::Io { .. } | HdrError::Exr { .. }) if is_output_error(e) => EXIT_FAILURE,
-        Some(_) => EXIT_USAGE,
-        None if is_output_error(e) => EXIT_FAILURE,
-        None => EXIT_USAGE,
-    }
-}
-
-fn is_output_error(e: &anyhow::Error) -> bool {
-    e.chain().any(|c| c.to_string().starts_with("writing "))
-}
-
-/// The bracket's files and the times given for them (`None`: from EXIF).
-fn paths_and_times(args: &BracketArgs) -> Result<(Vec<PathBuf>, Option<Vec<f64>>)> {
-    match &args.list {
-        Some(list) => {
-            let (p, t) = read_bracket_list(list).with_context(|| format!("reading bracket list {}", list.display()))?;
-            Ok((p, Some(t)))
-        }
-        None => {
-            if args.images.is_empty() {
-                return Err(anyhow!(
-                    "no images: give IMAGE… (times from EXIF or --times T,…) or --list FILE"
-                ));
-            }
-            let times = args
-                .times
-                .iter()
-                .map(|t| {
-                    parse_time_s(t)
-                        .ok_or_else(|| anyhow!("--times: '{t}' is not a time in seconds > 0 (e.g. 0.033 or 1/30)"))
-                })
-                .collect::<Result<Vec<_>>>()?;
-            Ok((args.images.clone(), (!times.is_empty()).then_some(times)))
-        }
-    }
-}
-
-/// The bracket's files with their times, sorted, to be read one frame at a time.
-fn open_files(args: &BracketArgs) -> Result<BracketFiles> {
-    let (paths, times) = paths_and_times(args)?;
-    let files = BracketFiles::open(&paths, times.as_deref()).context("reading the bracket")?;
-    report_exif(files.records())?;
-    Ok(files)
-}
-
-/// The whole bracket in memory (for alignment and deghosting, which look
-/// at every frame at once).
-fn load(args: &BracketArgs) -> Result<Bracket> {
-    let (paths, times) = paths_and_times(args)?;
-    let (bracket, frames) = load_bracket_files(&paths, times.as_deref()).context("reading the bracket")?;
-    report_exif(&frames)?;
-    let labels: Vec<&str> = bracket.images().iter().map(|im| im.label.as_str()).collect();
-    report_white_points(&labels, bracket.white_points(), bracket.images()[0].max_code())?;
-    Ok(bracket)
-}
-
-/// Reads `files` one frame at a time into `visit`, with a progress bar.
-fn scan<T>(files: &BracketFiles, what: &str, visit: impl FnOnce(&dyn Fn(usize)) -> Result<T, HdrError>) -> Result<T> {
-    let bar = campanile_session::progress::bar(files.len() as u64, what);
-    let out = visit(&|k| bar.set_position(k as u64));
-    bar.finish_and_clear();
-    Ok(out?)
-}
-
-/// One line per frame whose time came from EXIF: its time and where from.
-fn report_exif(frames: &[FrameRecord]) -> Result<()> {
-    for f in frames.iter().filter(|f| f.source == TimeSource::Exif) {
-        let m = &f.metadata;
-        let mut what = vec![format!("{} s", m.exposure_time_s.map_or_else(String::new, shutter))];
-        if let Some(n) = m.f_number {
-            what.push(format!("f/{n}"));
-        }
-        if let Some(iso) = m.iso {
-            what.push(format!("ISO {iso}"));
-        }
-        outln!(
-            "{}: EXIF {}{} → exposure {:.6} s",
-            f.path.display(),
-            what.join(", "),
-            m.camera.as_deref().map_or_else(String::new, |c| format!(" ({c})")),
-            f.time_s
-        )?;
-    }
-    Ok(())
-}
-
-/// One line per white point found below the largest code (frames by
-/// ascending exposure, labelled).
-fn report_white_points(labels: &[&str], white: &[[Option<WhitePoint>; 3]], max_code: u16) -> Result<()> {
-    for (label, wp) in labels.iter().zip(white) {
-        for (c, p) in wp.iter().enumerate() {
-            if let Some(p) = p {
-                outln!(
-                    "{label}: {} piles up at code {} (below the largest, {max_code}): codes ≥ {} treated as clipped ({} pixels)",
-                    ["red", "green", "blue"][c],
-                    p.code,
-                    p.clipped_from,
-                    p.pixels
-                )?;
-            }
-        }
-    }
-    Ok(())
-}
-
-/// The labels of a bracket's files, shortest exposure first.
-fn labels(files: &BracketFiles) -> Vec<String> {
-    files.records().iter().map(|r| r.path.display().to_string()).collect()
-}
-
-/// A time as photographers write it: "1/250" below a second, else decimal.
-fn shutter(t: f64) -> String {
-    if t < 1.0 && (1.0 / t - (1.0 / t).round()).abs() < 1e-3 * (1.0 / t) {
-        format!("1/{}", (1.0 / t).round())
-    } else {
-        format!("{t}")
-    }
-}
-
-fn write(path: &Path, text: &str) -> Result<()> {
-    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
-}
-
-fn calibrate(a: &CalibrateArgs) -> Result<()> {
-    let q = verdicts::thresholds(a.thresholds.as_deref(), None)?;
-    raw::refuse_raw_calibration(&a.bracket)?;
-    let sampling = SampleOptions {
-        samples: a.samples,
-        seed: a.seed,
-        ..Default::default()
-    };
-    let (curve, method, quality) = if a.align {
-        let bracket = align::aligned(&load(&a.bracket)?)?;
-        recover(&bracket, a, sampling, &q)?
-    } else {
-        // One frame at a time, keeping the pixels sampling looks at.
-        let files = open_files(&a.bracket)?;
-        let (sampled, white) = scan(&files, "reading frames", |p| SampledBracket::read(&files, &sampling, p))
-            .context("reading the bracket")?;
-        let labels = labels(&files);
-        let labels: Vec<&str> = labels.iter().map(String::as_str).collect();
-        report_white_points(&labels, &white, sampled.max_code())?;
-        recover(&sampled, a, sampling, &q)?
-    };
-    write(&a.out, &curve.to_csv(&method))?;
-    let plot = a.plot.clone().unwrap_or_else(|| a.out.with_extension("svg"));
-    let svg = curve_plot_svg(&curve, &format!("Response curve ({method})")).context("plotting the curve")?;
-    write(&plot, &svg)?;
-    outln!("wrote {} and {}", a.out.display(), plot.display())?;
-    verdicts::finish(&QualityReport::new(vec![quality], &q), &verdicts::beside(&a.out))
-}
-
-/// The response by `a.method` from `bracket`, its method line and verdict.
-fn recover<B: ExposureCodes>(
-    bracket: &B,
-    a: &CalibrateArgs,
-    sampling: SampleOptions,
-    q: &Quality,
-) -> Result<(ResponseCurve, String, ProductQuality)> {
-    Ok(match a.method {
-        Method::Debevec => {
-            let opts = DebevecOptions {
+/// Runs an `hdr` subcommand.
+pub fn run(cmd: HdrCommand) -> Result<()> {
+    let out = &mut std::io::stdout();
+    match cmd {
+        HdrCommand::Calibrate(a) => {
+            let o = CalibrateOptions {
+                bracket: a.bracket.source(),
+                out: a.out,
+                plot: a.plot,
+                method: match a.method {
+                    Method::Debevec => ResponseMethod::Debevec,
+                    Method::Robertson => ResponseMethod::Robertson,
+                },
                 lambda: a.lambda,
-                smoothness: Smoothness::Code,
-                sampling,
-                fit_exposure_times: a.fit_times,
-                ..Default::default()
+                samples: a.samples,
+                seed: a.seed,
+                fit_times: a.fit_times,
+                align: a.align,
+                thresholds: verdicts::thresholds(a.thresholds.as_deref(), None)?,
             };
-            let cal = calibrate_debevec(bracket, &opts).context("recovering the response (Debevec–Malik)")?;
-            for (c, d) in cal.channels.iter().enumerate() {
-                outln!(
-                    "channel {}: {} samples, {} observations, residual RMS {:.4}, {} nodes made monotone, \
-                     condition ≈ {:.1e}, dark-end bias correction up to {:.3}",
-                    ["R", "G", "B"][c],
-                    d.samples,
-                    d.observations,
-                    d.residual_rms,
-                    d.monotone_adjustments,
-                    d.condition_estimate,
-                    d.noise_bias.max_correction
-                )?;
-            }
-            if a.fit_times {
-                for (label, fitted) in bracket.times_s().iter().zip(&cal.times_s) {
-                    outln!(
-                        "exposure labelled {label} s: fitted {fitted:.6} s ({:+.2} %)",
-                        100.0 * (fitted / label - 1.0)
-                    )?;
-                }
-            }
-            let quality = gates::response(&cal, bracket.exposures(), bracket.exposures(), q);
-            (cal.curve, cal.method, quality)
+            let report = hdr_files::calibrate(&o, out)?;
+            verdicts::finish(&report, &verdicts::beside(&o.out))
         }
-        Method::Robertson => {
-            let opts = RobertsonOptions {
-                sampling,
-                ..Default::default()
+        HdrCommand::Merge(a) => {
+            let o = MergeRequest {
+                bracket: a.bracket.source(),
+                curve: a.curve,
+                raw_color: match a.raw_color {
+                    RawColorArg::Camera => RawColor::Camera,
+                    RawColorArg::Srgb => RawColor::Srgb,
+                    RawColorArg::Xyz => RawColor::Xyz,
+                },
+                out: a.out,
+                format: a.format.map(|f| match f {
+                    OutputFormat::Exr => MapFormat::Exr,
+                    OutputFormat::Hdr => MapFormat::Hdr,
+                }),
+                with_variance: a.with_variance,
+                half: a.half,
+                nd: a.nd,
+                scale: a.scale,
+                lens: a.lens,
+                full_well: a.full_well,
+                read_noise: a.read_noise,
+                align: a.align,
+                deghost: a.deghost,
+                thresholds: verdicts::thresholds(a.thresholds.as_deref(), None)?,
             };
-            let (curve, iters) = calibrate_robertson(bracket, &opts).context("recovering the response (Robertson)")?;
-            outln!("Robertson: {iters:?} iterations (R, G, B)")?;
-            let quality = gates::response_curve(&curve, bracket.exposures(), bracket.exposures(), q);
-            (
-                curve,
-                format!("robertson samples={} seed={}", a.samples, a.seed),
-                quality,
-            )
+            let report = hdr_files::merge_bracket(&o, out)?;
+            verdicts::finish(&report, &verdicts::beside(&o.out))
         }
-    })
-}
-
-fn per_channel(name: &str, v: &[f64]) -> Result<[f64; 3]> {
-    match v {
-        [x] => Ok([*x; 3]),
-        [r, g, b] => Ok([*r, *g, *b]),
-        _ => Err(anyhow!(
-            "--{name}: {} values given: expected one value or three (R,G,B)",
-            v.len()
-        )),
+        HdrCommand::Lens(a) => Ok(hdr_files::fit_lens(
+            &LensRequest {
+                flat: a.flat,
+                pairs: a.pairs,
+                out: a.out,
+            },
+            out,
+        )?),
     }
 }
 
-/// The output format: `--format`, else by OUT's extension; the
-/// OpenEXR-only options refused for Radiance RGBE.
-fn output_format(a: &MergeArgs) -> Result<OutputFormat> {
-    let format = a.format.unwrap_or_else(|| {
-        let hdr = a.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("hdr"));
-        if hdr { OutputFormat::Hdr } else { OutputFormat::Exr }
-    });
-    if format == OutputFormat::Hdr && (a.with_variance || a.half) {
-        return Err(super::exit::bad_input(
-            "--with-variance and --half are OpenEXR options: Radiance RGBE (.hdr) holds colour only",
-        ));
-    }
-    Ok(format)
-}
-
-/// Writes a merged map as `hdr merge`'s options ask.
-fn write_map(a: &MergeArgs, format: OutputFormat, map: &RadianceMap) -> Result<()> {
-    match format {
-        OutputFormat::Hdr => write_rgbe(map, &a.out),
-        OutputFormat::Exr if a.with_variance => write_radiance_exr(map, &a.out),
-        OutputFormat::Exr if a.half => write_rgb_exr(map, &a.out, ExrPrecision::Half),
-        OutputFormat::Exr => write_rgb_exr(map, &a.out, ExrPrecision::Float),
-    }
-    .context("writing the radiance map")
-}
-
-fn merge_cmd(a: &MergeArgs) -> Result<()> {
-    let format = output_format(a)?;
-    if raw::is_raw_bracket(&a.bracket)? {
-        return raw::merge_raw(a, format);
-    }
-    let q = verdicts::thresholds(a.thresholds.as_deref(), None)?;
-    let curve_path = a.curve.as_deref().ok_or_else(|| {
-        super::exit::bad_input(
-            "--curve is required for PNG/TIFF/JPEG brackets (run `campanile hdr calibrate` first); only RAW frames merge without one",
-        )
-    })?;
-    let text =
-        std::fs::read_to_string(curve_path).with_context(|| format!("reading curve {}", curve_path.display()))?;
-    let curve = ResponseCurve::from_csv(&text, curve_path).context("reading the curve")?;
-    let lens = match &a.lens {
-        Some(p) => {
-            let t = std::fs::read_to_string(p).with_context(|| format!("reading lens model {}", p.display()))?;
-            Some(LensModel::from_text(&t, p)?)
+impl BracketArgs {
+    fn source(self) -> BracketSource {
+        BracketSource {
+            images: self.images,
+            times: self.times,
+            list: self.list,
         }
-        None => None,
-    };
-    let opts = MergeOptions {
-        noise: NoiseModel {
-            full_well_electrons: a.full_well,
-            read_noise_electrons: a.read_noise,
-        },
-        nd_transmittance: per_channel("nd", &a.nd)?,
-        radiometric_scale: per_channel("scale", &a.scale)?,
-        falloff: lens.map(|l| l.falloff),
-    };
-    let (mut map, exposures) = if a.align || a.deghost {
-        let mut bracket = load(&a.bracket)?;
-        if a.align {
-            bracket = align::aligned(&bracket)?;
-        }
-        let map = if a.deghost {
-            let (map, stats) =
-                merge_deghosted(&bracket, &curve, &opts, &DeghostOptions::default()).context("merging")?;
-            align::report_deghost(&stats)?;
-            map
-        } else {
-            merge(&bracket, &curve, &opts).context("merging")?
-        };
-        (map, bracket.len())
-    } else {
-        // One frame at a time into per-pixel sums (bounded memory).
-        let files = open_files(&a.bracket)?;
-        let (map, white) =
-            scan(&files, "merging frames", |p| merge_files(&files, &curve, &opts, p)).context("merging")?;
-        let labels = labels(&files);
-        let labels: Vec<&str> = labels.iter().map(String::as_str).collect();
-        report_white_points(&labels, &white, max_code(curve.bits))?;
-        (map, files.len())
-    };
-    if !(a.with_variance || a.align || a.deghost) {
-        // Only the OpenEXR with variance writes it: free it before writing.
-        map.variance = Vec::new();
     }
-    if let Some(l) = lens
-        && (l.distortion.a != 0.0 || l.distortion.b != 0.0)
-    {
-        map = undistort_map(&map, &l.distortion);
-    }
-    write_map(a, format, &map)?;
-    let invalid = map.mask.iter().filter(|&&m| m != 0).count();
-    outln!(
-        "wrote {} ({}×{}, {} exposures; {invalid} pixels clipped in some channel in every exposure)",
-        a.out.display(),
-        map.width,
-        map.height,
-        exposures
-    )?;
-    let name = a
-        .out
-        .file_name()
-        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-    let mut quality = gates::radiance(&name, &map, false, &q);
-    if let Some(curve) = verdicts::of_input(curve_path)? {
-        quality.inherit(&curve);
-    }
-    verdicts::finish(&QualityReport::new(vec![quality], &q), &verdicts::beside(&a.out))
-}
-
-fn lens(a: &LensArgs) -> Result<()> {
-    if a.flat.is_none() && a.pairs.is_none() {
-        return Err(anyhow!("nothing to fit: give --flat FLAT.exr and/or --pairs PAIRS.csv"));
-    }
-    let mut model = LensModel::default();
-    if let Some(flat) = &a.flat {
-        let img = read_rgb_exr(flat).with_context(|| format!("reading flat field {}", flat.display()))?;
-        let (falloff, rms) = fit_falloff(&img).context("fitting the falloff")?;
-        outln!(
-            "falloff: a = {:.6}, b = {:.6} (RMS relative residual {:.4})",
-            falloff.a,
-            falloff.b,
-            rms
-        )?;
-        model.falloff = falloff;
-    }
-    if let Some(pairs) = &a.pairs {
-        let text = std::fs::read_to_string(pairs).with_context(|| format!("reading {}", pairs.display()))?;
-        let mut v = Vec::new();
-        for (i, line) in text.lines().enumerate() {
-            let line = line.trim();
-            if line.is_empty() || line.starts_with('#') || line.starts_with('r') {
-                continue;
-            }
-            let (d, u) = line.split_once(',').ok_or_else(|| {
-                anyhow!(
-                    "{}:{}: '{line}': expected 'r_distorted,r_ideal'",
-                    pairs.display(),
-                    i + 1
-                )
-            })?;
-            let num = |s: &str| {
-                s.trim()
-                    .parse::<f64>()
-                    .map_err(|_| anyhow!("{}:{}: '{}': expected a number", pairs.display(), i + 1, s.trim()))
-            };
-            v.push((num(d)?, num(u)?));
-        }
-        model.distortion = fit_distortion(&v).context("fitting the distortion")?;
-        outln!(
-            "distortion: a = {:.6}, b = {:.6} ({} pairs)",
-            model.distortion.a,
-            model.distortion.b,
-            v.len()
-        )?;
-    }
-    write(&a.out, &model.to_text())?;
-    outln!("wrote {}", a.out.display())?;
-    Ok(())
 }

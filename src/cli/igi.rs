@@ -5,12 +5,11 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, anyhow};
-use campanile_process::igi::IgiLight;
-use campanile_process::igi::scene_file::{WardVariantEntry, load, load_lights};
-use campanile_process::igi::variant_choice::describe;
-use campanile_session::igi::{ModelChoice, Recovered, Written, quality, recover_loaded, write_exr, write_products};
-use campanile_session::progress::bar;
+use anyhow::{Context, Result};
+use campanile_process::igi::scene_file::WardVariantEntry;
+use campanile_session::igi::{
+    ModelChoice, lights_file, quality, recover_scene_with, relight_views, write_products, write_summary,
+};
 use clap::Args;
 
 /// Recover every surface's Ward BRDF and albedo map from a scene file.
@@ -92,83 +91,24 @@ impl VariantArg {
 /// Prints the materials table, the Ward normalization chosen, the
 /// interreflection check, the triangulated lights, the exports refused and
 /// the files written.
-pub fn print_products(r: &Recovered, w: &Written) -> Result<()> {
-    out!("{}", w.table)?;
-    if r.variants.len() > 1 {
-        outln!(
-            "Ward normalization chosen: {}",
-            describe(&r.variants.iter().collect::<Vec<_>>())
-        )?;
-    }
-    outln!("{}", r.result.interreflection.message)?;
-    for (n, t) in &r.loaded.triangulated {
-        outln!(
-            "light {n:?} triangulated from {} images: position ({:.4}, {:.4}, {:.4}) m, radius {:.4} m, intensity {:.3?} W/sr, ray rms {:.2} mm",
-            t.sightings.len(),
-            t.light.position.x,
-            t.light.position.y,
-            t.light.position.z,
-            t.light.radius,
-            t.light.intensity,
-            t.ray_rms_m * 1e3
-        )?;
-    }
-    for why in &w.refused {
-        outln!("{why}")?;
-    }
-    outln!(
-        "wrote {}, materials.json, {}materials.xml (Mitsuba 3), {}, {} albedo maps under {}",
-        w.materials.display(),
-        if w.refused.is_empty() {
-            "materials.rad (RADIANCE), "
-        } else {
-            ""
-        },
-        w.summary.display(),
-        w.albedo.len(),
-        w.materials.with_file_name("albedo").display()
-    )?;
-    Ok(())
-}
-
-/// Loads `scene`, prints its warnings and recovers its materials and
-/// albedo maps (`campanile_session::igi::recover_loaded`).
-pub fn recover_scene(scene: &std::path::Path, quick: bool, choice: ModelChoice) -> Result<Recovered> {
-    let loaded = load(scene)?;
-    for w in &loaded.warnings {
-        eprintln!("warning: {w}");
-    }
-    Ok(recover_loaded(loaded, quick, choice)?)
-}
-
-/// Runs `campanile igi`.
 pub fn run(args: IgiArgs) -> Result<()> {
     let q = super::verdicts::thresholds(args.thresholds.as_deref(), None)?;
     let choice = ModelChoice {
         variant: args.ward_variant.map(VariantArg::entry),
         direct_only: args.direct_only,
     };
-    let r =
-        recover_scene(&args.scene, args.quick, choice).with_context(|| format!("reading {}", args.scene.display()))?;
+    let out = &mut std::io::stdout();
+    let lights = args.relight.as_deref().map(lights_file).transpose()?;
+    let r = recover_scene_with(&args.scene, args.quick, choice)
+        .with_context(|| format!("reading {}", args.scene.display()))?;
+    for w in &r.loaded.warnings {
+        eprintln!("warning: {w}");
+    }
     let quality = quality(&r, &q);
     let written = write_products(&r, &args.out, &quality)?;
-    print_products(&r, &written)?;
-    if let Some(lights) = &args.relight {
-        let lights: Vec<IgiLight> = load_lights(lights)
-            .map_err(|e| anyhow!("{e}"))?
-            .into_iter()
-            .map(|(_, l)| l)
-            .collect();
-        let cameras = r.image_cameras();
-        let bar = bar(cameras.len() as u64, "relighting");
-        for cam in cameras {
-            let img = r.relight(&lights, &cam, args.quick)?;
-            let path = args.out.join(format!("relit-{cam}.exr"));
-            write_exr(&img, &path)?;
-            bar.inc(1);
-            bar.suspend(|| outln!("relit {}", path.display()))?;
-        }
-        bar.finish_and_clear();
+    write_summary(&r, &written, out)?;
+    if let Some(lights) = &lights {
+        relight_views(&r, lights, None, &args.out, args.quick, out)?;
     }
     super::verdicts::finish(&quality, &args.out.join("quality.json"))
 }

@@ -17,7 +17,6 @@ mod process;
 mod render;
 mod ron_output;
 mod session;
-mod site;
 mod sky;
 mod station;
 mod sun;
@@ -140,7 +139,7 @@ pub fn run() -> ExitCode {
     logging::init(&cli.logging);
     let code = match cli.command {
         Command::Config { action } => finish(config_check::run(action)),
-        Command::Hdr { action } => hdr::run(action),
+        Command::Hdr { action } => report(hdr::run(action)),
         Command::Sun(args) => report(sun::run(args)),
         Command::Sky { action } => report(sky::run(action)),
         Command::Env { action } => report(env::run(action)),

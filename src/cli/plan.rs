@@ -1,14 +1,12 @@
 //! `campanile plan check`: simulate a plan forward without devices.
 
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::{Context, Result};
-use campanile_capture::schedule::{Occurrence, SceneGeometry, ShotKind, Timeline, TimelineOptions, timeline};
-use campanile_config::{Station, check_plan_on_station, load_plan, load_station};
+use anyhow::Result;
+use campanile_session::plan_check;
 use clap::{Args, Subcommand};
 
-use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
+use super::{EXIT_FAILURE, EXIT_OK};
 
 #[derive(Debug, Subcommand)]
 pub enum PlanCommand {
@@ -72,148 +70,13 @@ pub fn run(cmd: PlanCommand) -> Result<u8> {
 }
 
 fn check(args: &CheckArgs) -> Result<u8> {
-    let (t, station, plan_name) = match simulate(args) {
-        Ok(v) => v,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            return Ok(EXIT_USAGE);
-        }
-    };
-    print(&t, &station, &plan_name, args)?;
+    let c = plan_check::simulate(&args.plan, &args.station, args.days)?;
+    plan_check::write(&c, &mut std::io::stdout().lock())?;
     if let Some(out) = &args.ron
-        && let Err(e) = super::ron_output::write_ron(&t, Some(out))
+        && let Err(e) = super::ron_output::write_ron(&c.timeline, Some(out))
     {
         eprintln!("error: {e:#}");
         return Ok(EXIT_FAILURE);
     }
-    Ok(if t.is_covered() { EXIT_OK } else { EXIT_FAILURE })
-}
-
-fn simulate(args: &CheckArgs) -> Result<(Timeline, Station, String)> {
-    let plan = load_plan(&args.plan).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let station = load_station(&args.station).map_err(|e| anyhow::anyhow!("{e}"))?.value;
-    check_plan_on_station(&plan, &station).map_err(|e| {
-        anyhow::anyhow!(
-            "{e}\nthe plan does not run on station {:?} ({})",
-            station.name,
-            args.station.display()
-        )
-    })?;
-    let scene = match &plan.scene {
-        Some(s) => Some(SceneGeometry::load(&s.value, &s.source.base_dir()).context("reading the plan's scene")?),
-        None => None,
-    };
-    let options = TimelineOptions { days: args.days };
-    let t = timeline(&plan.plan.value, &station, scene.as_ref(), &options)
-        .with_context(|| format!("{}: cannot simulate the plan", args.plan.display()))?;
-    Ok((t, station, plan.plan.value.name))
-}
-
-fn frames(promised: usize, at_most: usize) -> String {
-    if promised == at_most {
-        promised.to_string()
-    } else {
-        format!("{promised}–{at_most}")
-    }
-}
-
-fn hms(d: std::time::Duration) -> String {
-    let s = d.as_secs_f64().round() as u64;
-    match (s / 3600, s / 60 % 60, s % 60) {
-        (0, 0, s) => format!("{s} s"),
-        (0, m, s) => format!("{m} min {s:02} s"),
-        (h, m, s) => format!("{h} h {m:02} min {s:02} s"),
-    }
-}
-
-fn kinds(o: &Occurrence) -> String {
-    [
-        (ShotKind::Data, "data"),
-        (ShotKind::Metering, "metering"),
-        (ShotKind::Centering, "centering"),
-    ]
-    .into_iter()
-    .filter_map(|(k, name)| {
-        let (p, m) = o.count(k);
-        (m > 0).then(|| format!("{} {name}", frames(p, m)))
-    })
-    .collect::<Vec<_>>()
-    .join(", ")
-}
-
-fn print(t: &Timeline, station: &Station, plan_name: &str, args: &CheckArgs) -> Result<()> {
-    let zone: chrono_tz::Tz = station.site.time_zone.parse().unwrap_or(chrono_tz::UTC);
-    let mut out = std::io::stdout().lock();
-    writeln!(
-        out,
-        "plan {plan_name:?} ({}) on station {:?} ({})",
-        args.plan.display(),
-        station.name,
-        display(&args.station)
-    )?;
-    writeln!(
-        out,
-        "site {}: {}°, {}°; local times in {}",
-        station.site.name, station.site.latitude_deg, station.site.longitude_deg, station.site.time_zone
-    )?;
-    if let Some(n) = args.days {
-        writeln!(out, "simulating the first {n} day(s) only")?;
-    }
-    writeln!(out)?;
-    let n = t.occurrences.len();
-    writeln!(out, "Timeline ({n} occurrence{})", if n == 1 { "" } else { "s" })?;
-    let width = t.occurrences.iter().map(|o| o.key.len()).max().unwrap_or(10).max(10);
-    writeln!(
-        out,
-        "  {:width$}  {:20}  {:22}  {:>7}  {:>7}  {:>9}  {:>14}  frames by kind",
-        "occurrence", "start (UTC)", "local", "sun az", "sun el", "frames", "est. duration"
-    )?;
-    for o in &t.occurrences {
-        let local = o.start.with_timezone(&zone).format("%Y-%m-%d %H:%M:%S %Z").to_string();
-        writeln!(
-            out,
-            "  {:width$}  {:20}  {:22}  {:>6.1}°  {:>6.1}°  {:>9}  {:>14}  {}{}",
-            o.key,
-            o.start.format("%Y-%m-%d %H:%M:%S").to_string(),
-            local,
-            o.sun.0,
-            o.sun.1,
-            frames(o.frames_promised(), o.frames_at_most()),
-            hms(o.estimated_duration),
-            kinds(o),
-            if o.held_out { " (held out)" } else { "" }
-        )?;
-    }
-    writeln!(out)?;
-    writeln!(out, "Totals")?;
-    writeln!(out, "  occurrences          {}", t.occurrences.len())?;
-    writeln!(out, "  frames promised      {} (exactly)", t.frames_promised())?;
-    if t.frames_at_most() != t.frames_promised() {
-        writeln!(
-            out,
-            "  frames at most       {} ({} more if every auto-bracket takes all its frames)",
-            t.frames_at_most(),
-            t.frames_at_most() - t.frames_promised()
-        )?;
-    }
-    writeln!(out, "  estimated time       {}", hms(t.estimated_duration()))?;
-    writeln!(out)?;
-    if t.uncovered.is_empty() {
-        writeln!(out, "Will not cover: nothing. The plan is fully covered.")?;
-    } else {
-        writeln!(out, "Will not cover ({})", t.uncovered.len())?;
-        for u in &t.uncovered {
-            let warning = if u.is_warning() {
-                " (a warning: every shot is still taken; exit status 0 if nothing else is listed)"
-            } else {
-                ""
-            };
-            writeln!(out, "  - {u}{warning}")?;
-        }
-    }
-    Ok(())
-}
-
-fn display(p: &Path) -> String {
-    p.display().to_string()
+    Ok(if c.timeline.is_covered() { EXIT_OK } else { EXIT_FAILURE })
 }

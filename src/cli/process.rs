@@ -6,9 +6,8 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use campanile_process::hdr::debevec::DebevecOptions;
-use campanile_process::quality::Quality;
 use campanile_session::process::room::RoomOptions;
-use campanile_session::run::{self, ProcessOptions, SessionKind, SkyWork};
+use campanile_session::run::{self, ProcessOptions, SessionKind};
 use clap::Args;
 
 use crate::cli::verdicts;
@@ -172,132 +171,26 @@ fn options(args: ProcessArgs) -> ProcessOptions {
 
 pub fn run(args: ProcessArgs) -> Result<()> {
     let opts = options(args);
-    match run::kind(&opts)? {
-        SessionKind::SkyOnly(q) => sky_only(&opts, &q),
-        SessionKind::Room => room(&opts),
-        SessionKind::Outdoor => outdoor(&opts),
-    }
-}
-
-/// `process` on a room session: the response and HDR, then the room stage.
-fn room(opts: &ProcessOptions) -> Result<()> {
-    let r = run::room(opts)?;
-    for w in &r.products.recovered.loaded.warnings {
-        eprintln!("warning: {w}");
-    }
-    super::igi::print_products(&r.products.recovered, &r.written)?;
-    outln!(
-        "processed {} → {} (scene file {})",
-        opts.session.display(),
-        opts.out.display(),
-        r.products.scene_file.display()
-    )?;
-    for (stage, s) in r.processed.summary.stage_seconds.iter().chain(&r.products.seconds) {
-        outln!("  {stage:<44} {s:>7.2} s")?;
-    }
-    verdicts::finish(&r.quality, &opts.out.join("quality.json"))
-}
-
-/// `process` on an outdoor session.
-fn outdoor(opts: &ProcessOptions) -> Result<()> {
-    let r = run::outdoor(opts)?;
-    for v in r.outdoor.iter().flat_map(|o| &o.products.held_out) {
-        outln!(
-            "  held out {:<32} relative RMSE {:.2}% per pixel, {:.2}% per 4×4 block ({} training photos' texture; grid alone {:.2}%)",
-            v.label,
-            100.0 * v.rmse_pixel,
-            100.0 * v.rmse_block,
-            v.references,
-            100.0 * v.rmse_block_grid
-        )?;
-    }
-    outln!("processed {} → {}", opts.session.display(), opts.out.display())?;
-    for (stage, s) in &r.processed.summary.stage_seconds {
-        outln!("  {stage:<28} {s:>7.2} s")?;
-    }
-    for o in &r.processed.summary.occurrences {
-        let sky = o.sky.as_ref().map_or("no sky".to_owned(), |s| {
-            format!(
-                "sky {} (rms {:.1}%)",
-                s.channels[1].chosen,
-                100.0 * s.channels.iter().map(|c| c.rms_relative).fold(0.0, f64::max)
-            )
-        });
-        let sun = o.sun_irradiance.map_or("no sun".to_owned(), |e| {
-            format!("sun {:.0}/{:.0}/{:.0} W·m⁻²", e[0], e[1], e[2])
-        });
-        outln!("  {:<28} {sun}; {sky}", o.occurrence)?;
-        for n in &o.notes {
-            outln!("    note: {n}")?;
-        }
-    }
-    verdicts::finish(&r.quality, &opts.out.join("quality.json"))
-}
-
-/// `process` on a sky-only session: the sky time series.
-fn sky_only(opts: &ProcessOptions, q: &Quality) -> Result<()> {
-    let r = run::sky_only(opts, q)?;
-    let out = &opts.out;
-    match &r.work {
-        SkyWork::Scan(occurrence, scan) => outln!(
-            "processed {occurrence} → {}: flags [{}]",
-            campanile_process::sky_series::scan_path(out, occurrence).display(),
-            scan.quality.names()
-        )?,
-        SkyWork::Merged(dirs, copied) => outln!(
-            "merged {dirs} shard directories ({copied} scan files copied): {} scans in {}",
-            r.series.scans.len(),
-            out.display()
-        )?,
-        SkyWork::New(run) => {
-            let rate = if run.scan_seconds > 0.0 {
-                run.processed.len() as f64 / run.scan_seconds
-            } else {
-                0.0
-            };
-            outln!(
-                "sky series {} → {}{}",
-                opts.session.display(),
-                out.display(),
-                opts.shard.map_or(String::new(), |s| format!(" (shard {s})"))
-            )?;
-            outln!(
-                "  processed {} scans in {:.2} s ({rate:.2} scans/s); {} already done, {} in other shards, {} still being captured",
-                run.processed.len(),
-                run.scan_seconds,
-                run.already_done,
-                run.other_shards,
-                run.incomplete.len()
-            )?;
-            outln!("  response: {}", run.response)?;
-        }
-    }
-    for d in &r.series.days {
-        let beta: Vec<String> = d
-            .fit
-            .iter()
-            .map(|f| {
-                f.as_ref()
-                    .map_or_else(|e| format!("none ({e})"), |e| format!("{:.4}", e.beta))
-            })
-            .collect();
-        outln!(
-            "  {}: β r/g/b {} from {} scans ({} left out)",
-            d.date,
-            beta.join(" / "),
-            d.points.len(),
-            d.left_out
-        )?;
-    }
-    let flagged = r.series.scans.iter().filter(|s| !s.quality.names().is_empty()).count();
-    outln!("  {} scans in the series, {flagged} flagged", r.series.scans.len())?;
-    if let Some(failure) = r.failure() {
-        if let SkyWork::New(run) = &r.work {
-            for (occ, why) in &run.failed {
-                eprintln!("  failed {occ}: {why}");
+    let (out, err) = (&mut std::io::stdout(), &mut std::io::stderr());
+    let quality = match run::kind(&opts)? {
+        SessionKind::SkyOnly(q) => {
+            let r = run::sky_only(&opts, &q)?;
+            r.write_lines(&opts, out, err)?;
+            if let Some(failure) = r.failure() {
+                return Err(failure.into());
             }
+            r.quality
         }
-        return Err(failure.into());
-    }
-    verdicts::finish(&r.quality, &out.join("quality.json"))
+        SessionKind::Room => {
+            let r = run::room(&opts)?;
+            r.write_lines(&opts, out, err)?;
+            r.quality
+        }
+        SessionKind::Outdoor => {
+            let r = run::outdoor(&opts)?;
+            r.write_lines(&opts, out)?;
+            r.quality
+        }
+    };
+    verdicts::finish(&quality, &opts.out.join("quality.json"))
 }

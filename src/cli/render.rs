@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use campanile_session::igi::write_exr;
+use campanile_session::igi::{lights_file, recover_scene, relight_views};
 use campanile_session::scene_render::{self, Rendered, SceneRenderOptions};
 use chrono::{DateTime, NaiveDate, Utc};
 use clap::Args;
@@ -123,25 +123,20 @@ pub struct RenderArgs {
 
 /// Room mode: the scene file's recovered materials under new lights.
 fn run_room(args: &RenderArgs, scene: &Path, lights: &Path) -> Result<()> {
-    let lights: Vec<campanile_process::igi::IgiLight> = campanile_process::igi::scene_file::load_lights(lights)
-        .map_err(|e| anyhow::anyhow!("{e}"))?
-        .into_iter()
-        .map(|(_, l)| l)
-        .collect();
-    let r = super::igi::recover_scene(scene, args.quick, Default::default())
-        .with_context(|| format!("reading {}", scene.display()))?;
-    let cameras = match &args.camera {
-        Some(c) => vec![c.clone()],
-        None => r.image_cameras(),
-    };
-    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
-    for cam in cameras {
-        let img = r.relight(&lights, &cam, args.quick)?;
-        let path = args.out.join(format!("relit-{cam}.exr"));
-        write_exr(&img, &path)?;
-        outln!("relit {}", path.display())?;
+    let lights = lights_file(lights)?;
+    let r = recover_scene(scene, args.quick).with_context(|| format!("reading {}", scene.display()))?;
+    for w in &r.loaded.warnings {
+        eprintln!("warning: {w}");
     }
-    Ok(())
+    let out = &mut std::io::stdout();
+    Ok(relight_views(
+        &r,
+        &lights,
+        args.camera.as_deref(),
+        &args.out,
+        args.quick,
+        out,
+    )?)
 }
 
 pub fn run(args: RenderArgs) -> Result<()> {

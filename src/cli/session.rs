@@ -4,13 +4,11 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
+use campanile_capture::import::ImportOptions;
 use campanile_capture::import::clock::ClockSettings;
 use campanile_capture::import::station_estimate::SiteGiven;
-use campanile_capture::import::{ImportError, ImportOptions, plan_import, write_session};
-use campanile_capture::store::SessionReader;
+use campanile_session::photo_import;
 use clap::{Args, Subcommand};
-
-use super::exit::bad_input;
 
 #[derive(Debug, Subcommand)]
 pub enum SessionCommand {
@@ -124,132 +122,28 @@ fn utc_offset(s: &str) -> Result<chrono::FixedOffset, String> {
         .ok_or_else(|| format!("{s:?}: expected an offset from UTC, +HH:MM or -HH:MM (e.g. +02:00)"))
 }
 
-fn import_error(e: ImportError) -> anyhow::Error {
-    if e.is_bad_input() {
-        bad_input(e.to_string())
-    } else {
-        anyhow::Error::new(e)
-    }
-}
-
 pub fn run(command: SessionCommand) -> Result<()> {
+    let out = &mut std::io::stdout().lock();
     match command {
-        SessionCommand::Import(args) => import(*args),
-        SessionCommand::Verify(args) => verify(args),
-    }
-}
-
-fn import(args: ImportArgs) -> Result<()> {
-    if !(args.occurrence_gap_min.is_finite() && args.occurrence_gap_min >= 0.0) {
-        return Err(bad_input(format!(
-            "--occurrence-gap-min {}: expected minutes ≥ 0",
-            args.occurrence_gap_min
-        )));
-    }
-    let opts = ImportOptions {
-        folder: args.folder.clone(),
-        bracket_gap_s: args.bracket_gap_s,
-        occurrence_gap_s: args.occurrence_gap_min * 60.0,
-        clock: ClockSettings {
-            clock_offset_s: args.clock_offset_s,
-            utc_offset: args.utc_offset,
-        },
-        times: args.times,
-        poses: args.poses,
-        scene: args.scene,
-        station: args.station,
-        site: args.site,
-        sky: args.sky,
-        skip_single: args.skip_single,
-    };
-    let bar = campanile_session::progress::bar(0, "reading EXIF");
-    let plan = plan_import(&opts, &|i, n| {
-        bar.set_length(n as u64);
-        bar.set_position(i as u64);
-    })
-    .map_err(import_error)?;
-    bar.finish_and_clear();
-    let bar = campanile_session::progress::bar(0, "copying frames");
-    let record = write_session(&plan, &args.out, &|i, n| {
-        bar.set_length(n as u64);
-        bar.set_position(i as u64);
-    })
-    .map_err(import_error)?;
-    bar.finish_and_clear();
-
-    outln!(
-        "imported {} → {}: {} brackets, {} frames, camera {} (station {})",
-        args.folder.display(),
-        args.out.display(),
-        record.brackets.len(),
-        record.brackets.iter().map(|b| b.frames.len()).sum::<usize>(),
-        record.camera,
-        record.station_from
-    )?;
-    outln!(
-        "{:<28} {:<5} {:>3}  {:<16} {:<16} {:<26} {:<20} began",
-        "group",
-        "kind",
-        "n",
-        "first",
-        "last",
-        "start (UTC)",
-        "exposures (s)"
-    )?;
-    for b in &record.brackets {
-        let (first, last) = (&b.frames[0], &b.frames[b.frames.len() - 1]);
-        let exposures: Vec<f64> = b.frames.iter().map(|f| f.exposure_time_s).collect();
-        let lo = exposures.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = exposures.iter().copied().fold(0.0, f64::max);
-        outln!(
-            "{:<28} {:<5} {:>3}  {:<16} {:<16} {:<26} {:<20} {}",
-            b.group,
-            b.purpose,
-            b.frames.len(),
-            first.file,
-            last.file,
-            first.utc,
-            format!("{lo}…{hi}"),
-            if b.began.is_empty() { "first" } else { &b.began }
-        )?;
-    }
-    for s in &record.skipped {
-        outln!("left out: {s}")?;
-    }
-    for p in &plan.unused_poses {
-        outln!("warning: poses entry {p:?} matches no bracket's first file")?;
-    }
-    for e in &record.estimated {
-        outln!("estimated ({}): {}", e.what, e.how)?;
-    }
-    Ok(())
-}
-
-fn verify(args: VerifyArgs) -> Result<()> {
-    let reader = SessionReader::open(&args.session).map_err(|e| bad_input(e.to_string()))?;
-    let mut problems = Vec::new();
-    let mut checked = 0;
-    for f in reader.frames() {
-        checked += 1;
-        if let Err(e) = reader.read_frame(f) {
-            problems.push(e.to_string());
+        SessionCommand::Import(args) => {
+            let opts = ImportOptions {
+                folder: args.folder,
+                bracket_gap_s: args.bracket_gap_s,
+                occurrence_gap_s: args.occurrence_gap_min * 60.0,
+                clock: ClockSettings {
+                    clock_offset_s: args.clock_offset_s,
+                    utc_offset: args.utc_offset,
+                },
+                times: args.times,
+                poses: args.poses,
+                scene: args.scene,
+                station: args.station,
+                site: args.site,
+                sky: args.sky,
+                skip_single: args.skip_single,
+            };
+            Ok(photo_import::import(&opts, &args.out, out)?)
         }
-    }
-    outln!(
-        "{}: {checked} frames checked, {} damaged or missing",
-        args.session.display(),
-        problems.len()
-    )?;
-    for p in &problems {
-        outln!("  {p}")?;
-    }
-    if problems.is_empty() {
-        Ok(())
-    } else {
-        Err(bad_input(format!(
-            "{}: {} of {checked} frames damaged or missing (listed above)",
-            args.session.display(),
-            problems.len()
-        )))
+        SessionCommand::Verify(args) => Ok(photo_import::verify(&args.session, out)?),
     }
 }

@@ -1,13 +1,11 @@
 //! `campanile sky`: fit sky models to samples, and evaluate them.
 
-use std::fs::File;
-use std::io::{BufReader, Write};
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
-use campanile_process::quality::{ProductQuality, QualityReport, gates};
-use campanile_process::sky::{ChannelSelection, SkyFile, SkyFitOptions, compare_with_samples, read_samples};
-use campanile_process::sun::Ephemeris;
+use anyhow::Result;
+use campanile_process::quality::QualityReport;
+use campanile_process::sky::{ChannelSelection, SkyFitOptions};
+use campanile_session::site::SunGiven;
 use campanile_session::sky_files;
 use chrono::{DateTime, Utc};
 use clap::{ArgGroup, Args, Subcommand};
@@ -231,49 +229,27 @@ fn rfc3339(text: &str) -> Result<DateTime<Utc>, String> {
 }
 
 impl SunArgs {
-    /// (zenith, azimuth) in radians, for a sun that may be below the
-    /// horizon (the environment is lit by the sky alone then).
-    pub fn resolve_any(&self) -> Result<(f64, f64)> {
-        let site = (&self.station, self.lat, self.lon);
-        match (self.sun_zenith_deg, self.sun_azimuth_deg, self.time, site) {
-            (Some(z), Some(a), _, _) if (0.0..=180.0).contains(&z) => Ok((z.to_radians(), a.to_radians())),
-            (Some(z), Some(_), _, _) => Err(super::exit::bad_input(format!(
-                "--sun-zenith-deg: found {}; expected a zenith angle from 0 to 180 degrees",
-                super::exit::shown(z)
-            ))),
-            (_, _, Some(t), (Some(path), _, _)) => {
-                let s = super::site::station_site(path)?;
-                let obs = super::site::observer(&s);
-                let p = Ephemeris::at(t, s.delta_t_s)?.position(&obs)?;
-                Ok((p.zenith_rad, p.azimuth_rad))
-            }
-            (_, _, Some(t), (None, Some(lat), Some(lon))) => {
-                let obs = super::site::observer_at(lat, lon, self.elevation_m.unwrap_or(0.0))?;
-                let p = Ephemeris::at(t, None)?.position(&obs)?;
-                Ok((p.zenith_rad, p.azimuth_rad))
-            }
-            _ => Err(super::exit::bad_input(
-                "give the sun: --sun-zenith-deg and --sun-azimuth-deg, or --time with --station or with --lat and --lon",
-            )),
+    /// The sun as given.
+    pub fn given(&self) -> SunGiven {
+        SunGiven {
+            zenith_deg: self.sun_zenith_deg,
+            azimuth_deg: self.sun_azimuth_deg,
+            time: self.time,
+            station: self.station.clone(),
+            lat: self.lat,
+            lon: self.lon,
+            elevation_m: self.elevation_m,
         }
-    }
-
-    /// (zenith, azimuth) in radians, for a sun above the horizon.
-    fn resolve(&self) -> Result<(f64, f64)> {
-        let (z, a) = self.resolve_any()?;
-        if z > std::f64::consts::FRAC_PI_2 {
-            return Err(super::exit::bad_input(format!(
-                "the sun is {:.2}° below the horizon then: no daylight sky to fit or predict",
-                (z - std::f64::consts::FRAC_PI_2).to_degrees()
-            )));
-        }
-        Ok((z, a))
     }
 }
 
-fn read_sky(path: &PathBuf) -> Result<SkyFile> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
-    ron::from_str(&text).map_err(|e| super::exit::bad_input(format!("{}:{}: {}", path.display(), e.span.start, e.code)))
+/// Where a product's verdict goes: beside `out`, or one line on standard
+/// error when the product went to standard output.
+fn finish(quality: &QualityReport, out: Option<&std::path::Path>) -> Result<()> {
+    match out {
+        Some(path) => super::verdicts::finish(quality, &super::verdicts::beside(path)),
+        None => super::verdicts::finish_on_stderr(quality),
+    }
 }
 
 pub fn run(cmd: SkyCommand) -> Result<()> {
@@ -293,116 +269,30 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
                 max_masked_fraction: max_masked,
             };
             let q = super::verdicts::thresholds(thresholds.as_deref(), None)?;
-            let (zs, az) = sun.resolve()?;
             let selection = columns.map_or(ChannelSelection::Auto, ChannelSelection::Named);
-            let sky = sky_files::fit(&samples, &selection, (zs, az), &options, residual_map.as_deref())?;
+            let sun = sun.given().resolve()?;
+            let (sky, quality) =
+                sky_files::fit_checked(&samples, &selection, sun, &options, residual_map.as_deref(), &q)?;
             super::ron_output::write_ron(&sky, out.as_deref())?;
-            let name = samples
-                .file_name()
-                .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-            let quality = QualityReport::new(vec![gates::sky(&name, &sky.channels, &q)], &q);
-            match &out {
-                Some(path) => super::verdicts::finish(&quality, &super::verdicts::beside(path)),
-                None => super::verdicts::finish_on_stderr(&quality),
-            }
+            finish(&quality, out.as_deref())
         }
         SkyCommand::Predict { skies, sun, out } => {
-            let (zs, az) = sun.resolve()?;
-            let known: Vec<SkyFile> = skies.iter().map(read_sky).collect::<Result<_>>()?;
-            let names: Vec<&str> = known[0].channels.iter().map(|c| c.channel.as_str()).collect();
-            for (path, k) in skies.iter().zip(&known) {
-                let these: Vec<&str> = k.channels.iter().map(|c| c.channel.as_str()).collect();
-                if these != names {
-                    return Err(super::exit::bad_input(format!(
-                        "{}: channels {these:?} differ from {}'s {names:?}",
-                        path.display(),
-                        skies[0].display()
-                    )));
-                }
-            }
-            super::ron_output::write_ron(&sky_files::predict(&known, (zs, az))?, out.as_deref())?;
-            // The prediction carries the verdicts its skies were fitted
-            // with (`NAME.quality.json` beside each): a failed fit is not
-            // used in silence.
-            let mut predicted = ProductQuality::new("sky predicted", Vec::new());
-            for path in &skies {
-                if let Some(input) = super::verdicts::of_input(path)? {
-                    predicted.inherit(&input);
-                }
-            }
-            let q = campanile_process::quality::Quality::default();
-            let quality = QualityReport::new(vec![predicted], &q);
-            match &out {
-                Some(path) => super::verdicts::finish(&quality, &super::verdicts::beside(path)),
-                None => super::verdicts::finish_on_stderr(&quality),
-            }
+            let (sky, quality) = sky_files::predict_files(&skies, sun.given().resolve()?)?;
+            super::ron_output::write_ron(&sky, out.as_deref())?;
+            finish(&quality, out.as_deref())
         }
-        SkyCommand::Map { sky, out, width } => {
-            let sky_file = read_sky(&sky)?;
-            let [r, g, b] = sky_file.channels.as_slice() else {
-                return Err(super::exit::bad_input(format!(
-                    "{}: {} channels; a map needs exactly three (r, g, b)",
-                    sky.display(),
-                    sky_file.channels.len()
-                )));
-            };
-            sky_files::write_map(&[r.model, g.model, b.model], &sky_file, width as usize, &out)?;
-            Ok(())
-        }
+        SkyCommand::Map { sky, out, width } => Ok(sky_files::map_file(&sky, width as usize, &out)?),
         SkyCommand::Eval {
             sky,
             directions,
             compare,
-        } => {
-            let sky_file = read_sky(&sky)?;
-            let names: Vec<&str> = sky_file.channels.iter().map(|c| c.channel.as_str()).collect();
-            let selection = if compare {
-                ChannelSelection::Named(names.iter().map(|&n| n.to_owned()).collect())
-            } else {
-                ChannelSelection::Directions
-            };
-            let file = File::open(&directions).with_context(|| format!("{}: cannot open", directions.display()))?;
-            let table = read_samples(BufReader::new(file), &selection).with_context(|| {
-                if compare {
-                    format!("{}: --compare needs the sky's channels", directions.display())
-                } else {
-                    format!("{}", directions.display())
-                }
-            })?;
-            let compared = if compare {
-                compare_with_samples(&sky_file, &table)
-            } else {
-                Vec::new()
-            };
-            let mut out = std::io::stdout().lock();
-            let mut header = format!("zenith_deg,azimuth_deg,{}", names.join(","));
-            for c in &compared {
-                header += &format!(",{}_residual", c.channel);
-            }
-            writeln!(out, "{header}")?;
-            for (row, &(z, a)) in table.directions.iter().enumerate() {
-                let mut line = format!("{:.6},{:.6}", z.to_degrees(), a.to_degrees());
-                for v in sky_file.radiance(z, a) {
-                    line += &format!(",{v:.9e}");
-                }
-                for c in &compared {
-                    line += &format!(",{:.6e}", c.ratio_minus_1[row]);
-                }
-                writeln!(out, "{line}")?;
-            }
-            if !compared.is_empty() {
-                let parts: Vec<String> = compared
-                    .iter()
-                    .map(|c| format!("{} median {:.5}, p95 {:.5}", c.channel, c.median_abs, c.p95_abs))
-                    .collect();
-                eprintln!(
-                    "compared {} samples, |measured / fitted − 1|: {}",
-                    table.directions.len(),
-                    parts.join("; ")
-                );
-            }
-            Ok(())
-        }
+        } => Ok(sky_files::eval(
+            &sky,
+            &directions,
+            compare,
+            &mut std::io::stdout().lock(),
+            &mut std::io::stderr(),
+        )?),
     }
 }
 

@@ -1,23 +1,18 @@
 //! `campanile station run|status`: the unattended station, and its heartbeat.
 
-use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::path::PathBuf;
+use std::time::Duration;
 
-use anyhow::{Context, Result};
-use campanile_capture::unattended::{
-    self, DeviceState, Heartbeat, Liveness, NoProcessing, StationEnd, StationOptions, StationReport, StopHandle,
-    StorageBudget, parse_bytes,
-};
+use anyhow::Result;
+use campanile_capture::unattended::{StationOptions, StorageBudget, parse_bytes};
 use campanile_sim::faults::Device;
 use chrono::{DateTime, Utc};
 use clap::{Args, Subcommand};
 
-use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
-use campanile_capture::unattended::ScanHook;
-use campanile_process::quality::Quality;
+use super::{EXIT_FAILURE, EXIT_OK};
 use campanile_session::capture_inputs::Inputs;
-use campanile_session::scan_processor::{SkySeriesProcessor, StationHook};
-use campanile_session::station_run::{StationRun, TimedOutage, run_real, run_simulated};
+use campanile_session::station_run::{StationRun, TimedOutage, run_station};
+use campanile_session::station_status;
 
 #[derive(Debug, Subcommand)]
 pub enum StationCommand {
@@ -175,228 +170,33 @@ pub struct StatusArgs {
 }
 
 pub fn run(command: StationCommand) -> Result<u8> {
-    match command {
-        StationCommand::Run(args) => run_station(&args),
-        StationCommand::Status(args) => status(&args),
-    }
-}
-
-fn run_station(args: &RunArgs) -> Result<u8> {
-    let inputs = match Inputs::from_files(&args.plan, &args.station, args.days) {
-        Ok(i) => i,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            return Ok(EXIT_USAGE);
+    let out = &mut std::io::stdout();
+    let ok = match command {
+        StationCommand::Run(args) => {
+            let inputs = Inputs::from_files(&args.plan, &args.station, args.days)
+                .map_err(|e| campanile_session::Error::input(format!("{e:#}")))?;
+            let run = StationRun {
+                store: args.store.clone(),
+                options: StationOptions {
+                    budget: args.budget.map(|max_bytes| StorageBudget { max_bytes }),
+                    ..StationOptions::default()
+                },
+                samples: args.sim_samples,
+                bounces: args.sim_bounces,
+                outages: args
+                    .sim_outage
+                    .iter()
+                    .map(|o| TimedOutage {
+                        device: o.device,
+                        start: o.start,
+                        duration: o.duration,
+                    })
+                    .collect(),
+            };
+            let response = args.response.as_deref().filter(|_| args.process);
+            run_station(&run, &inputs, response, out, &mut std::io::stderr())?
         }
+        StationCommand::Status(args) => station_status::status(&args.store, args.max_age, out)?,
     };
-    if !inputs.station.uses_simulation() && !args.sim_outage.is_empty() {
-        eprintln!(
-            "error: --sim-outage is for simulated stations; station {:?} ({}) has real devices",
-            inputs.station.name, inputs.station_label
-        );
-        return Ok(EXIT_USAGE);
-    }
-    let options = StationOptions {
-        budget: args.budget.map(|max_bytes| StorageBudget { max_bytes }),
-        ..StationOptions::default()
-    };
-    let wall = Instant::now();
-    let run = StationRun {
-        store: args.store.clone(),
-        options,
-        samples: args.sim_samples,
-        bounces: args.sim_bounces,
-        outages: args
-            .sim_outage
-            .iter()
-            .map(|o| TimedOutage {
-                device: o.device,
-                start: o.start,
-                duration: o.duration,
-            })
-            .collect(),
-    };
-    let mut hook = hook(args, inputs.plan.plan.value.quality.clone().unwrap_or_default());
-    let result = if inputs.station.uses_simulation() {
-        run_simulated(&run, &inputs, hook.as_mut(), &stop_on_signals)
-    } else {
-        run_real(&run, &inputs, hook.as_mut(), &stop_on_signals)
-    };
-    match result {
-        Ok(Ok(report)) => {
-            summary(&args.store, &report, wall.elapsed())?;
-            Ok(EXIT_OK)
-        }
-        Ok(Err(failure)) => {
-            summary(&args.store, &failure.report, wall.elapsed())?;
-            eprintln!("error: {:#}", anyhow::Error::new(failure.error));
-            eprintln!("continue with the same command once it is fixed");
-            Ok(EXIT_FAILURE)
-        }
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            Ok(EXIT_FAILURE)
-        }
-    }
-}
-
-/// SIGTERM and SIGINT ask `stop` to stop.
-fn stop_on_signals(stop: &StopHandle) -> Result<()> {
-    use tokio::signal::unix::{SignalKind, signal};
-    let mut term = signal(SignalKind::terminate()).context("listening for SIGTERM")?;
-    let mut int = signal(SignalKind::interrupt()).context("listening for SIGINT")?;
-    let stop = stop.clone();
-    tokio::spawn(async move {
-        tokio::select! {
-            _ = term.recv() => tracing::warn!("SIGTERM: stopping at the next frame boundary"),
-            _ = int.recv() => tracing::warn!("SIGINT: stopping at the next frame boundary"),
-        }
-        stop.request();
-    });
-    Ok(())
-}
-
-/// The scan hook `args` ask for.
-fn hook(args: &RunArgs, thresholds: Quality) -> Box<dyn ScanHook> {
-    match (&args.response, args.process) {
-        (Some(response), true) => Box::new(StationHook(SkySeriesProcessor {
-            response: response.clone(),
-            thresholds,
-        })),
-        _ => Box::new(NoProcessing),
-    }
-}
-
-fn summary(store: &Path, r: &StationReport, wall: Duration) -> Result<()> {
-    outln!("store {}", store.display())?;
-    outln!(
-        "  ended                {}",
-        match r.end {
-            StationEnd::Finished => "every occurrence of the plan's days is settled",
-            StationEnd::Stopped => "stopped on request (run the same command to continue)",
-        }
-    )?;
-    let days: Vec<String> = r.days.iter().map(|d| d.to_string()).collect();
-    outln!("  day sessions         {}", days.join(", "))?;
-    outln!(
-        "  scans                {} run, {} settled earlier",
-        r.occurrences_run,
-        r.occurrences_skipped
-    )?;
-    outln!(
-        "  this run             {} frames, {} missed, {} missed in outages, {} metering captures",
-        r.frames,
-        r.missed,
-        r.missed_in_outages,
-        r.metering_captures
-    )?;
-    for o in &r.outages {
-        outln!(
-            "  outage               {} from {} to {} ({:.1} min)",
-            o.device,
-            o.start.format("%Y-%m-%d %H:%M:%S UTC"),
-            o.end.format("%Y-%m-%d %H:%M:%S UTC"),
-            (o.end - o.start).num_seconds() as f64 / 60.0
-        )?;
-    }
-    outln!(
-        "  pruned               {} frames, {} bytes",
-        r.pruned_frames,
-        r.pruned_bytes
-    )?;
-    outln!("  wall time            {:.1} s", wall.as_secs_f64())?;
-    Ok(())
-}
-
-fn status(args: &StatusArgs) -> Result<u8> {
-    if !(args.max_age.is_finite() && args.max_age >= 0.0) {
-        return Err(super::exit::bad_input(format!(
-            "--max-age: found {}; expected a number of seconds, 0 or more",
-            super::exit::shown(args.max_age)
-        )));
-    }
-    let beat = match Heartbeat::read(&args.store) {
-        Ok(b) => b,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return Ok(EXIT_FAILURE);
-        }
-    };
-    let age = beat.age_s(Utc::now());
-    let t = |d: DateTime<Utc>| d.format("%Y-%m-%d %H:%M:%S UTC").to_string();
-    outln!(
-        "station heartbeat {}",
-        args.store.join(unattended::HEARTBEAT_FILE).display()
-    )?;
-    let state = serde_json::to_value(beat.state)
-        .ok()
-        .and_then(|v| v.as_str().map(str::to_owned))
-        .unwrap_or_default();
-    if beat.detail.is_empty() {
-        outln!("  state        {state}")?;
-    } else {
-        outln!("  state        {state}: {}", beat.detail)?;
-    }
-    outln!(
-        "  written      {} station time; {age:.0} s ago on this computer's clock (pid {})",
-        t(beat.written_utc),
-        beat.pid
-    )?;
-    match (&beat.last_frame_utc, &beat.last_frame_key) {
-        (Some(at), Some(key)) => outln!("  last frame   {} {key}", t(*at))?,
-        _ => outln!("  last frame   none in this run")?,
-    }
-    if let (Some(day), Some(dir)) = (beat.day, &beat.session_dir) {
-        outln!(
-            "  today        {day}: {} frames in {}",
-            beat.frames_today,
-            dir.display()
-        )?;
-    }
-    for d in &beat.devices {
-        let line = match &d.state {
-            DeviceState::Unknown => "not asked yet".to_owned(),
-            DeviceState::Up { last_answer } => format!("up (last answer {})", t(*last_answer)),
-            DeviceState::Down { since, error, probes } => {
-                format!("DOWN since {} ({probes} failed probes): {error}", t(*since))
-            }
-        };
-        outln!("  {:<12} {line}", d.device)?;
-    }
-    let mb = |b: u64| format!("{:.1} MB", b as f64 / 1e6);
-    outln!(
-        "  disk         {} free; the store holds {}{}",
-        beat.free_disk_bytes.map_or("unknown".to_owned(), mb),
-        mb(beat.store_bytes),
-        beat.budget_bytes
-            .map_or(String::new(), |b| format!(" of a {} budget", mb(b)))
-    )?;
-    // A station that ends on its own writes `stopped`, `finished` or
-    // `failed`; one whose heartbeat says it runs must still run.
-    let live = beat.liveness();
-    match &live {
-        Liveness::Running => outln!("  process      pid {} on this host: running", beat.pid)?,
-        Liveness::NotRunning(why) => outln!("  process      {why}")?,
-        Liveness::OtherHost(host) => outln!(
-            "  process      pid {} on host {host}, not this one: judged by the heartbeat's age only",
-            beat.pid
-        )?,
-        Liveness::Unknown(why) => outln!("  process      {why}; judged by the heartbeat's age only")?,
-    }
-    if beat.state.claims_running()
-        && let Liveness::NotRunning(why) = &live
-    {
-        outln!("not running (killed?): the heartbeat says {state}, but {why}")?;
-        return Ok(EXIT_FAILURE);
-    }
-    if age > args.max_age {
-        outln!(
-            "STALE: written {age:.0} s ago, more than --max-age {:.0} s: the station is not running or is stuck",
-            args.max_age
-        )?;
-        Ok(EXIT_FAILURE)
-    } else {
-        outln!("fresh: written {age:.0} s ago (--max-age {:.0} s)", args.max_age)?;
-        Ok(EXIT_OK)
-    }
+    Ok(if ok { EXIT_OK } else { EXIT_FAILURE })
 }

@@ -1,13 +1,11 @@
 //! `campanile sun`: where the sun is, for one instant or a CSV table.
 
-use std::fs::File;
-use std::io::{BufReader, Write};
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
-use super::exit::{bad_input, shown};
-use campanile_process::sun::{Ephemeris, Observer, SolarDay, solar_day, sun_table};
+use super::exit::bad_input;
+use campanile_session::sun_files::{self, SunAt};
 use chrono::{DateTime, Utc};
 use clap::Args;
 
@@ -69,117 +67,23 @@ pub struct SunArgs {
 
 pub fn run(args: SunArgs) -> Result<()> {
     if let Some(input) = &args.csv {
-        let file = File::open(input).with_context(|| format!("{}: cannot open", input.display()))?;
-        let n = match &args.out {
-            Some(out) => campanile_session::partial_file::write_with(out, |w| {
-                Ok(sun_table(BufReader::new(file), w).with_context(|| format!("{}", input.display()))?)
-            })?,
-            None => sun_table(BufReader::new(file), std::io::stdout().lock())
-                .with_context(|| format!("{}", input.display()))?,
-        };
+        let n = sun_files::table(input, args.out.as_deref())?;
         tracing::info!(rows = n, "solar positions written");
         return Ok(());
     }
     let Some(time) = args.time else {
         return Err(bad_input("--time is required without --csv"));
     };
-    let (observer, delta_t, zone, site_name) = match (&args.station, args.lat, args.lon) {
-        (Some(path), _, _) => {
-            let s = super::site::station_site(path)?;
-            let zone: chrono_tz::Tz = s.time_zone.parse().unwrap_or(chrono_tz::UTC);
-            (super::site::observer(&s), s.delta_t_s, zone, s.name)
-        }
-        (None, Some(lat), Some(lon)) => (
-            check_site(&args)
-                .map(|()| Observer::from_degrees(lat, lon, args.elevation_m, args.pressure_mbar, args.temperature_c))?,
-            args.delta_t_s,
-            args.time_zone,
-            format!("{lat}°, {lon}°"),
-        ),
-        _ => return Err(bad_input("give a site: --station FILE, or --lat and --lon")),
+    let instant = SunAt {
+        time,
+        station: args.station,
+        lat: args.lat,
+        lon: args.lon,
+        elevation_m: args.elevation_m,
+        pressure_mbar: args.pressure_mbar,
+        temperature_c: args.temperature_c,
+        time_zone: args.time_zone,
+        delta_t_s: args.delta_t_s,
     };
-    let delta_t = args.delta_t_s.or(delta_t);
-    let eph = Ephemeris::at(time, delta_t)?;
-    let p = eph.position(&observer)?;
-    let mut out = std::io::stdout().lock();
-    writeln!(out, "site            {site_name}")?;
-    writeln!(
-        out,
-        "time            {} ({})",
-        time.to_rfc3339(),
-        time.with_timezone(&zone).format("%Y-%m-%d %H:%M:%S %Z")
-    )?;
-    writeln!(out, "zenith_deg      {:.5}", p.zenith_rad.to_degrees())?;
-    writeln!(out, "azimuth_deg     {:.5}", p.azimuth_rad.to_degrees())?;
-    writeln!(out, "elevation_deg   {:.5}", p.elevation_rad().to_degrees())?;
-    writeln!(out, "earth_sun_au    {:.7}", eph.earth_sun_distance_au())?;
-    let local_date = time.with_timezone(&zone).date_naive();
-    let show = |t: Option<DateTime<Utc>>| match t {
-        Some(t) => format!(
-            "{} ({})",
-            t.format("%Y-%m-%d %H:%M:%S UTC"),
-            t.with_timezone(&zone).format("%H:%M:%S %Z")
-        ),
-        None => "none".into(),
-    };
-    match solar_day(local_date, &zone, &observer, delta_t)? {
-        SolarDay::Normal {
-            sunrise,
-            transit,
-            sunset,
-        } => {
-            writeln!(out, "sunrise         {}", show(sunrise))?;
-            writeln!(out, "transit         {}", show(transit))?;
-            writeln!(out, "sunset          {}", show(sunset))?;
-        }
-        SolarDay::PolarDay { transit } => writeln!(out, "polar day       the sun stays up; transit {}", show(transit))?,
-        SolarDay::PolarNight { transit } => {
-            writeln!(out, "polar night     the sun stays down; transit {}", show(transit))?
-        }
-    }
-    Ok(())
-}
-
-/// The site's arguments against their domains (those of the NREL SPA).
-fn check_site(args: &SunArgs) -> Result<()> {
-    let checks = [
-        ("--lat", args.lat.unwrap_or(0.0), -90.0, 90.0, "degrees from -90 to 90"),
-        (
-            "--lon",
-            args.lon.unwrap_or(0.0),
-            -180.0,
-            180.0,
-            "degrees from -180 to 180",
-        ),
-        (
-            "--elevation-m",
-            args.elevation_m,
-            -6_500_000.0,
-            1e7,
-            "metres above sea level, -6500000 to 10000000",
-        ),
-        (
-            "--pressure-mbar",
-            args.pressure_mbar,
-            f64::MIN_POSITIVE,
-            2000.0,
-            "more than 0 and at most 2000 mbar",
-        ),
-        (
-            "--temperature-c",
-            args.temperature_c,
-            -273.0 + 1e-9,
-            100.0,
-            "more than -273 and at most 100 °C",
-        ),
-    ];
-    for (flag, value, low, high, expected) in checks {
-        if !(low..=high).contains(&value) {
-            return Err(bad_input(format!(
-                "{flag}: found {}; expected {expected}",
-                shown(value)
-            )));
-        }
-    }
-    Ok(())
+    Ok(sun_files::instant(&instant, &mut std::io::stdout().lock())?)
 }

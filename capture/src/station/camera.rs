@@ -17,6 +17,16 @@ pub fn open_camera(config: &CameraConfig) -> Result<ThreadedCamera, DeviceError>
     }
 }
 
+/// Whether this build holds `driver` (the V4L2 and nokhwa drivers are
+/// cargo features; the simulator's camera always is).
+pub fn driver_built(driver: CameraDriver) -> bool {
+    match driver {
+        CameraDriver::V4l => cfg!(feature = "v4l"),
+        CameraDriver::Nokhwa => cfg!(feature = "nokhwa"),
+        CameraDriver::Sim => true,
+    }
+}
+
 #[cfg(feature = "v4l")]
 fn open_v4l(config: &CameraConfig) -> Result<ThreadedCamera, DeviceError> {
     crate::driver::v4l2::open(config, crate::driver::v4l2::V4l2Options::default())

@@ -23,7 +23,7 @@ pub mod camera;
 pub mod devices;
 pub mod port;
 
-pub use camera::open_camera;
+pub use camera::{driver_built, open_camera};
 pub use devices::{AnyHead, AnyLights, AnyWheel};
 pub use port::{PortOpener, SerialOpener};
 
