@@ -162,3 +162,70 @@ fn devices_test_refuses_a_bad_station() {
         "{stderr}"
     );
 }
+
+/// `examples/indi/station.ron` against a real `indiserver` running INDI's
+/// CCD and filter-wheel simulators (Debian's indi-bin), its Pelco-D head on
+/// a pseudo-terminal: every suite passes. `devices --indi` lists what the
+/// server offers.
+#[test]
+fn devices_test_on_the_indi_station() {
+    use campanile_capture::driver::indi::LocalServer;
+    let server = LocalServer::start(&["indi_simulator_ccd", "indi_simulator_wheel"]).unwrap_or_else(|e| panic!("{e}"));
+    let out = campanile(&["devices", "--indi", &server.address()]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        stdout.contains("\"CCD Simulator\"  CCD, guider, filter wheel (indi_simulator_ccd)"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("\"Filter Simulator\"  filter wheel (indi_simulator_wheel)"),
+        "{stdout}"
+    );
+
+    let rt = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(1)
+        .enable_all()
+        .build()
+        .unwrap();
+    let _enter = rt.enter();
+    let (head_master, head_slave) = serial::pty_pair().unwrap();
+    let head_path = serial::device_path(&head_slave).unwrap();
+    let pelco = PelcoConfig {
+        speed: 90_000,
+        pan_range: (-18_000, 17_999),
+        ..PelcoConfig::default()
+    };
+    let _emulator = Emulator::spawn(PelcoDevice::new(pelco), head_master, TICK);
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let example = std::fs::read_to_string(root.join("examples/indi/station.ron")).unwrap();
+    let station = example
+        .replace("/dev/ttyUSB0", &head_path)
+        .replace("127.0.0.1:7624", &server.address());
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("indi-station.ron");
+    std::fs::write(&file, &station).unwrap();
+    let out = campanile(&[
+        "devices",
+        "test",
+        "--station",
+        file.to_str().unwrap(),
+        "--move-limit-s",
+        "10",
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    println!("{stdout}");
+    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    let address = server.address();
+    assert!(
+        stdout.contains(&format!("filter wheel (INDI \"Filter Simulator\" on {address}):")),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains(&format!("camera (INDI \"CCD Simulator\" on {address}):")),
+        "{stdout}"
+    );
+    // 6 head, 2 wheel and 3 camera checks.
+    assert!(stdout.contains("11 checks, 0 failed"), "{stdout}");
+    drop(head_slave);
+}

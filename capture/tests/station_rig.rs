@@ -483,7 +483,7 @@ async fn a_session_completes_on_the_real_station_through_link_drops() {
 #[tokio::test(start_paused = true)]
 async fn shared_and_simulated_ports_are_refused_by_name() {
     let mut station = real_station();
-    station.filter_wheel.as_mut().unwrap().link.port = "/dev/ttyUSB0".into();
+    station.filter_wheel.as_mut().unwrap().link.as_mut().unwrap().port = "/dev/ttyUSB0".into();
     let camera = FlatCamera {
         clock: clock(),
         sequence: 0,

@@ -17,6 +17,10 @@ pub enum CameraDriver {
     V4l,
     /// A camera through `nokhwa` (cargo feature `nokhwa`).
     Nokhwa,
+    /// An INDI `CCD` device on an INDI server (`device: Indi(server:
+    /// "127.0.0.1:7624", device: "CCD Simulator")`); DSLRs reach INDI
+    /// through `indi_gphoto_ccd`.
+    Indi,
 }
 
 /// How to find the camera device.
@@ -27,6 +31,28 @@ pub enum DeviceRef {
     Path(String),
     /// A device index as the driver enumerates them.
     Index(u32),
+    /// A device on an INDI server, for the `Indi` driver.
+    Indi {
+        /// The server, `host:port` (INDI's port is 7624).
+        server: String,
+        /// The device's INDI name, e.g. "CCD Simulator".
+        device: String,
+    },
+}
+
+/// Checks an INDI server address and device name under `v`.
+pub(crate) fn validate_indi(v: &mut Validator, server: &str, device: &str) {
+    let port_ok = server
+        .rsplit_once(':')
+        .is_some_and(|(host, port)| !host.is_empty() && port.parse::<u16>().is_ok_and(|p| p > 0));
+    if !port_ok {
+        v.invalid(
+            "server",
+            format!("{server:?}"),
+            "an INDI server as host:port, e.g. \"127.0.0.1:7624\"",
+        );
+    }
+    v.non_empty("device", device);
 }
 
 /// Image size in pixels.
@@ -163,6 +189,19 @@ impl Validate for Camera {
     fn validate(&self, v: &mut Validator) {
         match (&self.driver, &self.device) {
             (CameraDriver::Sim, _) => {}
+            (CameraDriver::Indi, Some(DeviceRef::Indi { server, device })) => {
+                v.at("device", |v| validate_indi(v, server, device));
+            }
+            (CameraDriver::Indi, other) => v.invalid(
+                "device",
+                format!("{other:?}"),
+                "an INDI device for the Indi driver, e.g. `device: Indi(server: \"127.0.0.1:7624\", device: \"CCD Simulator\")`",
+            ),
+            (_, Some(DeviceRef::Indi { .. })) => v.invalid(
+                "device",
+                "Indi(...)".into(),
+                "a Path or an Index for this driver (an INDI device needs `driver: Indi`)",
+            ),
             (_, None) => v.invalid(
                 "device",
                 "nothing".into(),

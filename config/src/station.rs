@@ -54,7 +54,7 @@ impl Station {
         use crate::camera::CameraDriver;
         self.camera.driver == CameraDriver::Sim
             || self.head.link.is_simulated()
-            || self.filter_wheel.as_ref().is_some_and(|w| w.link.is_simulated())
+            || self.filter_wheel.as_ref().is_some_and(|w| w.is_simulated())
             || self.lights.as_ref().is_some_and(|l| l.link.is_simulated())
     }
 }
@@ -106,9 +106,18 @@ impl Station {
         }
         let links = [
             ("head", Some(&self.head.link)),
-            ("filter_wheel", self.filter_wheel.as_ref().map(|w| &w.link)),
+            ("filter_wheel", self.filter_wheel.as_ref().and_then(|w| w.link.as_ref())),
             ("lights", self.lights.as_ref().map(|l| &l.link)),
         ];
+        if let Some(i) = self.filter_wheel.as_ref().and_then(|w| w.indi.as_ref()) {
+            v.at("filter_wheel", |v| {
+                v.invalid(
+                    "indi",
+                    format!("{:?} on {}", i.device, i.server),
+                    &format!("a wheel on a `sim:` port, {WHY}"),
+                )
+            });
+        }
         for (device, link) in links {
             if let Some(link) = link.filter(|l| !l.is_simulated()) {
                 v.at(device, |v| {

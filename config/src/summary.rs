@@ -54,10 +54,12 @@ fn station_summary(s: &Station) -> String {
         CameraDriver::Sim => "simulated".to_owned(),
         CameraDriver::V4l => "V4L2".to_owned(),
         CameraDriver::Nokhwa => "nokhwa".to_owned(),
+        CameraDriver::Indi => "INDI".to_owned(),
     };
     let device = match &c.device {
         Some(DeviceRef::Path(p)) => format!(" at {p}"),
         Some(DeviceRef::Index(i)) => format!(" #{i}"),
+        Some(DeviceRef::Indi { server, device }) => format!(" {device:?} on {server}"),
         None => String::new(),
     };
     let focal = c.intrinsics.focal.pixels(c.resolution.width);
@@ -94,7 +96,7 @@ fn station_summary(s: &Station) -> String {
                 o,
                 "  filters    {:?} on {}: {}",
                 w.protocol,
-                w.link.port,
+                w.place(),
                 slots.join(", ")
             );
         }

@@ -24,6 +24,17 @@ fn every_example_file_is_valid() {
     );
 }
 
+/// The INDI station and its plan (`examples/indi/`) are valid, and the plan
+/// runs on it.
+#[test]
+fn the_indi_station_runs_its_plan() {
+    let station = load_station(&example("indi/station.ron")).expect("valid INDI station");
+    let Ok(Document::Plan(plan)) = load(&example("indi/sky-day.ron")) else {
+        panic!("indi/sky-day.ron is a plan")
+    };
+    check_plan_on_station(&plan, &station).unwrap_or_else(|e| panic!("{e}"));
+}
+
 #[test]
 fn plans_run_on_every_station() {
     for station in ["sim-station.ron", "real-station.ron", "sky-sim-station.ron"] {

@@ -9,7 +9,9 @@ use std::time::Instant;
 use anyhow::Context;
 use campanile_capture::clock::SystemClock;
 use campanile_capture::controller::{self, Progress, RunError, RunOptions, RunReport};
-use campanile_capture::station::{SerialOpener, StationOptions, StationRig, check_ports, driver_built, open_camera};
+use campanile_capture::station::{
+    SerialOpener, StationOptions, StationRig, check_ports, driver_built, open_camera, open_station_camera,
+};
 use campanile_capture::store::fault::QuotaStorage;
 use campanile_capture::store::{FsStorage, JournalEntry, SessionStore, Storage};
 use campanile_sim::camera::CameraOptions;
@@ -123,7 +125,8 @@ pub fn run_real<S: Storage>(
         .build()
         .context("starting the runtime")?;
     runtime.block_on(async {
-        let camera = open_camera(&inputs.station.camera)
+        let camera = open_station_camera(&inputs.station.camera)
+            .await
             .with_context(|| format!("opening the camera of station {}", inputs.station_label))?;
         // Sequence numbers from the clock, so that a restarted program does
         // not reuse numbers a campanile-link device still remembers.

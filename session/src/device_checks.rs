@@ -13,6 +13,7 @@ use campanile_capture::driver::backoff::Backoff;
 use campanile_capture::station::camera::list_cameras;
 use campanile_capture::station::{
     SerialOpener, connect_head, connect_lights, connect_wheel, driver_built, light_channel, open_camera,
+    open_station_camera,
 };
 use campanile_config::Station;
 use campanile_config::camera::CameraDriver;
@@ -49,6 +50,83 @@ pub fn list(out: &mut dyn Write) -> Result<()> {
             out,
             "note: built without the `v4l` feature: cameras are the /dev/video* nodes, named from /sys; \
              rebuild with `--features v4l` to open them"
+        )?;
+    }
+    Ok(())
+}
+
+/// What INDI's `DRIVER_INTERFACE` bits say a device is (INDI's
+/// `DeviceInterface`), by bit.
+const INDI_INTERFACES: [(u32, &str); 16] = [
+    (0, "telescope"),
+    (1, "CCD"),
+    (2, "guider"),
+    (3, "focuser"),
+    (4, "filter wheel"),
+    (5, "dome"),
+    (6, "GPS"),
+    (7, "weather"),
+    (8, "adaptive optics"),
+    (9, "dust cap"),
+    (10, "light box"),
+    (11, "detector"),
+    (12, "rotator"),
+    (13, "spectrograph"),
+    (14, "correlator"),
+    (15, "auxiliary"),
+];
+
+/// Writes the devices the INDI server at `server` offers to `out`: each
+/// with its driver and what it is (a `CCD` is a station camera, a `filter
+/// wheel` a station wheel).
+pub fn list_indi(server: &str, out: &mut dyn Write) -> Result<()> {
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .context("starting the runtime")?;
+    let devices = runtime.block_on(async {
+        let client = campanile_capture::driver::indi::IndiClient::connect(server).await?;
+        client
+            .settled(Duration::from_millis(500), Duration::from_secs(10))
+            .await;
+        Ok::<_, campanile_capture::device::DeviceError>(
+            client
+                .devices()
+                .into_iter()
+                .map(|d| {
+                    let info = client.property(&d, "DRIVER_INFO");
+                    let exec = info
+                        .as_ref()
+                        .and_then(|p| p.item("DRIVER_EXEC").map(|i| i.value.clone()));
+                    let bits = info
+                        .as_ref()
+                        .and_then(|p| p.number("DRIVER_INTERFACE"))
+                        .map_or(0, |x| x as u32);
+                    let kinds: Vec<&str> = INDI_INTERFACES
+                        .iter()
+                        .filter(|(bit, _)| bits & (1 << bit) != 0)
+                        .map(|(_, k)| *k)
+                        .collect();
+                    (d, exec, kinds)
+                })
+                .collect::<Vec<_>>(),
+        )
+    });
+    let devices = devices.with_context(|| format!("listing the devices of INDI server {server}"))?;
+    writeln!(out, "INDI server {server}:")?;
+    if devices.is_empty() {
+        writeln!(out, "  (no devices)")?;
+    }
+    for (name, exec, kinds) in devices {
+        writeln!(
+            out,
+            "  {name:?}  {}{}",
+            if kinds.is_empty() {
+                "general".to_owned()
+            } else {
+                kinds.join(", ")
+            },
+            exec.map_or(String::new(), |e| format!(" ({e})"))
         )?;
     }
     Ok(())
@@ -100,6 +178,13 @@ pub fn write_outcomes(outcomes: &[(String, Outcome)], out: &mut dyn Write) -> Re
     Ok((checks, failed))
 }
 
+fn wheel_label(w: &campanile_config::FilterWheel) -> String {
+    match &w.indi {
+        Some(i) => format!("filter wheel (INDI {:?} on {})", i.device, i.server),
+        None => label("filter wheel", w.protocol, &w.place()),
+    }
+}
+
 fn label(kind: &str, protocol: impl std::fmt::Debug, port: &str) -> String {
     format!("{kind} ({protocol:?} on {port})")
 }
@@ -137,7 +222,7 @@ fn test_real(station: &Station, head_options: conformance::pan_tilt::Options) ->
             })
             .await;
             out.push((
-                label("filter wheel", w.protocol, &w.link.port),
+                wheel_label(w),
                 match wheel {
                     Ok(mut wheel) => Outcome::Tested(conformance::filter_wheel::run(&mut wheel).await),
                     Err(e) => Outcome::Failed(e.to_string()),
@@ -163,10 +248,13 @@ fn test_real(station: &Station, head_options: conformance::pan_tilt::Options) ->
         let camera_label = match &cam.device {
             Some(campanile_config::camera::DeviceRef::Path(p)) => format!("camera ({:?} on {p})", cam.driver),
             Some(campanile_config::camera::DeviceRef::Index(i)) => format!("camera ({:?} number {i})", cam.driver),
+            Some(campanile_config::camera::DeviceRef::Indi { server, device }) => {
+                format!("camera (INDI {device:?} on {server})")
+            }
             None => format!("camera ({:?}, its first device)", cam.driver),
         };
         let outcome = if cam.driver != CameraDriver::Sim && driver_built(cam.driver) {
-            match open_camera(cam) {
+            match open_station_camera(cam).await {
                 Ok(mut camera) => Outcome::Tested(conformance::camera::run(&mut camera).await),
                 Err(e) => Outcome::Failed(e.to_string()),
             }
@@ -205,7 +293,7 @@ fn test_simulated(station: &Station, head_options: conformance::pan_tilt::Option
         ));
         if let (Some(w), Some(wheel)) = (&station.filter_wheel, sim.wheel.as_mut()) {
             out.push((
-                label("filter wheel", w.protocol, &w.link.port),
+                wheel_label(w),
                 Outcome::Tested(conformance::filter_wheel::run(wheel).await),
             ));
         }

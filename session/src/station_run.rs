@@ -10,7 +10,9 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use campanile_capture::clock::SystemClock;
 use campanile_capture::controller::NoProgress;
-use campanile_capture::station::{SerialOpener, StationOptions as RigOptions, StationRig, check_ports, open_camera};
+use campanile_capture::station::{
+    SerialOpener, StationOptions as RigOptions, StationRig, check_ports, open_station_camera,
+};
 use campanile_capture::store::{JournalEntry, SessionReader};
 use campanile_capture::unattended::day_rollover::existing_days;
 use campanile_capture::unattended::{
@@ -161,7 +163,8 @@ pub fn run_real(
     runtime.block_on(async {
         let stop = StopHandle::new();
         listen(&stop)?;
-        let camera = open_camera(&inputs.station.camera)
+        let camera = open_station_camera(&inputs.station.camera)
+            .await
             .with_context(|| format!("opening the camera of station {}", inputs.station_label))?;
         let link_seq = (Utc::now().timestamp_subsec_micros() % 4096) as u16 + 1;
         let rig_options = RigOptions {

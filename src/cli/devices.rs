@@ -17,16 +17,22 @@ use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
 ///
 /// Without a subcommand: the serial ports the system lists (through /sys)
 /// and the cameras (through V4L2 when built with the `v4l` feature,
-/// otherwise the /dev/video* nodes named from /sys).
+/// otherwise the /dev/video* nodes named from /sys); with --indi, the
+/// devices an INDI server offers (a CCD is a station camera, a filter wheel
+/// a station wheel: `driver: Indi, device: Indi(server: …, device: …)`).
 ///
 /// Examples:
 ///   campanile devices
+///   campanile devices --indi 127.0.0.1:7624
 ///   campanile devices test --station examples/real-station.ron
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment, args_conflicts_with_subcommands = true)]
 pub struct DevicesArgs {
     #[command(subcommand)]
     action: Option<DevicesCommand>,
+    /// List the devices of the INDI server at HOST:PORT instead.
+    #[arg(long, value_name = "HOST:PORT")]
+    indi: Option<String>,
 }
 
 #[derive(Debug, Subcommand)]
@@ -66,7 +72,10 @@ struct TestArgs {
 pub fn run(args: DevicesArgs) -> Result<u8> {
     let out = &mut std::io::stdout();
     let Some(DevicesCommand::Test(args)) = args.action else {
-        device_checks::list(out)?;
+        match &args.indi {
+            Some(server) => device_checks::list_indi(server, out)?,
+            None => device_checks::list(out)?,
+        }
         return Ok(EXIT_OK);
     };
     let station = match load_station(&args.station) {

@@ -20,11 +20,14 @@ pub enum FrameFormat {
     /// A DNG RAW file (read as a linear frame: black level removed, white
     /// level the largest code, clipped samples flagged).
     Dng,
+    /// A FITS image as astronomical cameras send it (an INDI `CCD1` BLOB):
+    /// integer codes, the camera's header kept in the file.
+    Fits,
 }
 
 impl FrameFormat {
     /// Every format, for listing.
-    pub const ALL: [FrameFormat; 3] = [FrameFormat::Png, FrameFormat::Jpeg, FrameFormat::Dng];
+    pub const ALL: [FrameFormat; 4] = [FrameFormat::Png, FrameFormat::Jpeg, FrameFormat::Dng, FrameFormat::Fits];
 
     /// The file name extension the store gives it (no dot).
     pub fn extension(self) -> &'static str {
@@ -32,6 +35,7 @@ impl FrameFormat {
             FrameFormat::Png => "png",
             FrameFormat::Jpeg => "jpg",
             FrameFormat::Dng => "dng",
+            FrameFormat::Fits => "fits",
         }
     }
 
@@ -41,6 +45,7 @@ impl FrameFormat {
             FrameFormat::Png => "PNG",
             FrameFormat::Jpeg => "JPEG",
             FrameFormat::Dng => "DNG",
+            FrameFormat::Fits => "FITS",
         }
     }
 
@@ -52,6 +57,7 @@ impl FrameFormat {
             FrameFormat::Png => bytes.starts_with(b"\x89PNG\r\n\x1a\n"),
             FrameFormat::Jpeg => bytes.starts_with(&[0xFF, 0xD8, 0xFF]),
             FrameFormat::Dng => bytes.starts_with(b"II*\0") || bytes.starts_with(b"MM\0*"),
+            FrameFormat::Fits => bytes.starts_with(b"SIMPLE  ="),
         };
         (!ok).then(|| {
             let head: Vec<String> = bytes.iter().take(8).map(|b| format!("{b:02x}")).collect();
@@ -59,6 +65,7 @@ impl FrameFormat {
                 FrameFormat::Png => "the PNG signature 89 50 4e 47 0d 0a 1a 0a",
                 FrameFormat::Jpeg => "the JPEG start of image ff d8 ff",
                 FrameFormat::Dng => "a TIFF header (49 49 2a 00 or 4d 4d 00 2a)",
+                FrameFormat::Fits => "the FITS card \"SIMPLE  =\" (53 49 4d 50 4c 45 20 20 3d)",
             };
             format!(
                 "{} bytes starting [{}], expected {expected} for a {} file",

@@ -12,6 +12,7 @@
 //! | [`enttec::DmxLights`] | Enttec DMX USB Pro | `Lights` |
 //! | `v4l2::V4l2Camera` (feature `v4l`) | V4L2 | `Camera`, through [`camera_thread`] |
 //! | `nokhwa_camera::NokhwaCamera` (feature `nokhwa`) | nokhwa (V4L2 backend) | `Camera`, through [`camera_thread`] |
+//! | [`indi::IndiCamera`], [`indi::IndiWheel`] | INDI over TCP (`indiserver`) | `Camera`, `FilterWheel` |
 //!
 //! The cameras share [`exposure_control`] (V4L2 exposure and gain
 //! controls) and [`pixel_format`] (buffers to RGB codes), which need no
@@ -27,6 +28,7 @@ pub mod enttec;
 pub mod exposure_control;
 pub mod flir_ptu;
 pub mod fw102c;
+pub mod indi;
 pub mod link;
 #[cfg(feature = "nokhwa")]
 pub mod nokhwa_camera;

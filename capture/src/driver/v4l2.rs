@@ -90,7 +90,8 @@ fn device_name(device: Option<&DeviceRef>) -> String {
     match device {
         Some(DeviceRef::Path(p)) => p.clone(),
         Some(DeviceRef::Index(i)) => format!("/dev/video{i}"),
-        None => "/dev/video0".to_owned(),
+        // An INDI device names no local camera (the config refuses it here).
+        None | Some(DeviceRef::Indi { .. }) => "/dev/video0".to_owned(),
     }
 }
 

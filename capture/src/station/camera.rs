@@ -1,8 +1,10 @@
 //! Opening the station's camera with the driver its config names, as far
 //! as this build has it (the V4L2 and nokhwa drivers are cargo features).
 
-use crate::device::DeviceError;
+use crate::device::{Camera, CameraInfo, CaptureSettings, DeviceError, Frame};
 use crate::driver::camera_thread::ThreadedCamera;
+use crate::driver::indi::IndiCamera;
+use campanile_config::camera::DeviceRef;
 use campanile_config::camera::{Camera as CameraConfig, CameraDriver};
 
 /// The camera `config` describes, open on its own thread; a clear error if
@@ -14,6 +16,50 @@ pub fn open_camera(config: &CameraConfig) -> Result<ThreadedCamera, DeviceError>
         )),
         CameraDriver::V4l => open_v4l(config),
         CameraDriver::Nokhwa => open_nokhwa(config),
+        CameraDriver::Indi => Err(DeviceError::Camera(
+            "an INDI camera is opened over the network: open_station_camera".into(),
+        )),
+    }
+}
+
+/// A real station's camera, whichever driver its config names.
+pub enum StationCamera {
+    /// A V4L2 or nokhwa camera on its own thread.
+    Threaded(ThreadedCamera),
+    /// An INDI CCD.
+    Indi(Box<IndiCamera>),
+}
+
+impl Camera for StationCamera {
+    fn info(&self) -> CameraInfo {
+        match self {
+            StationCamera::Threaded(c) => c.info(),
+            StationCamera::Indi(c) => c.info(),
+        }
+    }
+
+    async fn capture(&mut self, settings: CaptureSettings) -> Result<Frame, DeviceError> {
+        match self {
+            StationCamera::Threaded(c) => c.capture(settings).await,
+            StationCamera::Indi(c) => c.capture(settings).await,
+        }
+    }
+}
+
+/// The camera `config` describes: an INDI CCD over the network (its frame
+/// the configured resolution), or a V4L2 or nokhwa camera on its thread.
+pub async fn open_station_camera(config: &CameraConfig) -> Result<StationCamera, DeviceError> {
+    match (&config.driver, &config.device) {
+        (CameraDriver::Indi, Some(DeviceRef::Indi { server, device })) => {
+            let resolution = (config.resolution.width, config.resolution.height);
+            Ok(StationCamera::Indi(Box::new(
+                IndiCamera::open(server, device, Some(resolution)).await?,
+            )))
+        }
+        (CameraDriver::Indi, _) => Err(DeviceError::Camera(
+            "the Indi driver needs `device: Indi(server: \"host:port\", device: \"NAME\")`".into(),
+        )),
+        _ => open_camera(config).map(StationCamera::Threaded),
     }
 }
 
@@ -23,7 +69,7 @@ pub fn driver_built(driver: CameraDriver) -> bool {
     match driver {
         CameraDriver::V4l => cfg!(feature = "v4l"),
         CameraDriver::Nokhwa => cfg!(feature = "nokhwa"),
-        CameraDriver::Sim => true,
+        CameraDriver::Sim | CameraDriver::Indi => true,
     }
 }
 

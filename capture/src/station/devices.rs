@@ -29,6 +29,8 @@ pub enum AnyWheel<T> {
     Fw102c(Fw102cWheel<T>),
     /// campanile-link.
     Link(LinkController<T>),
+    /// A filter wheel on an INDI server.
+    Indi(crate::driver::indi::IndiWheel),
 }
 
 /// A light controller of any supported protocol. (One of each exists per
@@ -76,15 +78,15 @@ impl<T: AsyncRead + AsyncWrite + Unpin + Send> PanTilt for AnyHead<T> {
 
 impl<T: AsyncRead + AsyncWrite + Unpin + Send> FilterWheel for AnyWheel<T> {
     fn slots(&self) -> u8 {
-        each!(self, w => w.slots(), Fw102c, Link)
+        each!(self, w => w.slots(), Fw102c, Link, Indi)
     }
 
     async fn select(&mut self, slot: u8) -> Result<(), DeviceError> {
-        each!(self, w => w.select(slot).await, Fw102c, Link)
+        each!(self, w => w.select(slot).await, Fw102c, Link, Indi)
     }
 
     async fn current(&mut self) -> Result<u8, DeviceError> {
-        each!(self, w => w.current().await, Fw102c, Link)
+        each!(self, w => w.current().await, Fw102c, Link, Indi)
     }
 }
 

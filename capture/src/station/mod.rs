@@ -23,7 +23,7 @@ pub mod camera;
 pub mod devices;
 pub mod port;
 
-pub use camera::{driver_built, open_camera};
+pub use camera::{StationCamera, driver_built, open_camera, open_station_camera};
 pub use devices::{AnyHead, AnyLights, AnyWheel};
 pub use port::{PortOpener, SerialOpener};
 
@@ -33,6 +33,7 @@ use crate::driver::backoff::{Backoff, reopen};
 use crate::driver::enttec::DmxLights;
 use crate::driver::flir_ptu::FlirHead;
 use crate::driver::fw102c::Fw102cWheel;
+use crate::driver::indi::IndiWheel;
 use crate::driver::link::LinkController;
 use crate::driver::pelco_d::PelcoHead;
 use campanile_config::Station;
@@ -112,8 +113,8 @@ fn link_error(e: std::io::Error) -> DeviceError {
 /// The configured ports, checked: real, and one per device.
 pub fn check_ports(station: &Station) -> Result<(), StationError> {
     let mut ports: Vec<(DeviceKind, &SerialLink)> = vec![(DeviceKind::Head, &station.head.link)];
-    if let Some(w) = &station.filter_wheel {
-        ports.push((DeviceKind::Wheel, &w.link));
+    if let Some(link) = station.filter_wheel.as_ref().and_then(|w| w.link.as_ref()) {
+        ports.push((DeviceKind::Wheel, link));
     }
     if let Some(l) = &station.lights {
         ports.push((DeviceKind::Lights, &l.link));
@@ -177,10 +178,21 @@ pub async fn connect_wheel<O: PortOpener>(
     link_retry: RetryPolicy,
     link_seq: u16,
 ) -> Result<AnyWheel<O::Port>, DeviceError> {
-    let io = opener.open(&cfg.link).await.map_err(link_error)?;
+    if let (WheelProtocol::Indi, Some(indi)) = (cfg.protocol, &cfg.indi) {
+        return Ok(AnyWheel::Indi(IndiWheel::open(&indi.server, &indi.device).await?));
+    }
+    let link = cfg.link.as_ref().ok_or_else(|| {
+        link_error(std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            "the filter wheel has no serial link configured",
+        ))
+    })?;
+    let io = opener.open(link).await.map_err(link_error)?;
     Ok(match cfg.protocol {
         WheelProtocol::Fw102c => AnyWheel::Fw102c(Fw102cWheel::connect(io).await?),
-        WheelProtocol::CampanileLink => AnyWheel::Link(LinkController::connect(io, link_retry, link_seq).await?),
+        WheelProtocol::CampanileLink | WheelProtocol::Indi => {
+            AnyWheel::Link(LinkController::connect(io, link_retry, link_seq).await?)
+        }
     })
 }
 
@@ -242,22 +254,19 @@ impl<O: PortOpener, C: Camera> StationRig<O, C> {
                 .link_seq
                 .wrapping_add(connections.wrapping_sub(1).wrapping_mul(4096))
         };
-        let fail = |device, link: &SerialLink| {
-            let port = link.port.clone();
-            move |source| StationError::Connect { device, port, source }
-        };
+        let fail = |device, port: String| move |source| StationError::Connect { device, port, source };
         let (retry, backoff) = (options.link_retry, options.backoff);
         let s = seq();
         let head = reopen("head", backoff, || connect_head(&station.head, &opener, retry, s))
             .await
-            .map_err(fail(DeviceKind::Head, &station.head.link))?;
+            .map_err(fail(DeviceKind::Head, station.head.link.port.clone()))?;
         let wheel = match &station.filter_wheel {
             Some(cfg) => {
                 let s = seq();
                 Some(
                     reopen("filter wheel", backoff, || connect_wheel(cfg, &opener, retry, s))
                         .await
-                        .map_err(fail(DeviceKind::Wheel, &cfg.link))?,
+                        .map_err(fail(DeviceKind::Wheel, cfg.place()))?,
                 )
             }
             None => None,
@@ -268,7 +277,7 @@ impl<O: PortOpener, C: Camera> StationRig<O, C> {
                 Some(
                     reopen("lights", backoff, || connect_lights(cfg, &opener, retry, s))
                         .await
-                        .map_err(fail(DeviceKind::Lights, &cfg.link))?,
+                        .map_err(fail(DeviceKind::Lights, cfg.link.port.clone()))?,
                 )
             }
             None => None,

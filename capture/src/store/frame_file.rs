@@ -11,7 +11,7 @@
 use super::error::StoreError;
 use crate::device::{Frame, FrameFormat};
 use campanile_process::camera::image::CodeImage;
-use campanile_process::hdr::{HdrError, image_file, linear_codes, raw_file};
+use campanile_process::hdr::{HdrError, fits_file, image_file, linear_codes, raw_file};
 use image::codecs::png::{CompressionType, FilterType, PngDecoder, PngEncoder};
 use image::{ColorType, DynamicImage, ImageBuffer, ImageDecoder, Rgb};
 use std::io::Cursor;
@@ -153,7 +153,9 @@ pub(crate) fn read_checked_bytes<S: Storage + ?Sized>(
 ///   by the EXIF orientation;
 /// - DNG ([`raw_file::read_raw_bytes`]): the linear frame (black level
 ///   removed, white level 1, clipped samples flagged) as the logarithmic
-///   16-bit codes of [`linear_codes`], whose response is known.
+///   16-bit codes of [`linear_codes`], whose response is known;
+/// - FITS ([`fits_file::read_fits`]): the integer codes, `bits` (from the
+///   journal: the camera's stated depth) significant bits.
 ///
 /// A file that does not decode is [`StoreError::BadFrameFile`] naming it.
 pub fn decode_frame(path: &Path, bytes: &[u8], format: FrameFormat, bits: u8) -> Result<CodeImage, StoreError> {
@@ -175,6 +177,16 @@ pub fn decode_frame(path: &Path, bytes: &[u8], format: FrameFormat, bits: u8) ->
         FrameFormat::Dng => raw_file::read_raw_bytes(path, bytes.to_vec())
             .map(|frame| linear_codes::log_codes(&frame))
             .map_err(bad),
+        FrameFormat::Fits => fits_file::read_fits(bytes, &path.display().to_string())
+            .map(|f| {
+                let mut image = f.image;
+                image.bits = bits;
+                image
+            })
+            .map_err(|e| StoreError::BadFrameFile {
+                path: path.to_path_buf(),
+                reason: format!("not a readable FITS frame: {}", e.reason),
+            }),
     }
 }
 

@@ -91,6 +91,28 @@ pub struct FrameMeta {
     pub late_by_s: Option<f64>,
     /// Free-form notes (e.g. "late by 12 s: head stalled").
     pub notes: Vec<String>,
+    /// The camera's own report with the frame, when it sent one: its FITS
+    /// header's valued cards as `KEYWORD = value` (an INDI camera's
+    /// `EXPTIME`, `DATE-OBS`, `CCD-TEMP`, `INSTRUME`, …).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub camera_report: Vec<String>,
+}
+
+/// The header cards of a frame the camera delivered as FITS.
+fn camera_report(frame: &crate::device::Frame) -> Vec<String> {
+    match &frame.file {
+        Some(f) if f.format == crate::device::FrameFormat::Fits => {
+            campanile_process::hdr::fits_file::read_header(&f.bytes, "frame")
+                .map(|(cards, _)| {
+                    cards
+                        .into_iter()
+                        .map(|c| format!("{} = {}", c.keyword, c.value))
+                        .collect()
+                })
+                .unwrap_or_default()
+        }
+        _ => Vec::new(),
+    }
 }
 
 impl FrameMeta {
@@ -111,6 +133,7 @@ impl FrameMeta {
             temperature_c: frame.temperature_c,
             late_by_s: None,
             notes: Vec::new(),
+            camera_report: camera_report(frame),
         }
     }
 

@@ -39,6 +39,7 @@ pub mod dng_file;
 pub mod error;
 pub mod exposure_codes;
 pub mod exposure_metadata;
+pub mod fits_file;
 pub mod image_file;
 pub mod lens;
 pub mod linear_codes;

@@ -35,7 +35,15 @@ impl WheelPort {
             .ok()
             .filter(|n| (1..=12).contains(n))
             .ok_or_else(|| SimError::Unsupported(format!("a filter wheel with {} slots", cfg.slots.len())))?;
-        let name = cfg.link.port.as_str();
+        let name = match (&cfg.link, cfg.protocol) {
+            (Some(link), WheelProtocol::CampanileLink | WheelProtocol::Fw102c) => link.port.as_str(),
+            _ => {
+                return Err(SimError::Unsupported(format!(
+                    "a filter wheel at {}: the simulator emulates serial wheels on `sim:` ports",
+                    cfg.place()
+                )));
+            }
+        };
         Ok(match cfg.protocol {
             WheelProtocol::CampanileLink => WheelPort::Link(DevicePort::new(
                 name,
@@ -48,7 +56,7 @@ impl WheelPort {
                 faults,
                 Purpose::WheelLink,
             )),
-            WheelProtocol::Fw102c => WheelPort::Fw102c(DevicePort::new(
+            WheelProtocol::Fw102c | WheelProtocol::Indi => WheelPort::Fw102c(DevicePort::new(
                 name,
                 WheelDevice::new(if n <= 6 { 6 } else { 12 }),
                 tick,

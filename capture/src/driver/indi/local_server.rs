@@ -1,0 +1,92 @@
+//! An `indiserver` of INDI's own (Debian's `indi-bin`) run by this
+//! process on a free loopback port with the drivers asked for, and stopped
+//! by its PID when dropped: how the tests meet real INDI software, and how
+//! a user can try a station on INDI's simulators.
+
+use std::net::TcpListener;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// A running `indiserver`, killed (by PID) and reaped on drop.
+#[derive(Debug)]
+pub struct LocalServer {
+    child: Option<Child>,
+    port: u16,
+}
+
+impl LocalServer {
+    /// Starts `indiserver` with `drivers` (e.g. `indi_simulator_ccd`) on a
+    /// free loopback port, waiting until it listens.
+    pub fn start(drivers: &[&str]) -> Result<LocalServer, String> {
+        let port = TcpListener::bind("127.0.0.1:0")
+            .and_then(|l| l.local_addr())
+            .map_err(|e| format!("finding a free port: {e}"))?
+            .port();
+        LocalServer::start_on(port, drivers)
+    }
+
+    /// Starts `indiserver` with `drivers` on `port`.
+    pub fn start_on(port: u16, drivers: &[&str]) -> Result<LocalServer, String> {
+        // Its own local (abstract) socket too: every indiserver binds
+        // /tmp/indiserver by default, so a second one would exit at once.
+        let child = Command::new("indiserver")
+            .arg("-p")
+            .arg(port.to_string())
+            .arg("-u")
+            .arg(format!("/tmp/campanile-indiserver-{port}"))
+            .args(drivers)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .map_err(|e| {
+                format!(
+                    "cannot start indiserver ({e}): INDI's server and simulators come with Debian's indi-bin \
+                     (`sudo apt-get install indi-bin`; .ci/run installs it)"
+                )
+            })?;
+        let mut server = LocalServer {
+            child: Some(child),
+            port,
+        };
+        let deadline = Instant::now() + Duration::from_secs(15);
+        while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+            if let Some(Ok(Some(status))) = server.child.as_mut().map(Child::try_wait) {
+                return Err(format!("indiserver on port {port} exited at once ({status})"));
+            }
+            if Instant::now() > deadline {
+                return Err(format!("indiserver did not listen on port {port} within 15 s"));
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        Ok(server)
+    }
+
+    /// Its port.
+    pub fn port(&self) -> u16 {
+        self.port
+    }
+
+    /// Its address, `127.0.0.1:PORT`.
+    pub fn address(&self) -> String {
+        format!("127.0.0.1:{}", self.port)
+    }
+
+    /// Its process id.
+    pub fn pid(&self) -> Option<u32> {
+        self.child.as_ref().map(Child::id)
+    }
+
+    /// Kills the server (and so its drivers' pipes) and reaps it.
+    pub fn stop(&mut self) {
+        if let Some(mut child) = self.child.take() {
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+    }
+}
+
+impl Drop for LocalServer {
+    fn drop(&mut self) {
+        self.stop();
+    }
+}

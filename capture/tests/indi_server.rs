@@ -1,0 +1,325 @@
+//! The INDI camera and filter wheel against a real `indiserver` running
+//! INDI's own CCD and filter-wheel simulators (Debian's `indi-bin`, which
+//! `.ci/run` installs): the conformance suites, the frames as stored and
+//! read back, the FITS header in the journal's metadata, and a server that
+//! goes away in the middle of an exposure and comes back.
+//!
+//! Each test starts its own server on a free loopback port and stops it by
+//! its PID when done.
+
+use std::time::Duration;
+
+use campanile_capture::conformance;
+use campanile_capture::device::{Camera, CaptureSettings, DeviceError, ExposureTime, FrameFormat, Gain};
+use campanile_capture::driver::backoff::{Backoff, reopen};
+use campanile_capture::driver::indi::{IndiCamera, IndiClient, IndiWheel, LocalServer};
+use campanile_capture::store::{FrameMeta, ShotKind, decode_frame};
+
+const CCD: &str = "CCD Simulator";
+const WHEEL: &str = "Filter Simulator";
+
+struct Server;
+
+impl Server {
+    fn start() -> LocalServer {
+        LocalServer::start(&["indi_simulator_ccd", "indi_simulator_wheel"]).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    fn start_on(port: u16) -> LocalServer {
+        LocalServer::start_on(port, &["indi_simulator_ccd", "indi_simulator_wheel"]).unwrap_or_else(|e| panic!("{e}"))
+    }
+}
+
+fn settings(seconds: f64) -> CaptureSettings {
+    CaptureSettings {
+        exposure: ExposureTime::from_seconds(seconds).unwrap(),
+        gain: Gain::UNITY,
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_ccd_simulator_passes_the_camera_suite() {
+    let server = Server::start();
+    let mut camera = IndiCamera::open(&server.address(), CCD, Some((256, 192)))
+        .await
+        .unwrap();
+    let info = camera.info();
+    assert_eq!((info.width, info.height, info.bits), (256, 192, 16));
+    assert!(info.model.contains("indi_simulator_ccd"), "{}", info.model);
+    let report = conformance::camera::run(&mut camera).await;
+    assert!(report.passed(), "{report}");
+    assert_eq!(report.checks.len(), 3);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_wheel_simulator_passes_the_wheel_suite() {
+    let server = Server::start();
+    let mut wheel = IndiWheel::open(&server.address(), WHEEL).await.unwrap();
+    use campanile_capture::device::FilterWheel;
+    assert_eq!(wheel.slots(), 8, "the INDI filter simulator has 8 slots");
+    let report = conformance::filter_wheel::run(&mut wheel).await;
+    assert!(report.passed(), "{report}");
+}
+
+/// A frame keeps the camera's FITS file byte for byte; the store decodes it
+/// to the very codes the driver delivered, and the journal's metadata
+/// carries the camera's header, whose exposure is the one reported.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn frames_keep_their_fits_file_and_header() {
+    let server = Server::start();
+    let mut camera = IndiCamera::open(&server.address(), CCD, Some((64, 48))).await.unwrap();
+    let frame = camera.capture(settings(0.25)).await.unwrap();
+    let file = frame.file.as_ref().expect("the FITS file");
+    assert_eq!(file.format, FrameFormat::Fits);
+    let decoded = decode_frame(
+        std::path::Path::new("f.fits"),
+        &file.bytes,
+        FrameFormat::Fits,
+        frame.bits,
+    )
+    .unwrap();
+    assert_eq!((decoded.width, decoded.height), (64, 48));
+    assert_eq!(
+        decoded.data, frame.data,
+        "the stored file decodes to the driver's codes"
+    );
+    assert!(
+        (frame.exposure_actual.seconds() - 0.25).abs() < 1e-9,
+        "{:?}",
+        frame.exposure_actual
+    );
+    let meta = FrameMeta::from_frame(&frame, ShotKind::Data);
+    let card = |k: &str| {
+        meta.camera_report
+            .iter()
+            .find(|c| c.starts_with(&format!("{k} = ")))
+            .cloned()
+    };
+    let exptime: f64 = card("EXPTIME").unwrap()["EXPTIME = ".len()..]
+        .replace('D', "E")
+        .parse()
+        .unwrap();
+    assert!((exptime - 0.25).abs() < 1e-9, "EXPTIME card {exptime}");
+    assert!(card("DATE-OBS").is_some(), "{:?}", meta.camera_report);
+    assert!(
+        card("NAXIS1").is_some_and(|c| c.ends_with("64")),
+        "{:?}",
+        meta.camera_report
+    );
+    // Consecutive captures count up.
+    let second = camera.capture(settings(0.1)).await.unwrap();
+    assert_eq!(second.sequence, frame.sequence + 1);
+}
+
+/// The server killed during an exposure: the capture fails as a link error
+/// (no hang, no panic, no frame); the camera reopened with backoff after the
+/// server is back on the same port takes the next frame.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_server_lost_mid_exposure_is_a_link_error_and_reopens() {
+    let mut server = Server::start();
+    let address = server.address();
+    let mut camera = IndiCamera::open(&address, CCD, Some((64, 48))).await.unwrap();
+    let exposing = tokio::spawn(async move {
+        let r = camera.capture(settings(5.0)).await;
+        (camera, r)
+    });
+    tokio::time::sleep(Duration::from_millis(800)).await;
+    server.stop();
+    let (_, result) = tokio::time::timeout(Duration::from_secs(20), exposing)
+        .await
+        .expect("the capture must end when the server goes away")
+        .unwrap();
+    match result {
+        Err(DeviceError::Link(e)) => assert!(e.to_string().contains(&address), "{e}"),
+        other => panic!("expected a link error, got {:?}", other.map(|f| f.sequence)),
+    }
+    let port = server.port();
+    let restarted = std::thread::spawn(move || {
+        std::thread::sleep(Duration::from_millis(1500));
+        Server::start_on(port)
+    });
+    let backoff = Backoff {
+        attempts: 8,
+        first: Duration::from_millis(250),
+        cap: Duration::from_secs(2),
+    };
+    let mut camera = reopen("INDI camera", backoff, || {
+        IndiCamera::open(&address, CCD, Some((64, 48)))
+    })
+    .await
+    .expect("reopened once the server is back");
+    let _server = restarted.join().unwrap();
+    let frame = camera.capture(settings(0.1)).await.unwrap();
+    assert_eq!((frame.width, frame.height), (64, 48));
+}
+
+/// What a server offers: its devices, for `campanile devices`.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_client_lists_the_servers_devices() {
+    let server = Server::start();
+    let client = IndiClient::connect(&server.address()).await.unwrap();
+    client.defined(CCD, "CONNECTION").await.unwrap();
+    client.defined(WHEEL, "CONNECTION").await.unwrap();
+    let devices = client.devices();
+    assert!(
+        devices.contains(&CCD.to_owned()) && devices.contains(&WHEEL.to_owned()),
+        "{devices:?}"
+    );
+    let e = IndiCamera::open(&server.address(), "No Such CCD", None)
+        .await
+        .err()
+        .unwrap();
+    let text = e.to_string();
+    assert!(
+        text.contains("no device \"No Such CCD\"") && text.contains(CCD),
+        "{text}"
+    );
+}
+
+/// The serial head of `examples/indi/station.ron` (/dev/ttyUSB0), a Pelco-D
+/// emulator behind an in-memory link, for the controller test.
+struct PelcoBench(std::sync::Mutex<Vec<campanile_firmware_link::emulator::Emulator<PelcoDevice>>>);
+
+use campanile_firmware_link::pelco_d::device::{PelcoConfig, PelcoDevice};
+
+impl campanile_capture::station::PortOpener for PelcoBench {
+    type Port = tokio::io::DuplexStream;
+
+    async fn open(&self, link: &campanile_config::link::SerialLink) -> std::io::Result<Self::Port> {
+        assert_eq!(link.port, "/dev/ttyUSB0", "only the head is serial");
+        let (host, dev) = campanile_firmware_link::transport::memory::duplex(4096);
+        let cfg = PelcoConfig {
+            speed: 90_000,
+            pan_range: (-18_000, 17_999),
+            ..PelcoConfig::default()
+        };
+        let emu =
+            campanile_firmware_link::emulator::Emulator::spawn(PelcoDevice::new(cfg), dev, Duration::from_millis(2));
+        self.0.lock().unwrap().push(emu);
+        Ok(host)
+    }
+}
+
+/// A plan run by the session controller on the wall clock through the INDI
+/// station's devices (the INDI CCD and filter wheel on a real server, the
+/// head emulated): every promised frame is stored as the camera's FITS
+/// file, with the filter asked for in place and the camera's header in the
+/// journal, and reads back through the session reader.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_plan_runs_through_the_controller_on_the_indi_station() {
+    use campanile_capture::clock::SystemClock;
+    use campanile_capture::controller::{self, NoProgress, RunOptions};
+    use campanile_capture::schedule::{TimelineOptions, timeline};
+    use campanile_capture::station::{StationOptions, StationRig};
+    use campanile_capture::store::{JournalEntry, Provenance, SessionReader, SessionStore, Snapshot};
+
+    let server = Server::start();
+    let example = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/indi/station.ron");
+    let text = std::fs::read_to_string(&example)
+        .unwrap()
+        .replace("127.0.0.1:7624", &server.address());
+    let tmp = tempfile::tempdir().unwrap();
+    let station_file = tmp.path().join("indi-station.ron");
+    std::fs::write(&station_file, &text).unwrap();
+    let station = campanile_config::load_station(&station_file).unwrap().value;
+    let start = chrono::Utc::now() + chrono::TimeDelta::seconds(3);
+    let plan_text = format!(
+        r#"Plan(
+    name: "indi test",
+    start_date: "{}",
+    sessions: [(
+        name: "one",
+        trigger: Clock(time: "{}"),
+        steps: [
+            Bracket(aim: PanTilt(pan_deg: 20.0, tilt_deg: 10.0), exposures_s: [0.01, 0.04, 0.16],
+                    filter: Some("nd1"), on_error: (retries: 2, then: Continue)),
+            Bracket(aim: PanTilt(pan_deg: 40.0, tilt_deg: 30.0), exposures_s: [0.02, 0.08],
+                    filter: Some("clear"), on_error: (retries: 2, then: Continue)),
+        ],
+    )],
+)"#,
+        start.format("%Y-%m-%d"),
+        start.format("%H:%M:%S")
+    );
+    let plan: campanile_config::Plan = ron::from_str(&plan_text).unwrap();
+    let t = timeline(&plan, &station, None, &TimelineOptions { days: Some(1) }).unwrap();
+    assert_eq!(t.frames_promised(), 5, "{:?}", t.uncovered);
+    let camera = campanile_capture::station::open_station_camera(&station.camera)
+        .await
+        .unwrap();
+    let bench = PelcoBench(std::sync::Mutex::new(Vec::new()));
+    let mut rig = StationRig::connect(&station, bench, camera, StationOptions::default())
+        .await
+        .unwrap();
+    let snapshot = Snapshot {
+        plan_ron: plan_text.clone(),
+        station_ron: text.clone(),
+        scene_ron: None,
+        provenance: Provenance {
+            campanile_version: "test".into(),
+            created_utc: chrono::DateTime::default(),
+            calibration: Vec::new(),
+            sources: None,
+        },
+    };
+    let dir = tmp.path().join("session");
+    let mut store = SessionStore::create(&dir, snapshot).unwrap();
+    let report = controller::run(
+        &t,
+        &plan,
+        &station,
+        &mut store,
+        &mut rig,
+        &SystemClock,
+        &RunOptions::default(),
+        &mut NoProgress,
+    )
+    .await
+    .unwrap();
+    assert_eq!((report.frames, report.missed), (5, 0), "{report:?}");
+    let frames: Vec<_> = store
+        .entries()
+        .iter()
+        .filter_map(|e| match e {
+            JournalEntry::Done(f) | JournalEntry::Late(f) => Some(f.clone()),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(frames.len(), 5, "{:?}", store.entries());
+    for f in &frames {
+        assert_eq!(f.format, FrameFormat::Fits, "{}", f.key);
+        assert!(f.file.ends_with(".fits"), "{}", f.file);
+        let exptime = f
+            .meta
+            .camera_report
+            .iter()
+            .find_map(|c| c.strip_prefix("EXPTIME = "))
+            .and_then(|v| v.replace('D', "E").parse::<f64>().ok())
+            .unwrap_or_else(|| panic!("{}: no EXPTIME in {:?}", f.key, f.meta.camera_report));
+        assert!(
+            (exptime - f.meta.exposure_actual_s).abs() < 1e-9,
+            "{}: {exptime} vs {}",
+            f.key,
+            f.meta.exposure_actual_s
+        );
+        assert!(
+            (f.meta.exposure_actual_s - f.meta.exposure_requested_s).abs() < 1e-6,
+            "{}",
+            f.key
+        );
+        let wanted = if f.meta.exposure_requested_s > 0.015 && f.meta.exposure_requested_s < 0.03
+            || f.meta.exposure_requested_s > 0.07 && f.meta.exposure_requested_s < 0.1
+        {
+            "clear"
+        } else {
+            "nd1"
+        };
+        assert_eq!(f.meta.filter.as_deref(), Some(wanted), "{}", f.key);
+    }
+    drop(store);
+    let reader = SessionReader::open(&dir).unwrap();
+    for f in reader.frames() {
+        let image = reader.read_frame(f).unwrap();
+        assert_eq!((image.width, image.height), (256, 192), "{}", f.key);
+    }
+}
