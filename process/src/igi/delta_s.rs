@@ -23,10 +23,10 @@ use rayon::prelude::*;
 use super::geometry::{Geometry, SURFACE_OFFSET};
 use super::input::IgiInput;
 use super::observation::Observation;
-use super::radiosity::{REFLECTION_DEPTH, RadiosityField};
+use super::radiosity::{REFLECTION_DEPTH, RadiosityField, SurfaceLobe, surface_lobes};
 use super::specular_albedo::SpecularAlbedo;
 use super::stratified::Strata;
-use crate::brdf::{WardKernel, WardLobe, WardMaterial};
+use crate::brdf::{WardLobe, WardMaterial};
 use crate::render::Ray;
 
 /// `S_ind` per channel for every observation, with the lobe shape
@@ -44,15 +44,23 @@ pub(crate) fn indirect_specular(
     factor_max: u32,
     seed: u64,
 ) -> Vec<[f64; 3]> {
+    let lobes = surface_lobes(materials);
+    // Per surface: the lobe sampled (its shape) and the rays per sample.
+    let sampled: Vec<Option<(SurfaceLobe, u32)>> = shapes
+        .iter()
+        .enumerate()
+        .map(|(s, shape)| {
+            let factor = ray_factor(materials.get(s).copied().flatten().as_ref(), factor_max);
+            shape.map(|l| (SurfaceLobe::new(l), rays * factor))
+        })
+        .collect();
     observations
         .par_iter()
         .enumerate()
         .map(|(i, o)| {
-            let Some(lobe) = shapes.get(o.surface).copied().flatten() else {
+            let Some((SurfaceLobe { sampler, .. }, rays)) = sampled.get(o.surface).copied().flatten() else {
                 return [0.0; 3];
             };
-            let rays = rays * ray_factor(materials.get(o.surface).copied().flatten().as_ref(), factor_max);
-            let kernel = WardKernel::new(&lobe);
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             rng.set_stream(i as u64);
             let strata = Strata::new(rays, &mut rng);
@@ -60,14 +68,12 @@ pub(crate) fn indirect_specular(
             let origin = o.point + o.frame.normal * SURFACE_OFFSET * (1.0 + o.point.norm());
             for r in 0..rays {
                 let u = strata.point(r, &mut rng);
-                let Some(wi) = lobe.sample(&o.wo, u) else {
+                let Some(wi) = sampler.sample(&o.wo, u) else {
                     continue;
                 };
-                let pdf = lobe.pdf(&wi, &o.wo);
-                if !(pdf > 0.0 && pdf.is_finite()) {
+                let Some(weight) = sampler.weight(&wi, &o.wo) else {
                     continue;
-                }
-                let weight = kernel.eval(&wi, &o.wo) * wi.z / pdf;
+                };
                 let direction = o.frame.to_world(&wi);
                 let Some(hit) = geometry.intersect(&Ray { origin, direction }, f64::INFINITY) else {
                     continue;
@@ -75,7 +81,7 @@ pub(crate) fn indirect_specular(
                 let l = field.radiance_toward(
                     geometry,
                     input,
-                    materials,
+                    &lobes,
                     albedos,
                     hit.triangle,
                     &hit.point,
