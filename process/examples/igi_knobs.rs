@@ -4,7 +4,7 @@
 //! (`validation/igi`).
 //!
 //! `cargo run --release -p campanile-process --example igi_knobs -- SCENE OUT
-//! [cells_per_edge gather_rays lobe_rays iterations seed lobe_ray_factor_max]`
+//! [cells_per_edge gather_rays lobe_rays iterations seed lobe_ray_factor_max lobe_ray_block]`
 
 use campanile_process::brdf::WardVariant;
 use campanile_process::igi::material_record::{records, variant_name};
@@ -14,7 +14,7 @@ use campanile_process::igi::{IgiOptions, recover};
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if args.len() < 3 {
-        eprintln!("usage: igi_knobs SCENE OUT [cells gather lobe iterations seed factor]");
+        eprintln!("usage: igi_knobs SCENE OUT [cells gather lobe iterations seed factor block]");
         std::process::exit(2);
     }
     let knob = |i: usize, d: u64| args.get(i).and_then(|a| a.parse().ok()).unwrap_or(d);
@@ -35,6 +35,7 @@ fn main() {
         gather_rays: knob(4, 64) as u32,
         lobe_rays: knob(5, 16) as u32,
         lobe_ray_factor_max: knob(8, 1) as u32,
+        lobe_ray_block: knob(9, 1) as usize,
         iterations: knob(6, 4) as u32,
         seed: knob(7, 1),
         ..IgiOptions::default()

@@ -64,4 +64,4 @@ pub use quadrature::HemisphereQuadrature;
 pub use radiance_plastic::RadiancePlastic;
 pub use sample::Sample;
 pub use table_4_1::table_4_1;
-pub use ward::{MIN_ALPHA, WardKernel, WardLobe, WardVariant};
+pub use ward::{MIN_ALPHA, WardKernel, WardLobe, WardSampler, WardVariant};

@@ -139,12 +139,6 @@ impl WardLobe {
         self.alpha_x == self.alpha_y
     }
 
-    /// The exponent `E = tan²δ (cos²φ / αx² + sin²φ / αy²)` of eq. A.2 from
-    /// the (unnormalized) half vector `h` in the local frame, `hz > 0`.
-    fn exponent(&self, h: &Vector3<f64>) -> f64 {
-        WardKernel::new(self).exponent(h)
-    }
-
     /// The kernel `K(α, Θ)` of eq. A.1/A.2 in this lobe's variant (module
     /// table), sr⁻¹: the BRDF per unit ρs, which is what the linear
     /// least-squares step of eq. A.3 needs. Zero when either direction is
@@ -170,27 +164,7 @@ impl WardLobe {
     /// reflection falls at or below it (the density [`WardLobe::pdf`]
     /// counts those draws, so a path tracer scores them as zero).
     pub fn sample(&self, wo: &Vector3<f64>, u: [f64; 2]) -> Option<Vector3<f64>> {
-        if !above_horizon(wo) {
-            return None;
-        }
-        let (sp, cp) = (2.0 * PI * u[1]).sin_cos();
-        let (px, py) = (self.alpha_x * cp, self.alpha_y * sp);
-        let len = px.hypot(py);
-        let (cos_phi, sin_phi) = (px / len, py / len);
-        let a = cos_phi * cos_phi / (self.alpha_x * self.alpha_x) + sin_phi * sin_phi / (self.alpha_y * self.alpha_y);
-        // 1 − u₀ in (0, 1]; the floor keeps u₀ = 1 (outside the contract) finite.
-        let tan2 = -(1.0 - u[0]).max(f64::MIN_POSITIVE).ln() / a;
-        let cos_d = 1.0 / (1.0 + tan2).sqrt();
-        let sin_d = tan2.sqrt() * cos_d;
-        let (sg, cg) = self.gamma_rad.sin_cos();
-        let (lx, ly) = (sin_d * cos_phi, sin_d * sin_phi);
-        let h = Vector3::new(cg * lx - sg * ly, sg * lx + cg * ly, cos_d);
-        let wo_h = wo.dot(&h);
-        if wo_h.is_nan() || wo_h <= 0.0 {
-            return None;
-        }
-        let wi = h * (2.0 * wo_h) - wo;
-        (above_horizon(&wi) && wi.iter().all(|x| x.is_finite())).then_some(wi)
+        WardSampler::new(self).sample(wo, u)
     }
 
     /// The density of [`WardLobe::sample`] at `wi` given `wo`, per unit solid
@@ -200,19 +174,7 @@ impl WardLobe {
     /// that a draw reflects below the horizon (small except at grazing `wo`
     /// and large α).
     pub fn pdf(&self, wi: &Vector3<f64>, wo: &Vector3<f64>) -> f64 {
-        if !(above_horizon(wi) && above_horizon(wo)) {
-            return 0.0;
-        }
-        let h = wi + wo;
-        let g = (-self.exponent(&h)).exp();
-        if g == 0.0 {
-            return 0.0;
-        }
-        let len = h.norm();
-        let cos_d = h.z / len;
-        // wi·ĥ = |h| / 2 for unit directions; > 0 as both are above the horizon.
-        let wi_h = wi.dot(&h) / len;
-        g / (PI * self.alpha_x * self.alpha_y * cos_d * cos_d * cos_d * 4.0 * wi_h)
+        WardSampler::new(self).pdf(wi, wo)
     }
 
     /// The same lobe in another normalization, where an exact conversion
@@ -278,7 +240,12 @@ impl WardKernel {
             return 0.0;
         }
         let h = wi + wo;
-        let g = (-self.exponent(&h)).exp();
+        self.eval_with(wi, wo, &h, (-self.exponent(&h)).exp())
+    }
+
+    /// [`WardKernel::eval`] from `h = wi + wo` and `g = exp(−E)`, both
+    /// directions above the horizon.
+    fn eval_with(&self, wi: &Vector3<f64>, wo: &Vector3<f64>, h: &Vector3<f64>, g: f64) -> f64 {
         if g == 0.0 {
             return 0.0;
         }
@@ -291,6 +258,103 @@ impl WardKernel {
                 g * (h.norm_squared() / hz2) / (PI * axy * hz2)
             }
         }
+    }
+}
+
+/// [`WardLobe::sample`] and [`WardLobe::pdf`] with the lobe's constants
+/// (the kernel's, and the orientation's sine and cosine) worked out once,
+/// for drawing many directions from one lobe (the ray casting of inverse
+/// global illumination), and [`WardSampler::weight`], the sample's weight
+/// `K cos θi / p` with the exponential shared between the kernel and the
+/// density. The lobe's methods are this sampler built for one call, so
+/// both give the same numbers to the last bit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WardSampler {
+    kernel: WardKernel,
+    /// `(sin γ, cos γ)` of the lobe's orientation.
+    rotation: (f64, f64),
+    /// `αx²`, `αy²`.
+    alpha2: (f64, f64),
+}
+
+impl WardSampler {
+    /// The sampler of `lobe`.
+    pub fn new(lobe: &WardLobe) -> WardSampler {
+        WardSampler {
+            kernel: WardKernel::new(lobe),
+            rotation: lobe.gamma_rad.sin_cos(),
+            alpha2: (lobe.alpha_x * lobe.alpha_x, lobe.alpha_y * lobe.alpha_y),
+        }
+    }
+
+    /// The lobe's kernel evaluator.
+    pub fn kernel(&self) -> &WardKernel {
+        &self.kernel
+    }
+
+    /// [`WardLobe::sample`].
+    pub fn sample(&self, wo: &Vector3<f64>, u: [f64; 2]) -> Option<Vector3<f64>> {
+        if !above_horizon(wo) {
+            return None;
+        }
+        let (alpha_x, alpha_y) = (self.kernel.alpha_x, self.kernel.alpha_y);
+        let (sp, cp) = (2.0 * PI * u[1]).sin_cos();
+        let (px, py) = (alpha_x * cp, alpha_y * sp);
+        let len = px.hypot(py);
+        let (cos_phi, sin_phi) = (px / len, py / len);
+        let a = cos_phi * cos_phi / self.alpha2.0 + sin_phi * sin_phi / self.alpha2.1;
+        // 1 − u₀ in (0, 1]; the floor keeps u₀ = 1 (outside the contract) finite.
+        let tan2 = -(1.0 - u[0]).max(f64::MIN_POSITIVE).ln() / a;
+        let cos_d = 1.0 / (1.0 + tan2).sqrt();
+        let sin_d = tan2.sqrt() * cos_d;
+        let (sg, cg) = self.rotation;
+        let (lx, ly) = (sin_d * cos_phi, sin_d * sin_phi);
+        let h = Vector3::new(cg * lx - sg * ly, sg * lx + cg * ly, cos_d);
+        let wo_h = wo.dot(&h);
+        if wo_h.is_nan() || wo_h <= 0.0 {
+            return None;
+        }
+        let wi = h * (2.0 * wo_h) - wo;
+        (above_horizon(&wi) && wi.iter().all(|x| x.is_finite())).then_some(wi)
+    }
+
+    /// [`WardLobe::pdf`].
+    pub fn pdf(&self, wi: &Vector3<f64>, wo: &Vector3<f64>) -> f64 {
+        if !(above_horizon(wi) && above_horizon(wo)) {
+            return 0.0;
+        }
+        let h = wi + wo;
+        self.pdf_with(wi, &h, (-self.kernel.exponent(&h)).exp())
+    }
+
+    /// The density from the half vector `h = wi + wo` and `g = exp(−E)`.
+    fn pdf_with(&self, wi: &Vector3<f64>, h: &Vector3<f64>, g: f64) -> f64 {
+        if g == 0.0 {
+            return 0.0;
+        }
+        let len = h.norm();
+        let cos_d = h.z / len;
+        // wi·ĥ = |h| / 2 for unit directions; > 0 as both are above the horizon.
+        let wi_h = wi.dot(h) / len;
+        g / (PI * self.kernel.alpha_x * self.kernel.alpha_y * cos_d * cos_d * cos_d * 4.0 * wi_h)
+    }
+
+    /// The Monte Carlo weight of a direction `wi` drawn by
+    /// [`WardSampler::sample`] for `wo`: `K(wi, wo) cos θi / p(wi)`, or
+    /// `None` where the density is not positive and finite (such a draw
+    /// scores zero). The same number as `kernel.eval(wi, wo) * wi.z /
+    /// pdf(wi, wo)`, with one exponential instead of two.
+    pub fn weight(&self, wi: &Vector3<f64>, wo: &Vector3<f64>) -> Option<f64> {
+        if !(above_horizon(wi) && above_horizon(wo)) {
+            return None;
+        }
+        let h = wi + wo;
+        let g = (-self.kernel.exponent(&h)).exp();
+        let pdf = self.pdf_with(wi, &h, g);
+        if !(pdf > 0.0 && pdf.is_finite()) {
+            return None;
+        }
+        Some(self.kernel.eval_with(wi, wo, &h, g) * wi.z / pdf)
     }
 }
 

@@ -108,8 +108,10 @@ impl Geometry {
         let (u, v) = self.barycentric(tri, p);
         let n = self.n;
         let (x, y) = (u * n as f64, v * n as f64);
-        let i = ((x.floor().max(0.0)) as usize).min(n - 1);
-        let j = ((y.floor().max(0.0)) as usize).min(n - 1);
+        // `as` truncates toward zero and saturates (negative and NaN to 0):
+        // the floor clamped at 0, without a call to `floor`.
+        let i = (x as usize).min(n - 1);
+        let j = (y as usize).min(n - 1);
         let f = [(x - i as f64).clamp(0.0, 1.0), (y - j as f64).clamp(0.0, 1.0)];
         (tri * n * n + i * n + j, f)
     }

@@ -73,6 +73,13 @@ pub struct IgiOptions {
     /// not understood (BENCHMARKS.md), so only the command line's full
     /// setting uses it.
     pub lobe_ray_factor_max: u32,
+    /// ΔS rays shared between the pixels of a view's `b × b` blocks on
+    /// one triangle (`delta_s`: each pixel scores every ray of its block,
+    /// weighted by its own lobe over the density the ray was drawn from),
+    /// with the block's rays those of one pixel: the same noise per pixel
+    /// for about 1 / b² of the rays. 1 (the default): every pixel traces
+    /// its own rays alone.
+    pub lobe_ray_block: usize,
     /// At most this many samples per surface in the sparse set the
     /// roughness search uses (§4.5 footnote); the linear step uses all.
     pub sparse_samples: usize,
@@ -108,6 +115,7 @@ impl Default for IgiOptions {
             gather_rays: 256,
             lobe_rays: 16,
             lobe_ray_factor_max: 1,
+            lobe_ray_block: 1,
             sparse_samples: 2500,
             iterations: 3,
             max_view_angle_rad: 84f64.to_radians(),
@@ -135,6 +143,9 @@ impl IgiOptions {
         let err = |name, value: String, expected| Err(IgiError::Option { name, value, expected });
         if self.pixel_stride == 0 {
             return err("pixel_stride", "0".into(), "at least 1");
+        }
+        if self.lobe_ray_block == 0 {
+            return err("lobe_ray_block", "0".into(), "at least 1");
         }
         if !(1..=512).contains(&self.cells_per_edge) {
             return err("cells_per_edge", self.cells_per_edge.to_string(), "1 to 512");
@@ -346,6 +357,17 @@ mod tests {
             recover(&input(), &bad),
             Err(IgiError::Option {
                 name: "pixel_stride",
+                ..
+            })
+        ));
+        let bad = IgiOptions {
+            lobe_ray_block: 0,
+            ..opts
+        };
+        assert!(matches!(
+            recover(&input(), &bad),
+            Err(IgiError::Option {
+                name: "lobe_ray_block",
                 ..
             })
         ));

@@ -45,6 +45,9 @@ pub(crate) struct Observation {
     pub radiance: [f64; 3],
     /// Index of the view.
     pub view: usize,
+    /// Column and row of the pixel among the view's pixels used (every
+    /// `pixel_stride`-th).
+    pub pixel: [usize; 2],
     /// Direct light from each visible source.
     pub lights: Vec<LightTerm>,
     /// Direct irradiance, the sum of the terms.
@@ -188,6 +191,7 @@ pub(crate) fn observations(
                         wo,
                         radiance: [0, 1, 2].map(|c| f64::from(view.image.radiance(x, y, c))),
                         view: vi,
+                        pixel: [x / stride, y / stride],
                         lights,
                         e_direct,
                     });

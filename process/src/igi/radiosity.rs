@@ -30,7 +30,7 @@ use super::input::IgiInput;
 use super::observation::light_terms;
 use super::specular_albedo::SpecularAlbedo;
 use super::stratified::Strata;
-use crate::brdf::{WardKernel, WardMaterial, cosine_direction};
+use crate::brdf::{WardLobe, WardMaterial, WardSampler, cosine_direction};
 use crate::render::Ray;
 
 /// Glossy reflections followed per gather ray (module doc of
@@ -41,6 +41,34 @@ pub(crate) const REFLECTION_DEPTH: u32 = 1;
 /// side of the cell (a lamp 30 cm from a wall changes its irradiance
 /// several times across a 30 cm cell: the centre's value is not the mean).
 const DIRECT_POINTS: usize = 4;
+
+/// A surface's lobe with its sampler and kernel worked out once per pass
+/// for the ray casting ([`RadiosityField::radiance_toward`], ΔS).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SurfaceLobe {
+    /// The lobe.
+    pub lobe: WardLobe,
+    /// Its sampler (and kernel).
+    pub sampler: WardSampler,
+}
+
+impl SurfaceLobe {
+    /// The evaluators of `lobe`.
+    pub fn new(lobe: WardLobe) -> SurfaceLobe {
+        SurfaceLobe {
+            lobe,
+            sampler: WardSampler::new(&lobe),
+        }
+    }
+}
+
+/// Each surface's lobe under `materials` (`None`: diffuse or unknown).
+pub(crate) fn surface_lobes(materials: &[Option<WardMaterial>]) -> Vec<Option<SurfaceLobe>> {
+    materials
+        .iter()
+        .map(|m| m.and_then(|m| m.lobe).map(SurfaceLobe::new))
+        .collect()
+}
 
 /// Per-cell quantities of the radiosity solution.
 #[derive(Debug, Clone)]
@@ -149,10 +177,8 @@ impl RadiosityField {
             (f[0] * n - 0.5).clamp(0.0, n - 1.0),
             (f[1] * n - 0.5).clamp(0.0, n - 1.0),
         );
-        let (i0, j0) = (
-            (x.floor() as usize).min(DIRECT_POINTS - 2),
-            (y.floor() as usize).min(DIRECT_POINTS - 2),
-        );
+        // x, y ≥ 0: truncation is the floor.
+        let (i0, j0) = ((x as usize).min(DIRECT_POINTS - 2), (y as usize).min(DIRECT_POINTS - 2));
         let (fx, fy) = (x - i0 as f64, y - j0 as f64);
         let mut e = [0.0; 3];
         for (di, wx) in [(0, 1.0 - fx), (1, fx)] {
@@ -184,13 +210,14 @@ impl RadiosityField {
     /// doc). With `depth` > 0, the lobe's reflection of indirect light is
     /// estimated by one lobe-sampled ray (a glossy wall mirrors the bright
     /// patch under a lamp, not the average of its surroundings), recursively
-    /// with `depth − 1`; at depth 0 it is `a E_ind / π`.
+    /// with `depth − 1`; at depth 0 it is `a E_ind / π`. `lobes` are the
+    /// surfaces' lobes under the estimates ([`surface_lobes`]).
     #[allow(clippy::too_many_arguments)]
     pub fn radiance_toward(
         &self,
         geometry: &Geometry,
         input: &IgiInput,
-        materials: &[Option<WardMaterial>],
+        lobes: &[Option<SurfaceLobe>],
         albedos: &[Option<SpecularAlbedo>],
         tri: usize,
         y: &Vector3<f64>,
@@ -200,12 +227,12 @@ impl RadiosityField {
     ) -> [f64; 3] {
         let (cell, mut l) = self.diffuse_at(geometry, tri, y);
         let surface = geometry.triangles()[tri].surface as usize;
-        let Some(lobe) = materials.get(surface).and_then(|m| m.as_ref()).and_then(|m| m.lobe) else {
+        let Some(SurfaceLobe { lobe, sampler }) = lobes.get(surface).copied().flatten() else {
             return l;
         };
         let frame = geometry.frame(tri, toward);
         let wo = frame.to_local(toward);
-        let kernel = WardKernel::new(&lobe);
+        let kernel = sampler.kernel();
         let mut k = [0.0; 3];
         for &li in &self.visible[cell] {
             let light = &input.lights[li];
@@ -223,26 +250,24 @@ impl RadiosityField {
         let reflected = if depth > 0 {
             let mut r = [0.0; 3];
             let u = [rng.random::<f64>(), rng.random::<f64>()];
-            if let Some(wi) = lobe.sample(&wo, u) {
-                let pdf = lobe.pdf(&wi, &wo);
-                if pdf > 0.0 && pdf.is_finite() {
-                    let weight = kernel.eval(&wi, &wo) * wi.z / pdf;
-                    let direction = frame.to_world(&wi);
-                    let origin = y + frame.normal * SURFACE_OFFSET * (1.0 + y.norm());
-                    if let Some(hit) = geometry.intersect(&Ray { origin, direction }, f64::INFINITY) {
-                        let li = self.radiance_toward(
-                            geometry,
-                            input,
-                            materials,
-                            albedos,
-                            hit.triangle,
-                            &hit.point,
-                            &-direction,
-                            depth - 1,
-                            rng,
-                        );
-                        r = li.map(|v| v * weight);
-                    }
+            if let Some(wi) = sampler.sample(&wo, u)
+                && let Some(weight) = sampler.weight(&wi, &wo)
+            {
+                let direction = frame.to_world(&wi);
+                let origin = y + frame.normal * SURFACE_OFFSET * (1.0 + y.norm());
+                if let Some(hit) = geometry.intersect(&Ray { origin, direction }, f64::INFINITY) {
+                    let li = self.radiance_toward(
+                        geometry,
+                        input,
+                        lobes,
+                        albedos,
+                        hit.triangle,
+                        &hit.point,
+                        &-direction,
+                        depth - 1,
+                        rng,
+                    );
+                    r = li.map(|v| v * weight);
                 }
             }
             r
@@ -267,6 +292,7 @@ impl RadiosityField {
         rays: u32,
         seed: u64,
     ) {
+        let lobes = surface_lobes(materials);
         let e: Vec<[f64; 3]> = (0..geometry.cell_count())
             .into_par_iter()
             .map(|cell| {
@@ -298,7 +324,7 @@ impl RadiosityField {
                     let l = self.radiance_toward(
                         geometry,
                         input,
-                        materials,
+                        &lobes,
                         albedos,
                         hit.triangle,
                         &hit.point,

@@ -660,6 +660,7 @@ fn light_pass(
         shapes,
         options.lobe_rays,
         options.lobe_ray_factor_max,
+        options.lobe_ray_block,
         seed ^ 0x5555,
     );
     (gather_seconds, t.elapsed().as_secs_f64())

@@ -9,7 +9,7 @@ use bvh::bounding_hierarchy::BHShape;
 use bvh::bvh::{Bvh, BvhNode};
 use nalgebra::{Point3, Vector3};
 
-use super::mesh::{Ray, Triangle};
+use super::mesh::{EdgeForm, Ray, Triangle};
 
 /// A triangle's box while the tree is built.
 #[derive(Debug, Clone)]
@@ -74,6 +74,8 @@ impl Node {
 #[derive(Debug, Clone, Default)]
 pub struct Accel {
     nodes: Vec<Node>,
+    /// Per triangle, its corner and edges for the ray tests.
+    forms: Vec<EdgeForm>,
 }
 
 /// The nearest hit along a ray.
@@ -148,7 +150,10 @@ impl Accel {
             nodes[at].a = index_of[l];
             nodes[at].b = index_of[r];
         }
-        Accel { nodes }
+        Accel {
+            nodes,
+            forms: triangles.iter().map(EdgeForm::new).collect(),
+        }
     }
 
     /// Visits triangles whose boxes the ray enters within `(t_min, t_max)`,
@@ -205,11 +210,13 @@ impl Accel {
         }
     }
 
-    /// The nearest triangle hit in `(t_min, t_max)`.
+    /// The nearest triangle hit in `(t_min, t_max)`; `triangles` are those
+    /// the hierarchy was built over (their edges are kept from the build).
     pub fn nearest(&self, triangles: &[Triangle], ray: &Ray, t_min: f64, t_max: f64) -> Option<TriangleHit> {
+        debug_assert_eq!(triangles.len(), self.forms.len());
         let mut best: Option<TriangleHit> = None;
         self.traverse(ray, t_min, t_max, |i, limit| {
-            if let Some(t) = triangles[i].intersect(ray, t_min, limit) {
+            if let Some(t) = self.forms[i].intersect(ray, t_min, limit) {
                 best = Some(TriangleHit { triangle: i, t });
                 Some(t)
             } else {
@@ -221,9 +228,10 @@ impl Accel {
 
     /// Whether any triangle lies on `ray` within `(t_min, t_max)` (shadow rays).
     pub fn occluded(&self, triangles: &[Triangle], ray: &Ray, t_min: f64, t_max: f64) -> bool {
+        debug_assert_eq!(triangles.len(), self.forms.len());
         let mut hit = false;
         self.traverse(ray, t_min, t_max, |i, limit| {
-            if triangles[i].intersect(ray, t_min, limit).is_some() {
+            if self.forms[i].intersect(ray, t_min, limit).is_some() {
                 hit = true;
                 None
             } else {

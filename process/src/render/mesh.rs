@@ -53,27 +53,7 @@ impl Triangle {
     /// Distance along `ray` to the triangle, if it is hit in `(t_min, t_max)`.
     /// Both sides of the triangle are hit.
     pub fn intersect(&self, ray: &Ray, t_min: f64, t_max: f64) -> Option<f64> {
-        let [a, b, c] = self.vertices;
-        let e1 = b - a;
-        let e2 = c - a;
-        let p = ray.direction.cross(&e2);
-        let det = e1.dot(&p);
-        if det.abs() < 1e-14 * e1.norm() * e2.norm() {
-            return None;
-        }
-        let inv = 1.0 / det;
-        let s = ray.origin - a;
-        let u = s.dot(&p) * inv;
-        if !(0.0..=1.0).contains(&u) {
-            return None;
-        }
-        let q = s.cross(&e1);
-        let v = ray.direction.dot(&q) * inv;
-        if v < 0.0 || u + v > 1.0 {
-            return None;
-        }
-        let t = e2.dot(&q) * inv;
-        (t > t_min && t < t_max).then_some(t)
+        EdgeForm::new(self).intersect(ray, t_min, t_max)
     }
 
     /// Planar texture coordinates (metres) of a point on the face.
@@ -91,6 +71,57 @@ impl Triangle {
     /// The point at barycentric coordinates `(u, v)` (weights of corners 1 and 2).
     pub fn point(&self, u: f64, v: f64) -> Vector3<f64> {
         self.vertices[0] + (self.vertices[1] - self.vertices[0]) * u + (self.vertices[2] - self.vertices[0]) * v
+    }
+}
+
+/// A triangle's corner, edges and degeneracy tolerance, worked out once
+/// for many ray tests ([`Triangle::intersect`] builds one per call; a
+/// scene's hierarchy keeps one per triangle). Both give the same numbers
+/// to the last bit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct EdgeForm {
+    a: Vector3<f64>,
+    e1: Vector3<f64>,
+    e2: Vector3<f64>,
+    /// `|det|` below this is a ray in the triangle's plane.
+    tolerance: f64,
+}
+
+impl EdgeForm {
+    /// The form of `t`.
+    pub(crate) fn new(t: &Triangle) -> EdgeForm {
+        let [a, b, c] = t.vertices;
+        let e1 = b - a;
+        let e2 = c - a;
+        EdgeForm {
+            a,
+            e1,
+            e2,
+            tolerance: 1e-14 * e1.norm() * e2.norm(),
+        }
+    }
+
+    /// [`Triangle::intersect`] (Möller–Trumbore).
+    pub(crate) fn intersect(&self, ray: &Ray, t_min: f64, t_max: f64) -> Option<f64> {
+        let (a, e1, e2) = (self.a, self.e1, self.e2);
+        let p = ray.direction.cross(&e2);
+        let det = e1.dot(&p);
+        if det.abs() < self.tolerance {
+            return None;
+        }
+        let inv = 1.0 / det;
+        let s = ray.origin - a;
+        let u = s.dot(&p) * inv;
+        if !(0.0..=1.0).contains(&u) {
+            return None;
+        }
+        let q = s.cross(&e1);
+        let v = ray.direction.dot(&q) * inv;
+        if v < 0.0 || u + v > 1.0 {
+            return None;
+        }
+        let t = e2.dot(&q) * inv;
+        (t > t_min && t < t_max).then_some(t)
     }
 }
 
