@@ -32,7 +32,7 @@ fn the_indi_station_runs_its_plan() {
     let Ok(Document::Plan(plan)) = load(&example("indi/sky-day.ron")) else {
         panic!("indi/sky-day.ron is a plan")
     };
-    check_plan_on_station(&plan, &station).unwrap_or_else(|e| panic!("{e}"));
+    check_plan_on_station(&plan, &station.value).unwrap_or_else(|e| panic!("{e}"));
 }
 
 #[test]
