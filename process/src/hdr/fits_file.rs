@@ -206,17 +206,19 @@ pub fn read_fits(bytes: &[u8], label: &str) -> Result<FitsImage, FitsError> {
     })?;
     let top = (1u32 << bits) - 1;
     let mut clipped = 0usize;
-    let mut code = |i: usize| -> u16 {
-        let stored = match bytes_per {
-            1 => f64::from(data[i]),
-            _ => f64::from(i16::from_be_bytes([data[2 * i], data[2 * i + 1]])),
-        };
-        let physical = (bzero + bscale * stored).round();
-        if physical < 0.0 || physical > f64::from(top) {
-            clipped += 1;
-        }
-        physical.clamp(0.0, f64::from(top)) as u16
-    };
+    let samples: Vec<u16> = (0..w * h * p)
+        .map(|i| {
+            let stored = match bytes_per {
+                1 => f64::from(data[i]),
+                _ => f64::from(i16::from_be_bytes([data[2 * i], data[2 * i + 1]])),
+            };
+            let physical = (bzero + bscale * stored).round();
+            if physical < 0.0 || physical > f64::from(top) {
+                clipped += 1;
+            }
+            physical.clamp(0.0, f64::from(top)) as u16
+        })
+        .collect();
     let bottom_up = card_value(&cards, "ROWORDER").is_some_and(|r| r.eq_ignore_ascii_case("BOTTOM-UP"));
     let mut rgb = vec![0u16; w * h * 3];
     for y in 0..h {
@@ -224,7 +226,7 @@ pub fn read_fits(bytes: &[u8], label: &str) -> Result<FitsImage, FitsError> {
         for x in 0..w {
             for c in 0..3 {
                 let plane = if p == 3 { c } else { 0 };
-                rgb[(y * w + x) * 3 + c] = code(plane * w * h + row * w + x);
+                rgb[(y * w + x) * 3 + c] = samples[plane * w * h + row * w + x];
             }
         }
     }
@@ -253,7 +255,8 @@ mod tests {
     fn fits(cards: &[(&str, &str)], data: &[u8]) -> Vec<u8> {
         let mut header = String::new();
         for (k, v) in cards {
-            header += &format!("{k:<8}= {v:>20}{:50}", "");
+            let card = format!("{k:<8}= {v:>20}");
+            header += &format!("{card:<80}");
         }
         header += &format!("{:<80}", "END");
         let mut bytes = header.into_bytes();
