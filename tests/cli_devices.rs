@@ -18,6 +18,16 @@ use std::time::Duration;
 
 const TICK: Duration = Duration::from_millis(2);
 
+/// A Pelco-D head that turns all the way round, as the example stations'
+/// 0..359.99° pan says (the wire's −180° is its 180°).
+fn round_head() -> PelcoConfig {
+    PelcoConfig {
+        speed: 90_000,
+        pan_range: (-18_000, 17_999),
+        ..PelcoConfig::default()
+    }
+}
+
 #[test]
 fn lists_serial_ports_and_cameras() {
     let out = campanile(&["devices"]);
@@ -49,15 +59,8 @@ fn devices_test_runs_the_suites_over_pseudo_terminals() {
     let (lights_master, lights_slave) = serial::pty_pair().unwrap();
     let path = |s: &serial::SerialPort| serial::device_path(s).unwrap();
     let (head_path, wheel_path, lights_path) = (path(&head_slave), path(&wheel_slave), path(&lights_slave));
-    // A head that turns all the way round, as the station's 0..359.99° pan
-    // says (the wire's −180° is its 180°).
-    let pelco = PelcoConfig {
-        speed: 90_000,
-        pan_range: (-18_000, 17_999),
-        ..PelcoConfig::default()
-    };
     let _emulators = (
-        Emulator::spawn(PelcoDevice::new(pelco), head_master, TICK),
+        Emulator::spawn(PelcoDevice::new(round_head()), head_master, TICK),
         Emulator::spawn(WheelDevice::new(6), wheel_master, TICK),
         Emulator::spawn(DmxDevice::new(2718), lights_master, TICK),
     );
@@ -191,12 +194,7 @@ fn devices_test_on_the_indi_station() {
     let _enter = rt.enter();
     let (head_master, head_slave) = serial::pty_pair().unwrap();
     let head_path = serial::device_path(&head_slave).unwrap();
-    let pelco = PelcoConfig {
-        speed: 90_000,
-        pan_range: (-18_000, 17_999),
-        ..PelcoConfig::default()
-    };
-    let _emulator = Emulator::spawn(PelcoDevice::new(pelco), head_master, TICK);
+    let _emulator = Emulator::spawn(PelcoDevice::new(round_head()), head_master, TICK);
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let example = std::fs::read_to_string(root.join("examples/indi/station.ron")).unwrap();
     let station = example

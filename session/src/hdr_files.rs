@@ -189,7 +189,7 @@ fn classified<T>(r: anyhow::Result<T>) -> Result<T> {
         let output = chain().any(|c| c.to_string().starts_with("writing "));
         let work = match chain().find_map(|c| c.downcast_ref::<HdrError>()) {
             Some(HdrError::Singular { .. }) => true,
-            Some(_) | None => output || chain().any(is_io_failure),
+            Some(_) | None => output || chain().any(is_closed_pipe),
         };
         if work {
             Error::Work(e)
@@ -199,8 +199,9 @@ fn classified<T>(r: anyhow::Result<T>) -> Result<T> {
     })
 }
 
-/// A standard-output failure (a closed pipe) travels as work.
-fn is_io_failure(c: &(dyn std::error::Error + 'static)) -> bool {
+/// A closed standard output travels as work (the binary ends its output
+/// silently on one).
+fn is_closed_pipe(c: &(dyn std::error::Error + 'static)) -> bool {
     c.downcast_ref::<std::io::Error>()
         .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
 }

@@ -36,18 +36,16 @@ pub struct SunAt {
     pub delta_t_s: Option<f64>,
 }
 
-/// Solar positions for the CSV table `input`, written to `out` (a file,
-/// through a partial file and a rename) or to standard output; returns the
+/// Solar positions for the CSV table `input`, written to the file `out`
+/// (through a partial file and a rename) or else to `stdout`; returns the
 /// rows written.
-pub fn table(input: &Path, out: Option<&Path>) -> Result<usize> {
+pub fn table(input: &Path, out: Option<&Path>, stdout: &mut dyn Write) -> Result<usize> {
     let file = File::open(input).with_context(|| format!("{}: cannot open", input.display()))?;
     let n = match out {
         Some(out) => crate::partial_file::write_with(out, |w| {
             Ok(sun_table(BufReader::new(file), w).with_context(|| format!("{}", input.display()))?)
         })?,
-        None => {
-            sun_table(BufReader::new(file), std::io::stdout().lock()).with_context(|| format!("{}", input.display()))?
-        }
+        None => sun_table(BufReader::new(file), stdout).with_context(|| format!("{}", input.display()))?,
     };
     Ok(n)
 }

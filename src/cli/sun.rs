@@ -67,7 +67,7 @@ pub struct SunArgs {
 
 pub fn run(args: SunArgs) -> Result<()> {
     if let Some(input) = &args.csv {
-        let n = sun_files::table(input, args.out.as_deref())?;
+        let n = sun_files::table(input, args.out.as_deref(), &mut std::io::stdout().lock())?;
         tracing::info!(rows = n, "solar positions written");
         return Ok(());
     }
