@@ -192,11 +192,12 @@ impl Camera for FlatCamera {
                 max: Gain::from_db(18.0).unwrap(),
                 step_db: 0.0,
             },
+            exposure_table: None,
         }
     }
 
     async fn capture(&mut self, settings: CaptureSettings) -> Result<Frame, DeviceError> {
-        let actual = self.info().exposure.applied(settings.exposure)?;
+        let actual = self.info().exposure_applied(settings.exposure)?;
         let timestamp = self.clock.now();
         tokio::time::sleep(actual.duration()).await;
         self.sequence += 1;

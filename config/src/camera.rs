@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
+use crate::shutter::ShutterSteps;
 use crate::validate::{Validate, Validator};
 
 /// Which driver talks to the camera.
@@ -119,6 +120,11 @@ pub struct ExposureLimits {
     pub min_s: f64,
     /// Longest exposure in seconds, ≥ `min_s` and ≤ 3600.
     pub max_s: f64,
+    /// How the shutter steps between the limits: `Continuous` (the
+    /// default), or a DSLR's nominal series (`Thirds`, `Halves`, `Whole`),
+    /// to which the camera snaps every exposure asked for.
+    #[serde(default, skip_serializing_if = "ShutterSteps::is_continuous")]
+    pub steps: ShutterSteps,
 }
 
 /// A closed interval of analogue gains in dB.
@@ -271,6 +277,13 @@ impl Validate for Camera {
                 3600.0,
                 "an exposure time in seconds (at least min_s)",
             );
+            if e.steps.within(e.min_s, e.max_s).is_some_and(|s| s.is_empty()) {
+                v.invalid(
+                    "steps",
+                    format!("{:?}", e.steps),
+                    "a shutter series with a speed between min_s and max_s (the series run 1/8000 s to 30 s)",
+                );
+            }
         });
         v.at("gain", |v| {
             let g = self.gain;

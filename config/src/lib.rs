@@ -23,6 +23,7 @@ pub mod link;
 pub mod plan;
 pub mod quality;
 pub mod scene;
+pub mod shutter;
 pub mod site;
 pub mod source;
 pub mod span_tree;

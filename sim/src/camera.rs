@@ -48,7 +48,8 @@ use crate::devices::DeviceTruth;
 use crate::faults::{CameraFault, CameraFaultPlan};
 use crate::seed::{Purpose, derive};
 use campanile_capture::device::{
-    Camera, CameraInfo, CaptureSettings, DeviceError, ExposureRange, ExposureTime, Frame, Gain, GainRange,
+    Camera, CameraInfo, CaptureSettings, DeviceError, ExposureRange, ExposureTable, ExposureTime, Frame, Gain,
+    GainRange,
 };
 use campanile_capture::device::{FrameFile, FrameFormat};
 use campanile_config::camera::{Camera as CameraConfig, FrameFileFormat};
@@ -210,21 +211,32 @@ impl<S: FrameSource> SimCamera<S> {
     ) -> Self {
         let secs = |s: f64| ExposureTime::from_seconds(s).unwrap_or(ExposureTime::from_micros(1).unwrap_or_default());
         let gain = |db: f64| Gain::from_db(db).unwrap_or(Gain::UNITY);
+        // A stepped shutter (`steps: Thirds`, as a DSLR's) takes its
+        // series' speeds within the limits, and its range is theirs.
+        let exposure_table = config
+            .exposure
+            .steps
+            .within(config.exposure.min_s, config.exposure.max_s)
+            .and_then(|s| ExposureTable::new(&s));
         let info = CameraInfo {
             model: "campanile simulated camera".into(),
             width: config.resolution.width as usize,
             height: config.resolution.height as usize,
             bits: config.bit_depth.clamp(1, 16),
-            exposure: ExposureRange {
-                min: secs(config.exposure.min_s),
-                max: secs(config.exposure.max_s),
-                step: secs(options.exposure_step.as_secs_f64()),
-            },
+            exposure: exposure_table.as_ref().map_or(
+                ExposureRange {
+                    min: secs(config.exposure.min_s),
+                    max: secs(config.exposure.max_s),
+                    step: secs(options.exposure_step.as_secs_f64()),
+                },
+                ExposureTable::range,
+            ),
             gain: GainRange {
                 min: gain(config.gain.min_db),
                 max: gain(config.gain.max_db),
                 step_db: 0.1,
             },
+            exposure_table,
         };
         let (a, b) = config.intrinsics.falloff;
         Self {
@@ -400,7 +412,7 @@ impl<S: FrameSource> Camera for SimCamera<S> {
     }
 
     async fn capture(&mut self, settings: CaptureSettings) -> Result<Frame, DeviceError> {
-        let exposure = self.info.exposure.applied(settings.exposure)?;
+        let exposure = self.info.exposure_applied(settings.exposure)?;
         let gain = self.info.gain.applied(settings.gain)?;
         let sequence = self.sequence;
         self.sequence += 1;

@@ -120,11 +120,12 @@ mod tests {
                     max: crate::device::Gain::UNITY,
                     step_db: 0.0,
                 },
+                exposure_table: None,
             }
         }
 
         async fn capture(&mut self, settings: CaptureSettings) -> Result<Frame, DeviceError> {
-            let applied = self.info().exposure.applied(settings.exposure)?;
+            let applied = self.info().exposure_applied(settings.exposure)?;
             let reported = if self.lies {
                 ExposureTime::from_seconds(applied.seconds() * 2.0).unwrap()
             } else {

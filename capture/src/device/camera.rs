@@ -44,6 +44,67 @@ impl ExposureRange {
     }
 }
 
+/// The exposure times of a camera with a stepped shutter (a DSLR's
+/// nominal ⅓-stop speeds, a gphoto2 `shutterspeed` list), shortest first.
+///
+/// Requests snap to the nearest entry in stops (log₂ t), so a plan's
+/// 1/3 s lands on 0.3 s, not on 0.4 s, and an auto-bracket four stops
+/// apart stays four stops apart within the table's rounding.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExposureTable(Vec<ExposureTime>);
+
+impl ExposureTable {
+    /// A table of `seconds` (any order; repeats dropped), or `None` if it
+    /// holds no finite positive time.
+    pub fn new(seconds: &[f64]) -> Option<Self> {
+        let mut t: Vec<f64> = seconds.iter().copied().filter(|s| s.is_finite() && *s > 0.0).collect();
+        t.sort_by(f64::total_cmp);
+        t.dedup();
+        let times: Vec<ExposureTime> = t.into_iter().filter_map(ExposureTime::from_seconds).collect();
+        (!times.is_empty()).then_some(Self(times))
+    }
+
+    /// The times, shortest first.
+    pub fn times(&self) -> &[ExposureTime] {
+        &self.0
+    }
+
+    /// The index of the entry nearest `requested` in stops (the shorter of
+    /// two equally near).
+    pub fn nearest_index(&self, requested: ExposureTime) -> usize {
+        let l = requested.seconds().log2();
+        let mut best = 0;
+        for (i, t) in self.0.iter().enumerate() {
+            if (t.seconds().log2() - l).abs() < (self.0[best].seconds().log2() - l).abs() {
+                best = i;
+            }
+        }
+        best
+    }
+
+    /// The entry nearest `requested` in stops.
+    pub fn nearest(&self, requested: ExposureTime) -> ExposureTime {
+        self.0[self.nearest_index(requested)]
+    }
+
+    /// The notches a dial turns from the entry nearest `from` to the one
+    /// nearest `to` (positive: longer), for cameras that take a notch at a
+    /// time.
+    pub fn notches(&self, from: ExposureTime, to: ExposureTime) -> isize {
+        self.nearest_index(to) as isize - self.nearest_index(from) as isize
+    }
+
+    /// The range the table spans, with the step 0 (the table rounds).
+    pub fn range(&self) -> ExposureRange {
+        let (first, last) = (self.0[0], self.0[self.0.len() - 1]);
+        ExposureRange {
+            min: first,
+            max: last,
+            step: ExposureTime::default(),
+        }
+    }
+}
+
 /// A closed range of gains and the step the camera rounds to.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GainRange {
@@ -93,6 +154,22 @@ pub struct CameraInfo {
     pub exposure: ExposureRange,
     /// Gains it accepts.
     pub gain: GainRange,
+    /// The exposure times a stepped shutter offers (`None`: any time in
+    /// `exposure`, rounded to its step).
+    pub exposure_table: Option<ExposureTable>,
+}
+
+impl CameraInfo {
+    /// The exposure the camera applies for `requested`: range-checked, then
+    /// snapped to the table's nearest entry if the shutter is stepped, else
+    /// rounded to the range's step ([`ExposureRange::applied`]).
+    pub fn exposure_applied(&self, requested: ExposureTime) -> Result<ExposureTime, DeviceError> {
+        let rounded = self.exposure.applied(requested)?;
+        Ok(match &self.exposure_table {
+            Some(table) => table.nearest(requested),
+            None => rounded,
+        })
+    }
 }
 
 /// Settings for one frame (all manual: no auto-exposure).
@@ -191,6 +268,43 @@ mod tests {
         assert!((r.applied(e(0.012_345)).unwrap().seconds() - 0.012_35).abs() < 1e-12);
         assert!(matches!(r.applied(e(31.0)), Err(DeviceError::OutOfRange { .. })));
         assert!(matches!(r.applied(e(1e-6)), Err(DeviceError::OutOfRange { .. })));
+    }
+
+    #[test]
+    fn a_stepped_shutter_snaps_to_its_nearest_nominal_in_stops() {
+        let table = ExposureTable::new(campanile_config::shutter::ShutterSteps::Thirds.series().unwrap()).unwrap();
+        let info = CameraInfo {
+            model: "dslr".into(),
+            width: 2,
+            height: 2,
+            bits: 14,
+            exposure: table.range(),
+            gain: GainRange {
+                min: Gain::UNITY,
+                max: Gain::UNITY,
+                step_db: 0.0,
+            },
+            exposure_table: Some(table.clone()),
+        };
+        let e = |s| ExposureTime::from_seconds(s).unwrap();
+        let snapped = |s| info.exposure_applied(e(s)).unwrap().seconds();
+        // 1/3 s: 0.3 s is 0.152 stop away, 0.4 s 0.263 stop.
+        assert_eq!(snapped(1.0 / 3.0), 0.3);
+        // 1/128 s (2^-7) is the nominal 1/125 s.
+        assert_eq!(snapped(1.0 / 128.0), 1.0 / 125.0);
+        // Four stops down from 1/60 s: 1/960 s → 1/1000 s.
+        assert_eq!(snapped(1.0 / 960.0), 1.0 / 1000.0);
+        assert_eq!(snapped(30.0), 30.0);
+        assert!(matches!(
+            info.exposure_applied(e(31.0)),
+            Err(DeviceError::OutOfRange { .. })
+        ));
+        // From 1/125 s to 1/60 s is three notches; back is −3; 4 stops is 12.
+        assert_eq!(table.notches(e(1.0 / 125.0), e(1.0 / 60.0)), 3);
+        assert_eq!(table.notches(e(1.0 / 60.0), e(1.0 / 125.0)), -3);
+        assert_eq!(table.notches(e(1.0 / 1000.0), e(1.0 / 60.0)), 12);
+        assert_eq!(ExposureTable::new(&[f64::NAN, -1.0, 0.0]), None);
+        assert_eq!(ExposureTable::new(&[0.5, 0.25, 0.5]).unwrap().times().len(), 2);
     }
 
     #[test]

@@ -28,7 +28,7 @@ pub mod lights;
 pub mod pan_tilt;
 pub mod units;
 
-pub use camera::{Camera, CameraInfo, CaptureSettings, ExposureRange, Frame, GainRange};
+pub use camera::{Camera, CameraInfo, CaptureSettings, ExposureRange, ExposureTable, Frame, GainRange};
 pub use error::DeviceError;
 pub use filter_wheel::FilterWheel;
 pub use frame_format::{FrameFile, FrameFormat};

@@ -111,6 +111,7 @@ mod tests {
                 max: Gain::UNITY,
                 step_db: 0.0,
             },
+            exposure_table: None,
         }
     }
 

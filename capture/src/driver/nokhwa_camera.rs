@@ -169,6 +169,7 @@ impl NokhwaCamera {
             bits: 8,
             exposure: exposure_limits,
             gain: gain_map.range(),
+            exposure_table: None,
         };
         Ok(Self {
             camera,

@@ -212,6 +212,7 @@ impl V4l2Camera {
             bits,
             exposure: exposure_limits,
             gain: gain_map.range(),
+            exposure_table: None,
         };
         tracing::info!(camera = %info.model, format = ?format, ?exposure, "V4L2 camera open, manual exposure");
         Ok(Self {

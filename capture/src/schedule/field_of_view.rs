@@ -95,6 +95,7 @@ pub(crate) mod tests {
             exposure: ExposureLimits {
                 min_s: 1e-5,
                 max_s: 30.0,
+                steps: Default::default(),
             },
             gain: GainLimits {
                 min_db: 0.0,

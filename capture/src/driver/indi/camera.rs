@@ -141,6 +141,7 @@ impl IndiCamera {
                     max: Gain::UNITY,
                     step_db: 0.0,
                 },
+                exposure_table: None,
             },
             client,
             device: device.to_owned(),
@@ -167,7 +168,7 @@ impl Camera for IndiCamera {
     }
 
     async fn capture(&mut self, settings: CaptureSettings) -> Result<Frame, DeviceError> {
-        let applied = self.info.exposure.applied(settings.exposure)?;
+        let applied = self.info.exposure_applied(settings.exposure)?;
         let gain = self.info.gain.applied(settings.gain)?;
         self.sequence += 1;
         let device = self.device.clone();
