@@ -193,6 +193,7 @@ impl Camera for FlatCamera {
                 step_db: 0.0,
             },
             exposure_table: None,
+            linear: false,
         }
     }
 

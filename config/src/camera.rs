@@ -38,6 +38,14 @@ pub enum DeviceRef {
         server: String,
         /// The device's INDI name, e.g. "CCD Simulator".
         device: String,
+        /// The sensor's gain as the driver states it (`CCD_GAIN`, in the
+        /// driver's own units, not dB), held for the session; the driver's
+        /// own when absent.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        gain: Option<f64>,
+        /// A DSLR's ISO through `indi_gphoto_ccd` (`CCD_ISO`), e.g. "100".
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        iso: Option<String>,
     },
 }
 
@@ -150,6 +158,9 @@ pub enum FrameFileFormat {
     Jpeg,
     /// A DNG of the sensor's Bayer mosaic (linear, black and white levels).
     Dng,
+    /// A FITS file of the sensor's linear codes (R, G, B planes and an
+    /// `EXPTIME` card), as an INDI astro camera delivers.
+    Fits,
 }
 
 impl FrameFileFormat {
@@ -184,9 +195,9 @@ pub struct Camera {
     #[cfg_attr(test, proptest(strategy = "crate::arbitrary::opt_path()"))]
     pub response_curve: Option<PathBuf>,
     /// The file each frame arrives as (`Png` when absent): `Jpeg` or `Dng`
-    /// makes the simulated camera deliver what a DSLR would, kept byte for
-    /// byte by the session and decoded by `campanile process`. Only the
-    /// `Sim` driver takes it.
+    /// makes the simulated camera deliver what a DSLR would, `Fits` what an
+    /// astro camera would, kept byte for byte by the session and decoded by
+    /// `campanile process`. Only the `Sim` driver takes it.
     #[serde(default, skip_serializing_if = "FrameFileFormat::is_png")]
     pub file_format: FrameFileFormat,
 }
@@ -195,8 +206,16 @@ impl Validate for Camera {
     fn validate(&self, v: &mut Validator) {
         match (&self.driver, &self.device) {
             (CameraDriver::Sim, _) => {}
-            (CameraDriver::Indi, Some(DeviceRef::Indi { server, device })) => {
-                v.at("device", |v| validate_indi(v, server, device));
+            (CameraDriver::Indi, Some(DeviceRef::Indi { server, device, gain, iso })) => {
+                v.at("device", |v| {
+                    validate_indi(v, server, device);
+                    if let Some(g) = gain {
+                        v.range("gain", *g, 0.0, 1.0e6, "a gain in the INDI driver's units (CCD_GAIN), at least 0");
+                    }
+                    if iso.as_deref().is_some_and(|i| i.trim().is_empty()) {
+                        v.invalid("iso", format!("{iso:?}"), "an ISO the camera offers, e.g. \"100\"");
+                    }
+                });
             }
             (CameraDriver::Indi, other) => v.invalid(
                 "device",
@@ -300,7 +319,7 @@ impl Validate for Camera {
             v.invalid(
                 "file_format",
                 format!("{:?}", self.file_format),
-                "Png (the default) for a real camera driver: only the simulated camera delivers JPEG or DNG files",
+                "Png (the default) for a real camera driver: only the simulated camera delivers JPEG, DNG or FITS files",
             );
         }
         if let Some(p) = &self.response_curve {

@@ -59,7 +59,7 @@ fn station_summary(s: &Station) -> String {
     let device = match &c.device {
         Some(DeviceRef::Path(p)) => format!(" at {p}"),
         Some(DeviceRef::Index(i)) => format!(" #{i}"),
-        Some(DeviceRef::Indi { server, device }) => format!(" {device:?} on {server}"),
+        Some(DeviceRef::Indi { server, device, .. }) => format!(" {device:?} on {server}"),
         None => String::new(),
     };
     let focal = c.intrinsics.focal.pixels(c.resolution.width);

@@ -248,7 +248,7 @@ fn test_real(station: &Station, head_options: conformance::pan_tilt::Options) ->
         let camera_label = match &cam.device {
             Some(campanile_config::camera::DeviceRef::Path(p)) => format!("camera ({:?} on {p})", cam.driver),
             Some(campanile_config::camera::DeviceRef::Index(i)) => format!("camera ({:?} number {i})", cam.driver),
-            Some(campanile_config::camera::DeviceRef::Indi { server, device }) => {
+            Some(campanile_config::camera::DeviceRef::Indi { server, device, .. }) => {
                 format!("camera (INDI {device:?} on {server})")
             }
             None => format!("camera ({:?}, its first device)", cam.driver),

@@ -88,14 +88,18 @@ pub struct ScanRun {
 }
 
 /// Whether every step of `plan` is a sky or sun step (sun shots, sky scans,
-/// and brackets aimed at head angles or the sun, e.g. a calibration bracket):
-/// such a session is processed as a sky time series.
+/// and brackets aimed at head angles or the sun, e.g. a calibration
+/// bracket), with at least one sun shot or sky scan: such a session is
+/// processed as a sky time series. Brackets alone have no scan to make a
+/// series of; they are merged into HDR views as any session's are.
 pub fn is_sky_only(plan: &Plan) -> bool {
-    plan.sessions.iter().flat_map(|s| &s.steps).all(|step| match step {
+    let steps = || plan.sessions.iter().flat_map(|s| &s.steps);
+    let sky_or_sun = steps().all(|step| match step {
         Step::SunShot { .. } | Step::SkyScan { .. } => true,
         Step::Bracket { aim, .. } | Step::AutoBracket { aim, .. } => !matches!(aim, Aim::Pose(_)),
         _ => false,
-    })
+    });
+    sky_or_sun && steps().any(|step| matches!(step, Step::SunShot { .. } | Step::SkyScan { .. }))
 }
 
 /// The occurrence and plan step of a frame key `"{occurrence}/s{step}/…"`.

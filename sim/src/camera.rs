@@ -57,6 +57,7 @@ use campanile_process::camera::bayer::{BayerSensor, CfaPattern, Exposure};
 use campanile_process::camera::image::{CodeImage, RadianceImage};
 use campanile_process::camera::sensor::CameraModel;
 use campanile_process::hdr::dng_file::{DngLayout, DngMetadata, dng_bytes};
+use campanile_process::hdr::fits_file::fits_bytes;
 use campanile_process::hdr::image_file::jpeg_bytes;
 use campanile_process::hdr::lens::{RadialPolynomial, normalized_r2};
 use campanile_process::pose::HeadPose;
@@ -237,6 +238,7 @@ impl<S: FrameSource> SimCamera<S> {
                 step_db: 0.1,
             },
             exposure_table,
+            linear: config.file_format == FrameFileFormat::Fits,
         };
         let (a, b) = config.intrinsics.falloff;
         Self {
@@ -337,8 +339,9 @@ impl<S: FrameSource> SimCamera<S> {
 
 impl<S: FrameSource> SimCamera<S> {
     /// The file the config's `file_format` asks for (module doc, step 5):
-    /// none for PNG (the store encodes the codes), the codes as a JPEG, or
-    /// the sensor radiance photographed by a Bayer sensor as a DNG.
+    /// none for PNG (the store encodes the codes), the codes as a JPEG, the
+    /// linear codes as a FITS file, or the sensor radiance photographed by
+    /// a Bayer sensor as a DNG.
     fn frame_file(
         &self,
         codes: &CodeImage,
@@ -357,6 +360,16 @@ impl<S: FrameSource> SimCamera<S> {
                     })
                 })
                 .map_err(|e| format!("simulated JPEG not written: {e}")),
+            FrameFileFormat::Fits => {
+                let cards = [
+                    ("EXPTIME", format!("{exposure_s:E}")),
+                    ("INSTRUME", format!("'{}'", self.info.model.replace('\'', "''"))),
+                ];
+                Ok(Some(FrameFile {
+                    format: FrameFormat::Fits,
+                    bytes: fits_bytes(codes, &cards),
+                }))
+            }
             FrameFileFormat::Dng => {
                 let bayer = bayer_sensor(model);
                 let exposure = Exposure {
@@ -481,7 +494,13 @@ impl<S: FrameSource> Camera for SimCamera<S> {
             *k *= g;
         }
         let noise_seed = derive(self.seed, Purpose::SensorNoise, sequence);
-        let codes = model.photograph(&sensor, exposure.seconds(), noise_seed);
+        // A FITS camera reads its sensor out linearly (an astro camera's
+        // codes); the others through the model's response curve.
+        let codes = if self.file_format == FrameFileFormat::Fits {
+            model.photograph_linear(&sensor, exposure.seconds(), noise_seed)
+        } else {
+            model.photograph(&sensor, exposure.seconds(), noise_seed)
+        };
         let file = self
             .frame_file(&codes, &sensor, &model, exposure.seconds(), noise_seed)
             .map_err(DeviceError::Camera)?;

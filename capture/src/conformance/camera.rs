@@ -121,6 +121,7 @@ mod tests {
                     step_db: 0.0,
                 },
                 exposure_table: None,
+                linear: false,
             }
         }
 

@@ -54,6 +54,26 @@ pub const MAX_CAPTURES: usize = 8;
 /// The response gamma assumed between exposure and code.
 pub const ASSUMED_GAMMA: f64 = 2.2;
 
+/// A linear camera's codes ([`crate::device::CameraInfo::linear`]) as a
+/// camera with the [`ASSUMED_GAMMA`] response would give them, `z' = z_max
+/// · (z / z_max)^(1/γ)`: the controller meters, brackets and finds the sun
+/// on these, so a linear sensor is exposed as a gamma camera is (its median
+/// at 0.45^2.2 = 17 % of full scale, not at 45 %, which clips skies).
+pub fn gamma_equivalent(frame: Codes<'_>) -> CodeImage {
+    let top = max_code(frame);
+    CodeImage {
+        width: frame.width,
+        height: frame.height,
+        bits: frame.bits,
+        data: frame
+            .data
+            .iter()
+            .map(|&z| (top * (f64::from(z) / top).powf(1.0 / ASSUMED_GAMMA)).round() as u16)
+            .collect(),
+        label: String::new(),
+    }
+}
+
 /// The largest code of a frame.
 pub fn max_code(frame: Codes<'_>) -> f64 {
     f64::from((1u32 << frame.bits.min(16)) - 1)
@@ -104,6 +124,27 @@ pub fn next_exposure(exposure_s: f64, median: f64) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A linear camera's code at 0.45^2.2 of full scale reads as the
+    /// metering target 0.45; the ends stay where they are.
+    #[test]
+    fn linear_codes_read_through_the_assumed_gamma() {
+        let data = [0u16, 4095, (4095.0 * 0.45f64.powf(ASSUMED_GAMMA)).round() as u16];
+        let frame = Codes {
+            width: 1,
+            height: 1,
+            bits: 12,
+            data: &data,
+        };
+        let g = gamma_equivalent(frame);
+        assert_eq!(g.data[0], 0);
+        assert_eq!(g.data[1], 4095);
+        assert!(
+            (f64::from(g.data[2]) / 4095.0 - TARGET_FRACTION).abs() < 1e-3,
+            "{}",
+            g.data[2]
+        );
+    }
 
     /// A camera with an exact gamma-2.2 response converges in a few steps
     /// from 10 ms for radiances over six decades.

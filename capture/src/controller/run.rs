@@ -46,6 +46,7 @@ use crate::schedule::{
     FilterChoice, Occurrence, PlannedAim, PlannedExposure, PlannedShot, ShotKind, Timeline, duration,
 };
 use crate::store::{self, FrameMeta, LightLevel, PoseDeg, SessionStore, Storage, StoreError};
+use crate::unattended::outage::{DeviceHealth, WATCHED};
 
 /// Frame numbers reserved per shot (see [`Rig::number_frames_from`]):
 /// attempts from 0, saturation retakes from 16, metering from 32.
@@ -126,15 +127,24 @@ pub async fn run_supervised<R: Rig, C: Clock, S: Storage>(
         report: RunReport::default(),
         last_pose: None,
         last_slot: None,
+        health: DeviceHealth::default(),
+        linear_camera: false,
     };
+    c.linear_camera = c.rig.camera().info().linear;
     for occ in &timeline.occurrences {
         if c.stopping || c.supervisor.stop_requested() {
             c.report.stopped = Some(STOPPED_ON_REQUEST.to_owned());
             tracing::info!("the run stops on request, between shots");
+            if let Err(e) = c.journal_open_outages() {
+                tracing::error!(error = %e, "the open outages could not be journaled");
+            }
             return Ok(c.report);
         }
         let span = tracing::info_span!("occurrence", key = %occ.key);
         if let Err(error) = c.occurrence(occ).instrument(span).await {
+            if let Err(e) = c.journal_open_outages() {
+                tracing::error!(error = %e, "the open outages could not be journaled");
+            }
             c.report.stopped = Some(error.to_string());
             tracing::error!(%error, "the session stops");
             return Err(RunError {
@@ -142,6 +152,13 @@ pub async fn run_supervised<R: Rig, C: Clock, S: Storage>(
                 report: Box::new(c.report),
             });
         }
+    }
+    if let Err(error) = c.journal_open_outages() {
+        c.report.stopped = Some(error.to_string());
+        return Err(RunError {
+            error,
+            report: Box::new(c.report),
+        });
     }
     if c.stopping {
         c.report.stopped = Some(STOPPED_ON_REQUEST.to_owned());
@@ -223,6 +240,10 @@ struct Controller<'a, R, C, S: Storage> {
     last_pose: Option<(Pose, PoseDeg)>,
     /// The wheel's last slot, while nothing failed since.
     last_slot: Option<u8>,
+    /// Which devices are down since when, for the journal's `outage` lines.
+    health: DeviceHealth,
+    /// The camera's codes are linear ([`crate::device::CameraInfo::linear`]).
+    linear_camera: bool,
 }
 
 /// `"{occurrence}/s{step}/t{target}"` of a shot key.
@@ -411,7 +432,7 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
                     if attempt < policy.retries {
                         attempt += 1;
                         self.report.retries += 1;
-                        if matches!(e, DeviceError::Link(_)) && kind != DeviceKind::Camera {
+                        if matches!(e, DeviceError::Link(_)) {
                             self.reconnect(kind).await;
                         }
                         tracing::info!(attempt, of = policy.retries, "retrying the shot");
@@ -513,7 +534,7 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
         {
             let mut retake = 0;
             loop {
-                let disc = sun_shot::find_disc(Codes::from(&frame));
+                let disc = sun_shot::find_disc(Codes::from(&self.as_metered(Codes::from(&frame))));
                 let Some(d) = disc else {
                     notes.push("no sun disc found in the frame".to_owned());
                     break;
@@ -563,7 +584,8 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
             .filter(|&by| by > self.options.late_tolerance.as_secs_f64());
         meta.notes = notes;
         if shot.kind == ShotKind::Centering {
-            let fix = self.fix_from_centering(occ, shot, Codes::from(&frame), reached, frame.timestamp, exposure_s);
+            let codes = self.as_metered(Codes::from(&frame));
+            let fix = self.fix_from_centering(occ, shot, Codes::from(&codes), reached, frame.timestamp, exposure_s);
             meta.notes.push(format!(
                 "sun centring: {:+.3}° azimuth, {:+.3}° elevation from the ephemeris",
                 fix.correction.0, fix.correction.1
@@ -589,14 +611,62 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
         self.noted(DeviceKind::Camera, r)
     }
 
-    /// Tell the supervisor how a device call went; pass the result on.
+    /// `codes` as the controller reads them: a linear camera's through
+    /// the assumed gamma ([`metering::gamma_equivalent`]), others as they are.
+    fn as_metered(&self, codes: Codes<'_>) -> CodeImage {
+        if self.linear_camera {
+            metering::gamma_equivalent(codes)
+        } else {
+            CodeImage {
+                width: codes.width,
+                height: codes.height,
+                bits: codes.bits,
+                data: codes.data.to_vec(),
+                label: String::new(),
+            }
+        }
+    }
+
+    /// Tell the supervisor how a device call went, and journal an outage
+    /// it ends (unless the supervisor journals outages itself); pass the
+    /// result on.
     fn noted<T>(&mut self, kind: DeviceKind, r: Result<T, ShotError>) -> Result<T, ShotError> {
+        let now = self.clock.now();
         match &r {
-            Ok(_) => self.supervisor.device_answered(kind, self.clock.now()),
-            Err(ShotError::Device(k, e)) => self.supervisor.device_failed(*k, self.clock.now(), e),
+            Ok(_) => {
+                self.supervisor.device_answered(kind, now);
+                self.health.answered(kind, now);
+            }
+            Err(ShotError::Device(k, e)) => {
+                self.supervisor.device_failed(*k, now, e);
+                self.health.failed(*k, now, &e.to_string());
+            }
             Err(_) => {}
         }
+        let ended = self.health.take_ended();
+        if self.supervisor.journals_outages() {
+            for o in ended {
+                self.store
+                    .record_outage(&o.device.to_string(), o.start, o.end, false)
+                    .map_err(ShotError::Store)?;
+            }
+        }
         r
+    }
+
+    /// Journal the outages of devices still down as the run ends (`open`:
+    /// their end is the run's, not the device's return).
+    fn journal_open_outages(&mut self) -> Result<(), StoreError> {
+        if !self.supervisor.journals_outages() {
+            return Ok(());
+        }
+        let now = self.clock.now();
+        for kind in WATCHED {
+            if let Some(since) = self.health.down_since(kind) {
+                self.store.record_outage(&kind.to_string(), since, now, true)?;
+            }
+        }
+        Ok(())
     }
 
     /// Aim the head (and, for a pose, the tripod); the pose asked for and reached.
@@ -797,7 +867,7 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
             let frame = self.capture(t).await?;
             self.report.metering_captures += 1;
             captures += 1;
-            let median = metering::median_fraction(Codes::from(&frame));
+            let median = metering::median_fraction(Codes::from(&self.as_metered(Codes::from(&frame))));
             ideal = if median > 0.01 && median < 0.97 {
                 t * (metering::TARGET_FRACTION / median).powf(metering::ASSUMED_GAMMA)
             } else {
@@ -835,7 +905,8 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
         for f in 1..before {
             if let Some(e) = self.store.frame_entry(&format!("{target}/f{f}")) {
                 let e = e.clone();
-                frames.push((e.meta.exposure_actual_s, self.store.read_frame(&e)?));
+                let codes = self.store.read_frame(&e)?;
+                frames.push((e.meta.exposure_actual_s, self.as_metered(Codes::from(&codes))));
             }
         }
         Ok(frames)
@@ -887,6 +958,7 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
         let key = format!("{}/t0/f0", shot.key.rsplit_once("/t").map_or("", |(s, _)| s));
         if let Some(e) = self.store.frame_entry(&key).cloned() {
             let codes = self.store.read_frame(&e)?;
+            let codes = self.as_metered(Codes::from(&codes));
             let reached = e.meta.pose_reached.unwrap_or(PoseDeg {
                 pan_deg: 0.0,
                 tilt_deg: 0.0,
@@ -975,6 +1047,7 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
         for f in 1..=2 {
             if let Some(e) = self.store.frame_entry(&format!("{target}/f{f}")).cloned() {
                 let codes = self.store.read_frame(&e)?;
+                let codes = self.as_metered(Codes::from(&codes));
                 filters.insert(e.meta.filter.clone());
                 if let Some(d) = sun_shot::find_disc(Codes::from(&codes)) {
                     sums.push(d.sum);

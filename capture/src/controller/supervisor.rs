@@ -59,6 +59,14 @@ pub trait Supervisor: Send {
     fn device_answered(&mut self, device: DeviceKind, time: DateTime<Utc>) {
         let _ = (device, time);
     }
+
+    /// Whether the controller journals device outages (`outage` lines,
+    /// from a device's first failed call to its first answer after, or to
+    /// the run's end). A supervisor that also watches the devices between
+    /// runs (the unattended station) journals them itself and says no.
+    fn journals_outages(&self) -> bool {
+        true
+    }
 }
 
 /// No supervision: the run goes to its end, metering starts from

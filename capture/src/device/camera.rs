@@ -157,6 +157,10 @@ pub struct CameraInfo {
     /// The exposure times a stepped shutter offers (`None`: any time in
     /// `exposure`, rounded to its step).
     pub exposure_table: Option<ExposureTable>,
+    /// Its codes are proportional to exposure (an astro camera's FITS
+    /// frames, a machine-vision sensor's), not through a response curve:
+    /// the controller meters them as such.
+    pub linear: bool,
 }
 
 impl CameraInfo {
@@ -245,6 +249,13 @@ pub trait Camera: Send {
 
     /// Take one frame with `settings`.
     fn capture(&mut self, settings: CaptureSettings) -> impl Future<Output = Result<Frame, DeviceError>> + Send;
+
+    /// Open the camera's link anew after a capture failed with
+    /// [`DeviceError::Link`] (one attempt; the caller backs off between
+    /// attempts). Cameras with no link to lose do nothing.
+    fn reconnect(&mut self) -> impl Future<Output = Result<(), DeviceError>> + Send {
+        std::future::ready(Ok(()))
+    }
 }
 
 #[cfg(test)]
@@ -285,6 +296,7 @@ mod tests {
                 step_db: 0.0,
             },
             exposure_table: Some(table.clone()),
+            linear: false,
         };
         let e = |s| ExposureTime::from_seconds(s).unwrap();
         let snapped = |s| info.exposure_applied(e(s)).unwrap().seconds();

@@ -170,6 +170,7 @@ impl NokhwaCamera {
             exposure: exposure_limits,
             gain: gain_map.range(),
             exposure_table: None,
+            linear: false,
         };
         Ok(Self {
             camera,

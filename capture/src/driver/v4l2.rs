@@ -213,6 +213,7 @@ impl V4l2Camera {
             exposure: exposure_limits,
             gain: gain_map.range(),
             exposure_table: None,
+            linear: false,
         };
         tracing::info!(camera = %info.model, format = ?format, ?exposure, "V4L2 camera open, manual exposure");
         Ok(Self {

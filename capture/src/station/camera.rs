@@ -3,7 +3,7 @@
 
 use crate::device::{Camera, CameraInfo, CaptureSettings, DeviceError, Frame};
 use crate::driver::camera_thread::ThreadedCamera;
-use crate::driver::indi::IndiCamera;
+use crate::driver::indi::{CcdSettings, IndiCamera};
 use campanile_config::camera::DeviceRef;
 use campanile_config::camera::{Camera as CameraConfig, CameraDriver};
 
@@ -44,16 +44,35 @@ impl Camera for StationCamera {
             StationCamera::Indi(c) => c.capture(settings).await,
         }
     }
+
+    async fn reconnect(&mut self) -> Result<(), DeviceError> {
+        match self {
+            StationCamera::Threaded(c) => c.reconnect().await,
+            StationCamera::Indi(c) => c.reconnect().await,
+        }
+    }
 }
 
 /// The camera `config` describes: an INDI CCD over the network (its frame
 /// the configured resolution), or a V4L2 or nokhwa camera on its thread.
 pub async fn open_station_camera(config: &CameraConfig) -> Result<StationCamera, DeviceError> {
     match (&config.driver, &config.device) {
-        (CameraDriver::Indi, Some(DeviceRef::Indi { server, device })) => {
+        (
+            CameraDriver::Indi,
+            Some(DeviceRef::Indi {
+                server,
+                device,
+                gain,
+                iso,
+            }),
+        ) => {
             let resolution = (config.resolution.width, config.resolution.height);
+            let sensor = CcdSettings {
+                gain: *gain,
+                iso: iso.clone(),
+            };
             Ok(StationCamera::Indi(Box::new(
-                IndiCamera::open(server, device, Some(resolution)).await?,
+                IndiCamera::open_with(server, device, Some(resolution), &sensor).await?,
             )))
         }
         (CameraDriver::Indi, _) => Err(DeviceError::Camera(

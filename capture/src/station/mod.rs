@@ -345,7 +345,22 @@ impl<O: PortOpener, C: Camera> Rig for StationRig<O, C> {
         let (retry, backoff) = (self.options.link_retry, self.options.backoff);
         let seq = self.next_seq();
         match device {
-            DeviceKind::Camera => Ok(()),
+            DeviceKind::Camera => {
+                // The camera reopens itself in place (an INDI camera
+                // connects to its server anew), under the same backoff.
+                let mut n = 0;
+                loop {
+                    tokio::time::sleep(backoff.wait_before(n)).await;
+                    match self.camera.reconnect().await {
+                        Ok(()) => return Ok(()),
+                        Err(e) if n + 1 < backoff.attempts.max(1) => {
+                            tracing::warn!(device = "camera", attempt = n + 1, error = %e, "reopening the camera failed");
+                        }
+                        Err(e) => return Err(e),
+                    }
+                    n += 1;
+                }
+            }
             DeviceKind::Head => {
                 let (cfg, opener) = (&self.station.head, &self.opener);
                 self.head = reopen("head", backoff, || connect_head(cfg, opener, retry, seq)).await?;

@@ -39,6 +39,12 @@ impl Supervisor for StationSupervisor<'_> {
         self.beat.update(time, |_, h| h.failed(device, time, &message));
     }
 
+    fn journals_outages(&self) -> bool {
+        // The station journals outages itself: it probes its devices
+        // between scans too (`journal_outages`).
+        false
+    }
+
     fn device_answered(&mut self, device: DeviceKind, time: DateTime<Utc>) {
         // Rewrite the heartbeat only when the device's state changes.
         let changed = self.beat.health(|h| {

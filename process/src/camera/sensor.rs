@@ -77,6 +77,26 @@ impl CameraModel {
     /// stream of `seed`, so the result is the same for the same seed on any
     /// number of threads.
     pub fn photograph(&self, scene: &RadianceImage, exposure_time_s: f64, seed: u64) -> CodeImage {
+        self.expose(scene, exposure_time_s, seed, |c, x| self.response[c].code_fraction(x))
+    }
+
+    /// Photographs `scene` as [`CameraModel::photograph`] does, but read out
+    /// linearly, as an astro or machine-vision sensor's FITS frame is: the
+    /// code is `(2^bits − 1) · x` (the white level is the full well), no
+    /// response curve.
+    pub fn photograph_linear(&self, scene: &RadianceImage, exposure_time_s: f64, seed: u64) -> CodeImage {
+        self.expose(scene, exposure_time_s, seed, |_, x| x)
+    }
+
+    /// Exposure, noise and clipping as [`CameraModel::photograph`]
+    /// describes, then `transfer(channel, x)` as a fraction of the top code.
+    fn expose(
+        &self,
+        scene: &RadianceImage,
+        exposure_time_s: f64,
+        seed: u64,
+        transfer: impl Fn(usize, f64) -> f64 + Sync,
+    ) -> CodeImage {
         let s = self.sensor;
         let maxc = f64::from(max_code(s.bits));
         let width = scene.width;
@@ -92,7 +112,7 @@ impl CameraModel {
                 let (n1, n2) = standard_normal_pair(&mut rng);
                 let noisy = e + e.max(0.0).sqrt() * n1 + s.read_noise_electrons * n2;
                 let xn = (noisy / s.full_well_electrons).clamp(0.0, 1.0);
-                *out = (maxc * self.response[c].code_fraction(xn)).round() as u16;
+                *out = (maxc * transfer(c, xn)).round() as u16;
             }
         });
         CodeImage {

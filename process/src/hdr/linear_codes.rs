@@ -80,6 +80,33 @@ pub fn log_codes(frame: &LinearFrame) -> CodeImage {
     }
 }
 
+/// A linear sensor's codes (an astro or machine-vision camera's FITS
+/// frame: code ∝ exposure above `black`, its largest code the white level)
+/// as logarithmic codes: `v = (z − black) / (z_max − black)`, a code at
+/// `z_max` clipped. Its label is kept.
+pub fn log_codes_of_linear(image: &CodeImage, black: f64) -> CodeImage {
+    let top = image.max_code();
+    let span = (f64::from(top) - black).max(1.0);
+    let data = image
+        .data
+        .iter()
+        .map(|&z| {
+            if z >= top {
+                max_code(LOG_CODE_BITS)
+            } else {
+                log_code((f64::from(z) - black) / span)
+            }
+        })
+        .collect();
+    CodeImage {
+        width: image.width,
+        height: image.height,
+        bits: LOG_CODE_BITS,
+        data,
+        label: image.label.clone(),
+    }
+}
+
 /// The response curve of [`log_codes`]: `g(z) = D · (z / z_max − 1)` in
 /// every channel, exact at every node (zero uncertainty, no support).
 pub fn log_code_curve() -> ResponseCurve {
@@ -130,5 +157,31 @@ mod tests {
         // Unclipped white stays below the top code; the top code is exposure 1.
         assert_eq!(log_code(1.0), 65_534);
         assert!(curve.ln_exposure(1, 65_535.0).abs() < 1e-12);
+    }
+
+    /// A 16-bit linear frame: half the white level is one stop below it,
+    /// the white level is clipped, 0 is below the codes' range.
+    #[test]
+    fn linear_sensor_codes_become_log_codes() {
+        let image = CodeImage {
+            width: 2,
+            height: 1,
+            bits: 16,
+            data: vec![65535, 32767, 0, 4095, 16383, 100],
+            label: "fits".into(),
+        };
+        let log = log_codes_of_linear(&image, 0.0);
+        let curve = log_code_curve();
+        let g = |z: u16| curve.ln_exposure(0, f64::from(z));
+        assert_eq!(log.data[0], max_code(LOG_CODE_BITS));
+        assert!(
+            (g(log.data[1]) - (32767.0f64 / 65535.0).ln()).abs() < 2e-4,
+            "{}",
+            g(log.data[1])
+        );
+        assert_eq!(log.data[2], 0);
+        assert!((g(log.data[3]) - (4095.0f64 / 65535.0).ln()).abs() < 2e-4);
+        assert!((g(log.data[4]) - (16383.0f64 / 65535.0).ln()).abs() < 2e-4);
+        assert_eq!(log.bits, LOG_CODE_BITS);
     }
 }

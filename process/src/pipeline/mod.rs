@@ -113,7 +113,7 @@ pub enum PipelineError {
     NoBracket,
     /// Some frames are RAW and some are not.
     #[error(
-        "{linear} of the session's {total} frames are RAW (e.g. {raw_example:?}) and the others are not (e.g. {other_example:?}): one response cannot serve both; process them as separate sessions"
+        "{linear} of the session's {total} frames are linear, RAW or FITS (e.g. {raw_example:?}), and the others are not (e.g. {other_example:?}): one response cannot serve both; process them as separate sessions"
     )]
     MixedFrames {
         /// RAW frames.

@@ -156,7 +156,7 @@ pub fn calibrate_response(
     Ok((calibration, choice))
 }
 
-/// The known response of `frames` RAW frames (see [`calibrate_response`]).
+/// The known response of `frames` linear (RAW or FITS) frames (see [`calibrate_response`]).
 fn linear_response(frames: usize) -> (Calibration, ResponseChoice) {
     let calibration = Calibration {
         curve: linear_codes::log_code_curve(),
@@ -171,16 +171,16 @@ fn linear_response(frames: usize) -> (Calibration, ResponseChoice) {
         }),
         times_s: Vec::new(),
         method: format!(
-            "linear (RAW: black level removed, white level = exposure 1, {}-stop logarithmic codes)",
+            "linear (RAW or FITS: black level removed, white level = exposure 1, {}-stop logarithmic codes)",
             linear_codes::LOG_RANGE_STOPS
         ),
     };
     let choice = ResponseChoice {
-        group: "RAW frames".into(),
+        group: "linear frames".into(),
         exposures: 0,
         exposure_ratio: 1.0,
         reason: format!(
-            "all {frames} frames are RAW: the sensor is linear up to its white level, so the response is known, not recovered"
+            "all {frames} frames are linear (RAW or FITS): the sensor is linear up to its white level, so the response is known, not recovered"
         ),
     };
     (calibration, choice)

@@ -49,6 +49,13 @@ pub fn response(calibration: &Calibration, used: usize, planned: usize, q: &Qual
     ProductQuality::new("response", checks)
 }
 
+/// The response of linear frames (RAW, FITS), which is known, not
+/// recovered: there is no fit to judge, so the product is ok with no
+/// figures; the merged maps are judged on their own.
+pub fn known_response() -> ProductQuality {
+    ProductQuality::new("response", Vec::new())
+}
+
 /// A response curve from any method, by what the curve itself shows:
 /// exposures used over planned, and the span of codes observed over the
 /// code range (worst channel).

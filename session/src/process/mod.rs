@@ -190,8 +190,13 @@ pub fn process_session(
     let (calibration, choice) = calibrate_response(&groups, debevec)?;
     stages.push(("response (Debevec–Malik)".to_owned(), t.elapsed().as_secs_f64()));
     let planned = inputs.planned_exposures(&choice.group, choice.exposures);
-    let response_quality = gates::response(&calibration, choice.exposures, planned, &q)
-        .with_note(format!("bracket {}: {}", choice.group, choice.reason));
+    let linear = groups.iter().flat_map(|g| &g.frames).all(|f| f.linear);
+    let response_quality = if linear {
+        gates::known_response()
+    } else {
+        gates::response(&calibration, choice.exposures, planned, &q)
+    }
+    .with_note(format!("bracket {}: {}", choice.group, choice.reason));
 
     let t = Instant::now();
     let b = bar(1, "merging HDR");

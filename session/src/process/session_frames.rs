@@ -10,6 +10,7 @@ use campanile_capture::store::{FrameEntry, JournalEntry, SessionReader, ShotKind
 use campanile_config::plan::Step;
 use campanile_config::source::SourceFile;
 use campanile_config::{Plan, Scene, Station};
+use campanile_process::hdr::linear_codes;
 use campanile_process::pipeline::{CapturedFrame, Purpose, clip_lossy_top};
 use campanile_process::pose::HeadPose;
 use indicatif::ProgressBar;
@@ -125,6 +126,13 @@ impl SessionInputs {
                 if e.format == FrameFormat::Jpeg {
                     clip_lossy_top(&mut codes);
                 }
+                // A FITS frame (an INDI camera's) holds a linear sensor's
+                // codes: its response is known, as a RAW frame's is. Black
+                // is code 0: the FITS header states no black level (a
+                // camera with a bias offset needs dark frames, not done here).
+                if e.format == FrameFormat::Fits {
+                    codes = linear_codes::log_codes_of_linear(&codes, 0.0);
+                }
                 bar.inc(1);
                 let pose = e.meta.pose_reached.or(e.meta.pose_requested).ok_or_else(|| {
                     anyhow!(
@@ -164,7 +172,7 @@ impl SessionInputs {
                     exposure_s: e.meta.exposure_actual_s,
                     filter_transmittance,
                     codes,
-                    linear: e.format == FrameFormat::Dng,
+                    linear: matches!(e.format, FrameFormat::Dng | FrameFormat::Fits),
                 })
             })
             .collect();

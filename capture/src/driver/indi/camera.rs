@@ -27,16 +27,42 @@ pub const READOUT_TIMEOUT: Duration = Duration::from_secs(60);
 #[derive(Debug)]
 pub struct IndiCamera {
     client: IndiClient,
+    server: String,
     device: String,
+    resolution: Option<(u32, u32)>,
+    sensor: CcdSettings,
     info: CameraInfo,
     sequence: u64,
+}
+
+/// The sensor's gain or ISO, held for the whole session (INDI's units are
+/// each driver's own, so they are set as the driver states them, not in
+/// dB; the frames' FITS headers record them, e.g. `GAIN`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CcdSettings {
+    /// `CCD_GAIN.GAIN`, in the driver's units, within its stated range.
+    pub gain: Option<f64>,
+    /// A `CCD_ISO` switch (a DSLR through `indi_gphoto_ccd`), by its name
+    /// or label, e.g. "100" or "ISO 100".
+    pub iso: Option<String>,
 }
 
 impl IndiCamera {
     /// Opens the CCD `device` on the INDI server at `server` (`host:port`),
     /// its frame `resolution` (width, height) centred on the sensor, or the
-    /// whole sensor when `None`.
+    /// whole sensor when `None`, at the driver's own gain.
     pub async fn open(server: &str, device: &str, resolution: Option<(u32, u32)>) -> Result<Self, DeviceError> {
+        Self::open_with(server, device, resolution, &CcdSettings::default()).await
+    }
+
+    /// [`IndiCamera::open`], then the gain or ISO of `sensor` set; a value
+    /// the device does not offer is refused, naming what it offers.
+    pub async fn open_with(
+        server: &str,
+        device: &str,
+        resolution: Option<(u32, u32)>,
+        sensor: &CcdSettings,
+    ) -> Result<Self, DeviceError> {
         let client = IndiClient::connect(server).await?;
         client.connect_device(device).await?;
         client.defined(device, "CCD_INFO").await?;
@@ -71,6 +97,8 @@ impl IndiCamera {
                 break;
             }
         }
+        // By now the driver has defined what it defines on connecting.
+        set_sensor(&client, device, sensor).await?;
         let missing = |what: &str| DeviceError::Camera(format!("INDI device {device:?}: CCD_INFO has no {what}"));
         let max_x = info.number("CCD_MAX_X").ok_or_else(|| missing("CCD_MAX_X"))? as u32;
         let max_y = info.number("CCD_MAX_Y").ok_or_else(|| missing("CCD_MAX_Y"))? as u32;
@@ -142,9 +170,13 @@ impl IndiCamera {
                     step_db: 0.0,
                 },
                 exposure_table: None,
+                linear: true,
             },
             client,
+            server: server.to_owned(),
             device: device.to_owned(),
+            resolution,
+            sensor: sensor.clone(),
             sequence: 0,
         })
     }
@@ -153,6 +185,54 @@ impl IndiCamera {
     pub fn client(&self) -> &IndiClient {
         &self.client
     }
+}
+
+/// Sets the gain and ISO of `sensor` on `device`, each checked against what
+/// the device states (`CCD_GAIN`'s range, `CCD_ISO`'s switches).
+async fn set_sensor(client: &IndiClient, device: &str, sensor: &CcdSettings) -> Result<(), DeviceError> {
+    if let Some(gain) = sensor.gain {
+        let offered = client
+            .property(device, "CCD_GAIN")
+            .and_then(|p| p.item("GAIN").cloned());
+        let Some(item) = offered else {
+            return Err(DeviceError::Camera(format!(
+                "INDI device {device:?} has no CCD_GAIN: leave `gain` out for this camera"
+            )));
+        };
+        let (lo, hi) = (item.min.unwrap_or(f64::NEG_INFINITY), item.max.unwrap_or(f64::INFINITY));
+        if !(lo..=hi).contains(&gain) {
+            return Err(DeviceError::OutOfRange {
+                what: "INDI CCD_GAIN",
+                requested: gain,
+                min: lo,
+                max: hi,
+            });
+        }
+        client.set_numbers(device, "CCD_GAIN", &[("GAIN", gain)]).await?;
+    }
+    if let Some(iso) = &sensor.iso {
+        let Some(property) = client.property(device, "CCD_ISO") else {
+            return Err(DeviceError::Camera(format!(
+                "INDI device {device:?} has no CCD_ISO: leave `iso` out for this camera"
+            )));
+        };
+        let wanted = iso.trim();
+        let item = property.items.iter().find(|i| {
+            i.name.eq_ignore_ascii_case(wanted)
+                || i.label.eq_ignore_ascii_case(wanted)
+                || i.label.trim_start_matches("ISO").trim() == wanted.trim_start_matches("ISO").trim()
+        });
+        let Some(item) = item else {
+            let offered: Vec<&str> = property.items.iter().map(|i| i.label.as_str()).collect();
+            return Err(DeviceError::Camera(format!(
+                "INDI device {device:?} offers no ISO {wanted:?}: it offers {}",
+                offered.join(", ")
+            )));
+        };
+        let name = item.name.clone();
+        client.switch_on(device, "CCD_ISO", &name).await?;
+    }
+    Ok(())
 }
 
 /// A FITS `DATE-OBS` (UTC, `YYYY-MM-DDThh:mm:ss[.s…]`).
@@ -235,6 +315,19 @@ impl Camera for IndiCamera {
                 bytes: blob.bytes,
             }),
         })
+    }
+
+    /// Connects to the server anew and sets the device up as
+    /// [`IndiCamera::open`] did; the frame counter goes on where it was.
+    async fn reconnect(&mut self) -> Result<(), DeviceError> {
+        let fresh = IndiCamera::open_with(&self.server, &self.device, self.resolution, &self.sensor).await?;
+        if fresh.info != self.info {
+            tracing::warn!(before = ?self.info, after = ?fresh.info, "the INDI camera came back different");
+        }
+        let sequence = self.sequence;
+        *self = fresh;
+        self.sequence = sequence;
+        Ok(())
     }
 }
 

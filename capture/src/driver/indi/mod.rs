@@ -26,7 +26,7 @@ pub mod element;
 pub mod local_server;
 pub mod wheel;
 
-pub use camera::IndiCamera;
+pub use camera::{CcdSettings, IndiCamera};
 pub use client::{Blob, IndiClient, Property, PropertyKind, PropertyState};
 pub use local_server::LocalServer;
 pub use wheel::IndiWheel;
