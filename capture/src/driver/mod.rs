@@ -16,7 +16,9 @@
 //!
 //! The cameras share [`exposure_control`] (V4L2 exposure and gain
 //! controls) and [`pixel_format`] (buffers to RGB codes), which need no
-//! camera and are tested in every build.
+//! camera and are tested in every build; so does [`gphoto_settings`]
+//! (gphoto2's shutter, aperture, ISO and image-format choices, bulb, and
+//! the exposure read from a delivered file's EXIF) for the gphoto2 driver.
 //!
 //! A link that drops is reopened by [`backoff::reopen`] (exponential
 //! backoff, capped, logged); [`crate::station`] does so for every serial
@@ -28,6 +30,7 @@ pub mod enttec;
 pub mod exposure_control;
 pub mod flir_ptu;
 pub mod fw102c;
+pub mod gphoto_settings;
 pub mod indi;
 pub mod link;
 #[cfg(feature = "nokhwa")]
