@@ -13,6 +13,7 @@
 //! | `v4l2::V4l2Camera` (feature `v4l`) | V4L2 | `Camera`, through [`camera_thread`] |
 //! | `nokhwa_camera::NokhwaCamera` (feature `nokhwa`) | nokhwa (V4L2 backend) | `Camera`, through [`camera_thread`] |
 //! | [`indi::IndiCamera`], [`indi::IndiWheel`] | INDI over TCP (`indiserver`) | `Camera`, `FilterWheel` |
+//! | `gphoto2_camera::Gphoto2Camera` (feature `gphoto2`) | libgphoto2 (tethered DSLRs); **has never met a camera** | `Camera`, through [`camera_thread`] |
 //!
 //! The cameras share [`exposure_control`] (V4L2 exposure and gain
 //! controls) and [`pixel_format`] (buffers to RGB codes), which need no
@@ -30,6 +31,8 @@ pub mod enttec;
 pub mod exposure_control;
 pub mod flir_ptu;
 pub mod fw102c;
+#[cfg(feature = "gphoto2")]
+pub mod gphoto2_camera;
 pub mod gphoto_settings;
 pub mod indi;
 pub mod link;
