@@ -29,8 +29,9 @@
 //! file is downloaded into [`Frame::file`] byte for byte, decoded to codes
 //! for metering, and the frame's exposure time is the file's EXIF; a time
 //! more than ⅙ stop from the speed set is logged as a warning (the journal
-//! keeps both the requested and the actual time). The file is then deleted
-//! from the camera.
+//! keeps both the requested and the actual time), and so is an f-number or
+//! ISO in the file other than the camera was set to
+//! ([`settings_mismatches`]). The file is then deleted from the camera.
 //!
 //! Not done: RAW formats other than DNG (the session store keeps JPEG and
 //! DNG frames), RAW+JPEG pairs, live view, the sensor's temperature,
@@ -39,6 +40,7 @@
 use super::camera_thread::{BlockingCamera, ThreadedCamera};
 use super::gphoto_settings::{
     self, IsoTable, MISMATCH_STOPS, ShutterPlan, ShutterTable, WantedFile, decode_delivered, exposure_mismatch_stops,
+    settings_mismatches,
 };
 use crate::device::{CameraInfo, CaptureSettings, DeviceError, ExposureTime, Frame, Gain, GainRange};
 use campanile_config::camera::{Camera as CameraConfig, DeviceRef, FrameFileFormat};
@@ -101,10 +103,13 @@ fn pick<'a>(found: &'a [CameraDescriptor], device: Option<&DeviceRef>) -> Result
         }
     };
     chosen.ok_or_else(|| {
+        let what = match device {
+            None => String::new(),
+            Some(_) => format!(" matching {}", device_label(device)),
+        };
         DeviceError::Camera(format!(
-            "gphoto2 finds no camera matching {} (cameras found: {}); check that it is connected, switched on, \
+            "gphoto2 finds no camera{what} (cameras found: {}); check that it is connected, switched on, \
              in PTP/PC mode, and not held by another program (a desktop's gvfs mounts cameras: `gio mount -s gphoto2`)",
-            device_label(device),
             listed()
         ))
     })
@@ -142,6 +147,8 @@ pub struct Gphoto2Camera {
     iso: Option<IsoTable>,
     bulb: Option<BulbControl>,
     longest_s: f64,
+    /// The f-number the camera stayed at, when it states one.
+    aperture: Option<f64>,
     info: CameraInfo,
     sequence: u64,
 }
@@ -186,9 +193,10 @@ impl Gphoto2Camera {
             Some((_, w)) => Some(IsoTable::from_choices(&choices(&w))?),
             None => None,
         };
-        if let Some((key, w)) = radio(&camera, &["aperture", "f-number"]) {
+        let aperture = radio(&camera, &["aperture", "f-number"]).and_then(|(key, w)| {
             tracing::info!(camera = %name, setting = key, aperture = %w.choice(), "aperture kept as the camera has it");
-        }
+            gphoto_settings::parse_aperture(&w.choice()).ok().flatten()
+        });
         let want = match config.file_format {
             FrameFileFormat::Jpeg => Some(WantedFile::Jpeg),
             FrameFileFormat::Dng => Some(WantedFile::Raw),
@@ -252,6 +260,7 @@ impl Gphoto2Camera {
             iso,
             bulb,
             longest_s,
+            aperture,
             info,
             sequence: 0,
         })
@@ -307,16 +316,18 @@ impl Gphoto2Camera {
         }
     }
 
-    fn set_iso(&self, gain: Gain) -> Result<Gain, DeviceError> {
+    /// Sets the ISO for `gain`; the gain applied and the ISO set (`None`
+    /// for a camera without an ISO setting).
+    fn set_iso(&self, gain: Gain) -> Result<(Gain, Option<f64>), DeviceError> {
         let Some(table) = &self.iso else {
             self.info.gain.applied(gain)?;
-            return Ok(Gain::UNITY);
+            return Ok((Gain::UNITY, None));
         };
-        let (label, _, applied) = table.choice_for(gain)?;
+        let (label, iso, applied) = table.choice_for(gain)?;
         let (_, w) = radio(&self.camera, &["iso", "isospeed"])
             .ok_or_else(|| self.failed("setting the ISO", "the iso setting has gone"))?;
         set_choice(&self.camera, &w, label).map_err(|e| self.failed("setting the ISO", e))?;
-        Ok(applied)
+        Ok((applied, Some(iso)))
     }
 
     /// Holds the shutter open for `hold` in bulb and returns the new
@@ -403,7 +414,7 @@ impl BlockingCamera for Gphoto2Camera {
 
     fn capture(&mut self, settings: CaptureSettings) -> Result<Frame, DeviceError> {
         let plan = self.shutter.plan(settings.exposure, self.longest_s)?;
-        let gain = self.set_iso(settings.gain)?;
+        let (gain, iso) = self.set_iso(settings.gain)?;
         let sequence = self.sequence;
         self.sequence += 1;
         let timestamp = chrono::Utc::now();
@@ -431,6 +442,9 @@ impl BlockingCamera for Gphoto2Camera {
                 off_stops = off,
                 "the file's exposure time is not the speed set; the frame keeps the file's"
             );
+        }
+        for m in settings_mismatches(self.aperture, iso, &delivered.exposure) {
+            tracing::warn!(camera = %self.name, file = %file, "{m}");
         }
         let (w, h) = (delivered.codes.width, delivered.codes.height);
         if (w, h) != (self.info.width, self.info.height) {
@@ -491,7 +505,11 @@ mod tests {
             "{err}"
         );
         let err = pick(&[], None).unwrap_err().to_string();
-        assert!(err.contains("(cameras found: none)") && err.contains("PTP"), "{err}");
+        assert!(
+            err.starts_with("camera failure: gphoto2 finds no camera (cameras found: none); check")
+                && err.contains("PTP"),
+            "{err}"
+        );
     }
 
     /// No camera is attached where the tests run: opening is a clear error,
@@ -515,10 +533,17 @@ mod tests {
             let err = Gphoto2Camera::open(&cfg).unwrap_err();
             assert!(matches!(err, DeviceError::Camera(_)), "{device:?}: {err:?}");
             let msg = err.to_string();
-            assert!(msg.contains("gphoto2 finds no camera matching"), "{device:?}: {msg}");
+            assert!(
+                msg.starts_with("camera failure: gphoto2 finds no camera"),
+                "{device:?}: {msg}"
+            );
+            assert!(msg.contains("(cameras found: none)"), "{device:?}: {msg}");
+            if let Some(DeviceRef::Path(p)) = &device {
+                assert!(msg.contains(&format!("matching {p} ")), "{device:?}: {msg}");
+            }
             // Through the camera thread too.
             let err = open(&cfg).unwrap_err().to_string();
-            assert!(err.contains("gphoto2 finds no camera matching"), "{device:?}: {err}");
+            assert_eq!(err, msg, "{device:?}");
         }
     }
 }

@@ -43,7 +43,7 @@
 //! **Exposure used.** The exposure time, f-number and ISO of a frame come
 //! from its file (JPEG EXIF through
 //! [`exposure_metadata`](campanile_process::hdr::exposure_metadata), RAW
-//! through [`raw_file`](campanile_process::hdr::raw_file)), not from what
+//! through [`raw_file`]), not from what
 //! was asked. A time more than [`MISMATCH_STOPS`] from the chosen speed is a
 //! warning, not an error: the frame is good data with a known exposure,
 //! and the journal records both the requested and the actual time.
@@ -621,6 +621,33 @@ pub struct FileExposure {
     pub iso: Option<f64>,
 }
 
+/// What a delivered file says that differs from the aperture `f_number`
+/// and ISO `iso` the camera was set to, by more than [`MISMATCH_STOPS`]
+/// (aperture stops: `2·log₂` of the f-number ratio; ISO stops: `log₂` of
+/// the ratio), one message each. A bracket merged as varying time alone
+/// needs both fixed. Fields the file or the setting leaves unknown are not
+/// compared.
+pub fn settings_mismatches(f_number: Option<f64>, iso: Option<f64>, file: &FileExposure) -> Vec<String> {
+    let mut out = Vec::new();
+    if let (Some(set), Some(got)) = (f_number, file.f_number) {
+        let stops = 2.0 * (got / set).log2();
+        if stops.abs() > MISMATCH_STOPS {
+            out.push(format!(
+                "the file says f/{got}, the aperture was f/{set} ({stops:+.2} stops)"
+            ));
+        }
+    }
+    if let (Some(set), Some(got)) = (iso, file.iso) {
+        let stops = (got / set).log2();
+        if stops.abs() > MISMATCH_STOPS {
+            out.push(format!(
+                "the file says ISO {got}, the camera was set to ISO {set} ({stops:+.2} stops)"
+            ));
+        }
+    }
+    out
+}
+
 /// A file a camera delivered, decoded.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DeliveredFrame {
@@ -628,7 +655,7 @@ pub struct DeliveredFrame {
     pub file: FrameFile,
     /// Its codes for metering (a JPEG's 8-bit codes turned upright; a
     /// RAW's logarithmic codes of
-    /// [`linear_codes`](campanile_process::hdr::linear_codes)), as the
+    /// [`linear_codes`]), as the
     /// store decodes them.
     pub codes: CodeImage,
     /// Its exposure.
@@ -665,7 +692,8 @@ pub fn decode_delivered(name: &str, bytes: Vec<u8>) -> Result<DeliveredFrame, De
             "neither a JPEG nor a DNG"
         };
         return Err(DeviceError::Camera(format!(
-            "{name}: the camera delivered {kind}; set its image format to a JPEG (or DNG) choice"
+            "{name}: the camera delivered {kind}; set the station camera's file_format to Jpeg (Dng only for a \
+             camera whose RAW is DNG)"
         )));
     };
     let time_s = time_s.filter(|t| t.is_finite() && *t > 0.0).ok_or_else(|| {
@@ -1044,6 +1072,19 @@ mod tests {
         // Had 1/10 s been set, the file shows the camera took one stop more.
         let other = table.plan(e(0.1), 30.0).unwrap();
         assert!((exposure_mismatch_stops(&other, d.exposure.time_s) - 1.0).abs() < 1e-12);
+        // The file's f/5.6 and ISO 100 against what the camera was set to.
+        assert!(settings_mismatches(Some(5.6), Some(100.0), &d.exposure).is_empty());
+        assert!(settings_mismatches(None, None, &d.exposure).is_empty());
+        assert_eq!(
+            settings_mismatches(Some(8.0), Some(400.0), &d.exposure),
+            [
+                "the file says f/5.6, the aperture was f/8 (-1.03 stops)",
+                "the file says ISO 100, the camera was set to ISO 400 (-2.00 stops)"
+            ]
+        );
+        // f/6.3 is a third stop (0.34) from f/5.6: reported; f/5.7 (0.05) is not.
+        assert_eq!(settings_mismatches(Some(6.3), None, &d.exposure).len(), 1);
+        assert!(settings_mismatches(Some(5.7), None, &d.exposure).is_empty());
         // The bytes are kept as delivered.
         assert_eq!(
             d.file.bytes,
@@ -1075,7 +1116,10 @@ mod tests {
         let err = decode_delivered("IMG_2.CR2", b"II*\0\x10\0\0\0CR\x02\0".to_vec())
             .unwrap_err()
             .to_string();
-        assert!(err.contains("cannot keep yet") && err.contains("JPEG"), "{err}");
+        assert!(
+            err.contains("cannot keep yet") && err.contains("file_format to Jpeg"),
+            "{err}"
+        );
         let err = decode_delivered("x.bin", vec![1, 2, 3]).unwrap_err().to_string();
         assert!(err.contains("neither a JPEG nor a DNG"), "{err}");
         // A JPEG without EXIF: the exposure used is unknown.
