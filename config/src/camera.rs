@@ -193,8 +193,9 @@ pub struct Camera {
     /// makes the simulated camera deliver what a DSLR would, kept byte for
     /// byte by the session and decoded by `campanile process`. The `Sim`
     /// driver takes it, and `Gphoto2`, which sets the camera's image format
-    /// to its largest finest JPEG (`Jpeg`) or its RAW (`Dng`), or leaves it
-    /// as the camera has it (`Png`).
+    /// to its largest finest JPEG (`Jpeg`) or its RAW (`Dng`: whatever RAW
+    /// the camera writes, DNG, CR2, NEF, …), or leaves it as the camera has
+    /// it (`Png`).
     #[serde(default, skip_serializing_if = "FrameFileFormat::is_png")]
     pub file_format: FrameFileFormat,
 }

@@ -33,9 +33,13 @@
 //! ISO in the file other than the camera was set to
 //! ([`settings_mismatches`]). The file is then deleted from the camera.
 //!
-//! Not done: RAW formats other than DNG (the session store keeps JPEG and
-//! DNG frames), RAW+JPEG pairs, live view, the sensor's temperature,
-//! mirror lock-up.
+//! The RAW file (DNG, CR2, CR3, NEF, ARW, RAF, RW2, ORF, PEF, SRW) is kept
+//! under its own format and read through `rawler`, as `campanile hdr`
+//! reads it; only DNG has been read here from a file (the repository holds
+//! no maker's RAW).
+//!
+//! Not done: RAW+JPEG pairs, live view, the sensor's temperature, mirror
+//! lock-up, choosing the aperture.
 
 use super::camera_thread::{BlockingCamera, ThreadedCamera};
 use super::gphoto_settings::{
@@ -238,10 +242,15 @@ impl Gphoto2Camera {
             },
             IsoTable::range,
         );
+        // A JPEG's codes are 8-bit, a RAW's the 16-bit logarithmic codes of
+        // linear_codes; with the camera's own format, the first frame tells.
         let bits = match want {
             Some(WantedFile::Raw) => campanile_process::hdr::linear_codes::LOG_CODE_BITS,
             _ => 8,
         };
+        if want.is_some() && bits != config.bit_depth {
+            tracing::warn!(camera = %name, configured = config.bit_depth, delivered = bits, "the camera's frames have another bit depth than the station config says");
+        }
         let info = CameraInfo {
             model: name.clone(),
             width: config.resolution.width as usize,

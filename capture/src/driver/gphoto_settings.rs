@@ -663,37 +663,46 @@ pub struct DeliveredFrame {
 }
 
 /// Decodes a file the camera delivered as `name`: a JPEG by its EXIF, a
-/// DNG through the RAW reader. Other RAW files (CR2, NEF, ARW, …) are
-/// refused with what to set instead, as the session store keeps JPEG and
-/// DNG frames; so is a file whose exposure time is not stated.
+/// RAW file (DNG by its content, a maker's RAW, CR2, NEF, ARW …, by its
+/// name and first bytes) through the RAW reader. Anything else is refused,
+/// and so is a file whose exposure time is not stated.
 pub fn decode_delivered(name: &str, bytes: Vec<u8>) -> Result<DeliveredFrame, DeviceError> {
     let path = Path::new(name);
     let failed = |e: campanile_process::hdr::HdrError| DeviceError::Camera(format!("{name}: {e}"));
+    let raw = if tiff_structure::parse(&bytes).is_some_and(|s| s.is_dng()) {
+        Some(FrameFormat::Dng)
+    } else {
+        FrameFormat::from_file_name(name).filter(|f| f.is_raw() && *f != FrameFormat::Dng)
+    };
     let (format, codes, time_s, f_number, iso) = if bytes.starts_with(&[0xFF, 0xD8, 0xFF]) {
         if let Some(problem) = FrameFormat::Jpeg.end_problem(&bytes) {
             return Err(DeviceError::Camera(format!("{name}: {problem}")));
         }
         let (codes, meta) = image_file::read_frame_bytes(path, &bytes).map_err(failed)?;
         (FrameFormat::Jpeg, codes, meta.exposure_time_s, meta.f_number, meta.iso)
-    } else if tiff_structure::parse(&bytes).is_some_and(|s| s.is_dng()) {
+    } else if let Some(format) = raw {
+        if let Some(problem) = format.signature_problem(&bytes) {
+            return Err(DeviceError::Camera(format!("{name}: {problem}")));
+        }
         let frame = raw_file::read_raw_bytes(path, bytes.clone()).map_err(failed)?;
         let meta = frame.meta.clone();
         (
-            FrameFormat::Dng,
+            format,
             linear_codes::log_codes(&frame),
             meta.exposure_time_s,
             meta.f_number,
             meta.iso,
         )
     } else {
-        let kind = if raw_file::is_raw(path) {
-            "a RAW file the session store cannot keep yet (it keeps JPEG and DNG)"
-        } else {
-            "neither a JPEG nor a DNG"
-        };
         return Err(DeviceError::Camera(format!(
-            "{name}: the camera delivered {kind}; set the station camera's file_format to Jpeg (Dng only for a \
-             camera whose RAW is DNG)"
+            "{name}: the camera delivered neither a JPEG nor a RAW file campanile reads ({}); set the station \
+             camera's file_format to Jpeg or Dng",
+            FrameFormat::ALL
+                .iter()
+                .filter(|f| f.is_raw())
+                .map(|f| f.name())
+                .collect::<Vec<_>>()
+                .join(", ")
         )));
     };
     let time_s = time_s.filter(|t| t.is_finite() && *t > 0.0).ok_or_else(|| {
@@ -1102,6 +1111,10 @@ mod tests {
         assert_eq!(d.exposure.iso, Some(100.0));
         assert_eq!(d.codes.bits, 16);
         assert_eq!(d.codes.data.len(), d.codes.width * d.codes.height * 3);
+        // A DNG is known by its content, whatever the camera names it.
+        let named = decode_delivered("IMGP0001.PEF", fixture("validation/raw/fixtures/sim_rggb_14bit.dng")).unwrap();
+        assert_eq!(named.file.format, FrameFormat::Dng);
+        assert!(named.codes.data == d.codes.data && named.codes.width == d.codes.width);
     }
 
     #[test]
@@ -1113,15 +1126,25 @@ mod tests {
         };
         let err = decode_delivered("IMG_1.JPG", cut).unwrap_err().to_string();
         assert!(err.contains("IMG_1.JPG") && err.contains("cut short"), "{err}");
-        let err = decode_delivered("IMG_2.CR2", b"II*\0\x10\0\0\0CR\x02\0".to_vec())
+        // A CR2 that is no TIFF, and one whose TIFF holds no raw image: the
+        // RAW reader's error, named, never a panic.
+        let err = decode_delivered("IMG_2.CR2", b"GIF89a".to_vec())
             .unwrap_err()
             .to_string();
         assert!(
-            err.contains("cannot keep yet") && err.contains("file_format to Jpeg"),
+            err.starts_with("camera failure: IMG_2.CR2: 6 bytes") && err.contains("CR2 file"),
             "{err}"
         );
+        let err = decode_delivered("IMG_3.CR2", b"II*\0\x10\0\0\0CR\x02\0\0\0\0\0".to_vec())
+            .unwrap_err()
+            .to_string();
+        assert!(err.starts_with("camera failure: IMG_3.CR2: "), "{err}");
         let err = decode_delivered("x.bin", vec![1, 2, 3]).unwrap_err().to_string();
-        assert!(err.contains("neither a JPEG nor a DNG"), "{err}");
+        assert!(
+            err.contains("neither a JPEG nor a RAW file campanile reads (DNG, CR2, CR3, NEF")
+                && err.contains("file_format to Jpeg"),
+            "{err}"
+        );
         // A JPEG without EXIF: the exposure used is unknown.
         let mut plain = Vec::new();
         image::codecs::jpeg::JpegEncoder::new(&mut plain)

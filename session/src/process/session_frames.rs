@@ -164,7 +164,7 @@ impl SessionInputs {
                     exposure_s: e.meta.exposure_actual_s,
                     filter_transmittance,
                     codes,
-                    linear: e.format == FrameFormat::Dng,
+                    linear: e.format.is_raw(),
                 })
             })
             .collect();
