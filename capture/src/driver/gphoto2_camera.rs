@@ -1,53 +1,26 @@
 //! A tethered DSLR or mirrorless body through libgphoto2 (cargo feature
-//! `gphoto2`, crate `gphoto2`, Debian `libgphoto2-dev`).
+//! `gphoto2`, crate `gphoto2`, Debian `libgphoto2-dev`): the [`Tether`]
+//! that [`TetheredCamera`] drives.
 //!
 //! **This backend has never met a camera.** Debian's libgphoto2 has no
 //! virtual camera (`vusb`), so what is tested is the settings mapping
-//! ([`gphoto_settings`], every build: real choice lists, real EXIF files)
-//! and that opening with no camera attached is a clear
-//! [`DeviceError`]; the capture path below follows libgphoto2's documented
-//! use (`gphoto2 --capture-image-and-download`, the bulb recipes of
-//! gphoto.org/doc/remote) and is untried.
+//! ([`gphoto_settings`](super::gphoto_settings)) and the camera logic
+//! ([`tethered_camera`](super::tethered_camera)) in every build, against
+//! real choice lists and real camera files, and here the choice of camera
+//! and that opening with no camera attached is a clear [`DeviceError`].
+//! The libgphoto2 calls below follow its documented use (`gphoto2
+//! --capture-image-and-download`, the bulb recipes of gphoto.org/doc/remote)
+//! and are untried.
 //!
-//! Opening finds the camera (the first one libgphoto2 detects, or the one
-//! the station's `device` names by port, model or index), reads its
-//! `shutterspeed` (Nikon's exact `shutterspeed2` when present), `iso`,
-//! `aperture` (`f-number` on Nikon) and `imageformat` (`imagequality`)
-//! choices, sets the image format the station's `file_format` asks for
-//! (largest finest JPEG for `Jpeg`, plain RAW for `Dng`, the camera's own
-//! for `Png`), and captures to the camera's RAM when it offers that
-//! (`capturetarget`). The camera must be in manual (M) exposure mode.
-//!
-//! Each capture snaps the exposure to the camera's table
-//! ([`ShutterTable::plan`]): a timed speed is set and `gp_camera_capture`
-//! takes the frame; beyond the longest timed speed, bulb is set and the
-//! shutter held open for the planned time (`eosremoterelease` Press Full /
-//! Release Full on Canon, the `bulb` toggle elsewhere), after which the new
-//! file is awaited. A camera that takes a shutter setting only a notch at a
-//! time (it reads back another speed than was set) is stepped there
-//! ([`ShutterTable::notches`]). The gain sets the ISO ([`IsoTable`]). The
-//! file is downloaded into [`Frame::file`] byte for byte, decoded to codes
-//! for metering, and the frame's exposure time is the file's EXIF; a time
-//! more than ⅙ stop from the speed set is logged as a warning (the journal
-//! keeps both the requested and the actual time), and so is an f-number or
-//! ISO in the file other than the camera was set to
-//! ([`settings_mismatches`]). The file is then deleted from the camera.
-//!
-//! The RAW file (DNG, CR2, CR3, NEF, ARW, RAF, RW2, ORF, PEF, SRW) is kept
-//! under its own format and read through `rawler`, as `campanile hdr`
-//! reads it; only DNG has been read here from a file (the repository holds
-//! no maker's RAW).
-//!
-//! Not done: RAW+JPEG pairs, live view, the sensor's temperature, mirror
-//! lock-up, choosing the aperture.
+//! The camera is the first one libgphoto2 detects, or the one the station's
+//! `device` names: a port (`Path("usb:001,004")`, any string with a gphoto2
+//! port prefix), a model as `gphoto2 --auto-detect` lists it
+//! (`Path("Canon EOS 5D Mark II")`), or the n-th camera found (`Index(n)`).
 
-use super::camera_thread::{BlockingCamera, ThreadedCamera};
-use super::gphoto_settings::{
-    self, IsoTable, MISMATCH_STOPS, ShutterPlan, ShutterTable, WantedFile, decode_delivered, exposure_mismatch_stops,
-    settings_mismatches,
-};
-use crate::device::{CameraInfo, CaptureSettings, DeviceError, ExposureTime, Frame, Gain, GainRange};
-use campanile_config::camera::{Camera as CameraConfig, DeviceRef, FrameFileFormat};
+use super::camera_thread::ThreadedCamera;
+use super::tethered_camera::{CameraFile, Tether, TetheredCamera};
+use crate::device::DeviceError;
+use campanile_config::camera::{Camera as CameraConfig, DeviceRef};
 use gphoto2::camera::CameraEvent;
 use gphoto2::list::CameraDescriptor;
 use gphoto2::widget::{RadioWidget, ToggleWidget};
@@ -66,16 +39,15 @@ const PORT_PREFIXES: [&str; 7] = [
     "usbscsi:",
 ];
 
-/// How long after the exposure (timed or bulb) a new file may take to
-/// arrive.
-const FILE_TIMEOUT: Duration = Duration::from_secs(30);
-
 /// Open the station's gphoto2 camera on its own thread, as a
 /// [`Camera`](crate::device::Camera).
 pub fn open(config: &CameraConfig) -> Result<ThreadedCamera, DeviceError> {
     let config = config.clone();
     let name = format!("gphoto2 {}", device_label(config.device.as_ref()));
-    ThreadedCamera::spawn(&name, move || Gphoto2Camera::open(&config))
+    ThreadedCamera::spawn(&name, move || {
+        let tether = Gphoto2Tether::open(config.device.as_ref())?;
+        TetheredCamera::new(tether, &config)
+    })
 }
 
 fn device_label(device: Option<&DeviceRef>) -> String {
@@ -119,366 +91,137 @@ fn pick<'a>(found: &'a [CameraDescriptor], device: Option<&DeviceRef>) -> Result
     })
 }
 
-fn gp_error(what: &str) -> impl Fn(gphoto2::Error) -> DeviceError + '_ {
-    move |e| DeviceError::Camera(format!("gphoto2: {what}: {e}"))
-}
-
-/// The first of `keys` the camera has as a radio (or menu) widget.
-fn radio(camera: &Camera, keys: &[&'static str]) -> Option<(&'static str, RadioWidget)> {
-    keys.iter()
-        .find_map(|k| camera.config_key::<RadioWidget>(k).wait().ok().map(|w| (*k, w)))
-}
-
-fn choices(w: &RadioWidget) -> Vec<String> {
-    w.choices_iter().collect()
-}
-
-/// How the camera's bulb is worked.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum BulbControl {
-    /// Canon EOS: `eosremoterelease` Press Full, then Release Full.
-    EosRemoteRelease,
-    /// Nikon, Olympus and others: the `bulb` toggle on, then off.
-    Toggle,
-}
-
-/// An open gphoto2 camera (blocking; see [`open`]).
-pub struct Gphoto2Camera {
+/// A camera open through libgphoto2.
+pub struct Gphoto2Tether {
     camera: Camera,
     name: String,
-    shutter_key: &'static str,
-    shutter: ShutterTable,
-    iso: Option<IsoTable>,
-    bulb: Option<BulbControl>,
-    longest_s: f64,
-    /// The f-number the camera stayed at, when it states one.
-    aperture: Option<f64>,
-    info: CameraInfo,
-    sequence: u64,
 }
 
-impl std::fmt::Debug for Gphoto2Camera {
+impl std::fmt::Debug for Gphoto2Tether {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Gphoto2Camera")
+        f.debug_struct("Gphoto2Tether")
             .field("name", &self.name)
-            .field("shutter_key", &self.shutter_key)
             .finish_non_exhaustive()
     }
 }
 
-impl Gphoto2Camera {
-    /// Find, open and set up the camera `config` names (on the calling
-    /// thread). With no camera attached this is a [`DeviceError::Camera`]
-    /// saying what to check.
-    pub fn open(config: &CameraConfig) -> Result<Self, DeviceError> {
-        let context = Context::new().map_err(gp_error("cannot start libgphoto2"))?;
+impl Gphoto2Tether {
+    /// Finds and opens the camera `device` names (module doc); with no
+    /// camera attached, a [`DeviceError::Camera`] saying what to check.
+    pub fn open(device: Option<&DeviceRef>) -> Result<Self, DeviceError> {
+        let gp = |what: &'static str| move |e: gphoto2::Error| DeviceError::Camera(format!("gphoto2: {what}: {e}"));
+        let context = Context::new().map_err(gp("cannot start libgphoto2"))?;
         let found: Vec<CameraDescriptor> = context
             .list_cameras()
             .wait()
-            .map_err(gp_error("cannot list cameras"))?
+            .map_err(gp("cannot list cameras"))?
             .collect();
-        let desc = pick(&found, config.device.as_ref())?.clone();
+        let desc = pick(&found, device)?.clone();
         let name = format!("{} at {}", desc.model, desc.port);
         let camera = context
             .get_camera(&desc)
             .wait()
             .map_err(|e| DeviceError::Camera(format!("gphoto2: cannot open {name}: {e}")))?;
-
-        let (shutter_key, shutter_widget) = radio(&camera, &["shutterspeed2", "shutterspeed"]).ok_or_else(|| {
-            DeviceError::Camera(format!(
-                "{name}: has no shutterspeed setting, so manual exposure is impossible (put it in manual, M, mode)"
-            ))
-        })?;
-        let shutter = ShutterTable::from_choices(&choices(&shutter_widget))?;
-        for s in shutter.skipped() {
-            tracing::info!(camera = %name, "shutterspeed choice skipped: {s}");
-        }
-        let iso = match radio(&camera, &["iso", "isospeed"]) {
-            Some((_, w)) => Some(IsoTable::from_choices(&choices(&w))?),
-            None => None,
-        };
-        let aperture = radio(&camera, &["aperture", "f-number"]).and_then(|(key, w)| {
-            tracing::info!(camera = %name, setting = key, aperture = %w.choice(), "aperture kept as the camera has it");
-            gphoto_settings::parse_aperture(&w.choice()).ok().flatten()
-        });
-        let want = match config.file_format {
-            FrameFileFormat::Jpeg => Some(WantedFile::Jpeg),
-            FrameFileFormat::Dng => Some(WantedFile::Raw),
-            FrameFileFormat::Png => None,
-        };
-        if let Some(want) = want {
-            let (key, w) = radio(&camera, &["imageformat", "imagequality"]).ok_or_else(|| {
-                DeviceError::Camera(format!(
-                    "{name}: has no imageformat setting, so the station's file_format cannot be set; leave file_format out"
-                ))
-            })?;
-            let choice = gphoto_settings::image_format_choice(&choices(&w), want)?;
-            set_choice(&camera, &w, &choice).map_err(|e| DeviceError::Camera(format!("{name}: {key}: {e}")))?;
-        }
-        if let Some((_, w)) = radio(&camera, &["capturetarget"])
-            && let Some(ram) = choices(&w).into_iter().find(|c| c.to_ascii_lowercase().contains("ram"))
-            && let Err(e) = set_choice(&camera, &w, &ram)
-        {
-            tracing::warn!(camera = %name, "cannot capture to the camera's RAM ({e}); frames go to its card and are deleted after download");
-        }
-        let bulb = shutter.bulb().and_then(|_| {
-            if camera.config_key::<RadioWidget>("eosremoterelease").wait().is_ok() {
-                Some(BulbControl::EosRemoteRelease)
-            } else if camera.config_key::<ToggleWidget>("bulb").wait().is_ok() {
-                Some(BulbControl::Toggle)
-            } else {
-                tracing::warn!(camera = %name, "lists bulb but has neither eosremoterelease nor a bulb toggle: exposures end at its longest timed speed");
-                None
-            }
-        });
-        // Without a way to work bulb, the table stops at the timed speeds.
-        let longest_s = if bulb.is_some() { config.exposure.max_s } else { 0.0 };
-        let table = shutter.exposure_table(longest_s);
-        let gain = iso.as_ref().map_or(
-            GainRange {
-                min: Gain::UNITY,
-                max: Gain::UNITY,
-                step_db: 0.0,
-            },
-            IsoTable::range,
-        );
-        // A JPEG's codes are 8-bit, a RAW's the 16-bit logarithmic codes of
-        // linear_codes; with the camera's own format, the first frame tells.
-        let bits = match want {
-            Some(WantedFile::Raw) => campanile_process::hdr::linear_codes::LOG_CODE_BITS,
-            _ => 8,
-        };
-        if want.is_some() && bits != config.bit_depth {
-            tracing::warn!(camera = %name, configured = config.bit_depth, delivered = bits, "the camera's frames have another bit depth than the station config says");
-        }
-        let info = CameraInfo {
-            model: name.clone(),
-            width: config.resolution.width as usize,
-            height: config.resolution.height as usize,
-            bits,
-            exposure: table.range(),
-            gain,
-            exposure_table: Some(table),
-        };
-        tracing::info!(camera = %name, shutter = shutter_key, speeds = shutter.timed().len(), bulb = ?bulb, "gphoto2 camera open");
-        Ok(Self {
-            camera,
-            name,
-            shutter_key,
-            shutter,
-            iso,
-            bulb,
-            longest_s,
-            aperture,
-            info,
-            sequence: 0,
-        })
+        Ok(Self { camera, name })
     }
 
     fn failed(&self, what: &str, e: impl std::fmt::Display) -> DeviceError {
         DeviceError::Camera(format!("{}: {what}: {e}", self.name))
     }
 
-    fn shutter_widget(&self) -> Result<RadioWidget, DeviceError> {
-        self.camera
-            .config_key::<RadioWidget>(self.shutter_key)
+    fn radio(&self, key: &str) -> Result<RadioWidget, gphoto2::Error> {
+        self.camera.config_key::<RadioWidget>(key).wait()
+    }
+}
+
+impl Tether for Gphoto2Tether {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn choices(&mut self, key: &str) -> Option<Vec<String>> {
+        self.radio(key).ok().map(|w| w.choices_iter().collect())
+    }
+
+    fn current(&mut self, key: &str) -> Result<String, DeviceError> {
+        self.radio(key)
+            .map(|w| w.choice())
+            .map_err(|e| self.failed(&format!("reading {key}"), e))
+    }
+
+    fn set(&mut self, key: &str, choice: &str) -> Result<(), DeviceError> {
+        let w = self.radio(key).map_err(|e| self.failed(&format!("reading {key}"), e))?;
+        w.set_choice(choice)
+            .and_then(|()| self.camera.set_config(&w).wait())
+            .map_err(|e| self.failed(&format!("setting {key} to {choice:?}"), e))
+    }
+
+    fn has_toggle(&mut self, key: &str) -> bool {
+        self.camera.config_key::<ToggleWidget>(key).wait().is_ok()
+    }
+
+    fn set_toggle(&mut self, key: &str, on: bool) -> Result<(), DeviceError> {
+        let w = self
+            .camera
+            .config_key::<ToggleWidget>(key)
             .wait()
-            .map_err(|e| self.failed("reading the shutter speed", e))
+            .map_err(|e| self.failed(&format!("reading {key}"), e))?;
+        w.set_toggled(on);
+        self.camera
+            .set_config(&w)
+            .wait()
+            .map_err(|e| self.failed(&format!("setting {key} {}", if on { "on" } else { "off" }), e))
     }
 
-    /// Sets the shutter to `label`, stepping a notch at a time if the
-    /// camera only moves that way.
-    fn set_shutter(&self, label: &str) -> Result<(), DeviceError> {
-        let w = self.shutter_widget()?;
-        set_choice(&self.camera, &w, label).map_err(|e| self.failed("setting the shutter speed", e))?;
-        let mut now = self.shutter_widget()?.choice();
-        if now == label {
-            return Ok(());
-        }
-        let target = self
-            .shutter
-            .choice(label)
-            .and_then(|c| ExposureTime::from_seconds(c.seconds))
-            .ok_or_else(|| self.failed("setting the shutter speed", format!("{label:?} is no timed speed")))?;
-        let notches = self.shutter.notches(&now, target)?;
-        tracing::info!(camera = %self.name, from = %now, to = label, notches, "the shutter steps a notch at a time");
-        for _ in 0..notches.unsigned_abs() {
-            let i = self.shutter.timed().iter().position(|c| c.label == now).unwrap_or(0);
-            let next = if notches > 0 { i + 1 } else { i.saturating_sub(1) };
-            let Some(next) = self.shutter.timed().get(next) else {
-                break;
-            };
-            let w = self.shutter_widget()?;
-            set_choice(&self.camera, &w, &next.label).map_err(|e| self.failed("stepping the shutter speed", e))?;
-            now = self.shutter_widget()?.choice();
-        }
-        if now == label {
-            Ok(())
-        } else {
-            Err(self.failed(
-                "setting the shutter speed",
-                format!(
-                    "asked for {label:?}, the camera reads {now:?} after {} notches",
-                    notches.unsigned_abs()
-                ),
-            ))
-        }
+    fn capture(&mut self) -> Result<CameraFile, DeviceError> {
+        let path = self
+            .camera
+            .capture_image()
+            .wait()
+            .map_err(|e| self.failed("capturing", e))?;
+        Ok(CameraFile {
+            folder: path.folder().into_owned(),
+            name: path.name().into_owned(),
+        })
     }
 
-    /// Sets the ISO for `gain`; the gain applied and the ISO set (`None`
-    /// for a camera without an ISO setting).
-    fn set_iso(&self, gain: Gain) -> Result<(Gain, Option<f64>), DeviceError> {
-        let Some(table) = &self.iso else {
-            self.info.gain.applied(gain)?;
-            return Ok((Gain::UNITY, None));
-        };
-        let (label, iso, applied) = table.choice_for(gain)?;
-        let (_, w) = radio(&self.camera, &["iso", "isospeed"])
-            .ok_or_else(|| self.failed("setting the ISO", "the iso setting has gone"))?;
-        set_choice(&self.camera, &w, label).map_err(|e| self.failed("setting the ISO", e))?;
-        Ok((applied, Some(iso)))
-    }
-
-    /// Holds the shutter open for `hold` in bulb and returns the new
-    /// file's folder and name.
-    fn bulb_exposure(&self, choice: &str, hold: Duration) -> Result<(String, String), DeviceError> {
-        let control = self
-            .bulb
-            .ok_or_else(|| self.failed("bulb", "the camera offers no way to hold the shutter open"))?;
-        let w = self.shutter_widget()?;
-        set_choice(&self.camera, &w, choice).map_err(|e| self.failed("setting bulb", e))?;
-        let press = |on: bool| -> Result<(), DeviceError> {
-            match control {
-                BulbControl::EosRemoteRelease => {
-                    let w = self
-                        .camera
-                        .config_key::<RadioWidget>("eosremoterelease")
-                        .wait()
-                        .map_err(|e| self.failed("eosremoterelease", e))?;
-                    let v = if on { "Press Full" } else { "Release Full" };
-                    set_choice(&self.camera, &w, v).map_err(|e| self.failed("eosremoterelease", e))
-                }
-                BulbControl::Toggle => {
-                    let w = self
-                        .camera
-                        .config_key::<ToggleWidget>("bulb")
-                        .wait()
-                        .map_err(|e| self.failed("bulb", e))?;
-                    w.set_toggled(on);
-                    self.camera.set_config(&w).wait().map_err(|e| self.failed("bulb", e))
-                }
-            }
-        };
-        let opened = Instant::now();
-        press(true)?;
-        std::thread::sleep(hold.saturating_sub(opened.elapsed()));
-        press(false)?;
-        tracing::debug!(camera = %self.name, held_s = opened.elapsed().as_secs_f64(), "bulb closed");
-        self.await_new_file()
-    }
-
-    fn await_new_file(&self) -> Result<(String, String), DeviceError> {
-        let deadline = Instant::now() + FILE_TIMEOUT;
+    fn await_new_file(&mut self, timeout: Duration) -> Result<CameraFile, DeviceError> {
+        let deadline = Instant::now() + timeout;
         while Instant::now() < deadline {
             let left = deadline.saturating_duration_since(Instant::now());
             match self.camera.wait_event(left).wait() {
-                Ok(CameraEvent::NewFile(path)) => return Ok((path.folder().into_owned(), path.name().into_owned())),
+                Ok(CameraEvent::NewFile(path)) => {
+                    return Ok(CameraFile {
+                        folder: path.folder().into_owned(),
+                        name: path.name().into_owned(),
+                    });
+                }
                 Ok(CameraEvent::Timeout) => break,
                 Ok(_) => {}
                 Err(e) => return Err(self.failed("waiting for the file", e)),
             }
         }
         Err(DeviceError::Timeout(format!(
-            "{}: no new file within {:?} of the exposure's end",
-            self.name, FILE_TIMEOUT
+            "{}: no new file within {timeout:?} of the exposure's end",
+            self.name
         )))
     }
 
-    fn download(&self, folder: &str, file: &str) -> Result<Vec<u8>, DeviceError> {
+    fn download(&mut self, file: &CameraFile) -> Result<Vec<u8>, DeviceError> {
+        let path = format!("{}/{}", file.folder, file.name);
         let fs = self.camera.fs();
         let f = fs
-            .download(folder, file)
+            .download(&file.folder, &file.name)
             .wait()
-            .map_err(|e| self.failed(&format!("downloading {folder}/{file}"), e))?;
+            .map_err(|e| self.failed(&format!("downloading {path}"), e))?;
         let data = f
             .get_data(&self.camera)
             .wait()
-            .map_err(|e| self.failed(&format!("reading {folder}/{file}"), e))?;
-        if let Err(e) = fs.delete_file(folder, file).wait() {
-            tracing::info!(camera = %self.name, file = %format!("{folder}/{file}"), "left on the camera: {e}");
+            .map_err(|e| self.failed(&format!("reading {path}"), e))?;
+        if let Err(e) = fs.delete_file(&file.folder, &file.name).wait() {
+            tracing::info!(camera = %self.name, file = %path, "left on the camera: {e}");
         }
         Ok(data.into_vec())
-    }
-}
-
-fn set_choice(camera: &Camera, w: &RadioWidget, choice: &str) -> Result<(), gphoto2::Error> {
-    w.set_choice(choice)?;
-    camera.set_config(w).wait()
-}
-
-impl BlockingCamera for Gphoto2Camera {
-    fn info(&self) -> CameraInfo {
-        self.info.clone()
-    }
-
-    fn capture(&mut self, settings: CaptureSettings) -> Result<Frame, DeviceError> {
-        let plan = self.shutter.plan(settings.exposure, self.longest_s)?;
-        let (gain, iso) = self.set_iso(settings.gain)?;
-        let sequence = self.sequence;
-        self.sequence += 1;
-        let timestamp = chrono::Utc::now();
-        let (folder, file) = match &plan {
-            ShutterPlan::Timed(choice) => {
-                self.set_shutter(&choice.label)?;
-                let path = self
-                    .camera
-                    .capture_image()
-                    .wait()
-                    .map_err(|e| self.failed("capturing", e))?;
-                (path.folder().into_owned(), path.name().into_owned())
-            }
-            ShutterPlan::Bulb { choice, hold } => self.bulb_exposure(choice, hold.duration())?,
-        };
-        let bytes = self.download(&folder, &file)?;
-        let delivered = decode_delivered(&file, bytes)?;
-        let off = exposure_mismatch_stops(&plan, delivered.exposure.time_s);
-        if off > MISMATCH_STOPS {
-            tracing::warn!(
-                camera = %self.name,
-                file = %file,
-                set_s = plan.nominal().seconds(),
-                exif_s = delivered.exposure.time_s,
-                off_stops = off,
-                "the file's exposure time is not the speed set; the frame keeps the file's"
-            );
-        }
-        for m in settings_mismatches(self.aperture, iso, &delivered.exposure) {
-            tracing::warn!(camera = %self.name, file = %file, "{m}");
-        }
-        let (w, h) = (delivered.codes.width, delivered.codes.height);
-        if (w, h) != (self.info.width, self.info.height) {
-            return Err(self.failed(
-                "frame size",
-                format!(
-                    "the camera delivered {w}×{h}, the station's camera resolution is {}×{}; set it to what the camera gives",
-                    self.info.width, self.info.height
-                ),
-            ));
-        }
-        let actual = ExposureTime::from_seconds(delivered.exposure.time_s).unwrap_or_else(|| plan.nominal());
-        Ok(Frame {
-            width: w,
-            height: h,
-            bits: delivered.codes.bits,
-            data: delivered.codes.data,
-            exposure_requested: settings.exposure,
-            exposure_actual: actual,
-            gain,
-            sequence,
-            timestamp,
-            temperature_c: None,
-            file: Some(delivered.file),
-        })
     }
 }
 
@@ -539,7 +282,7 @@ mod tests {
             Some(DeviceRef::Path("Canon EOS 5D Mark II".into())),
         ] {
             cfg.device = device.clone();
-            let err = Gphoto2Camera::open(&cfg).unwrap_err();
+            let err = Gphoto2Tether::open(cfg.device.as_ref()).unwrap_err();
             assert!(matches!(err, DeviceError::Camera(_)), "{device:?}: {err:?}");
             let msg = err.to_string();
             assert!(
