@@ -375,8 +375,12 @@ mod tests {
     use std::path::Path;
 
     /// The radiantlab EOS 5D Mark II bracket (640×640 crops, EXIF kept):
-    /// file and EXIF exposure time (exposures.csv beside them).
-    const BRACKET: [(&str, f64); 8] = [
+    /// file and EXIF exposure time (exposures.csv beside them). The
+    /// scripted camera delivers the one nearest the exposure taken.
+    const BRACKET: [(&str, f64); 18] = [
+        ("IMG_6955.JPG", 13.0),
+        ("IMG_6956.JPG", 6.0),
+        ("IMG_6957.JPG", 3.2),
         ("IMG_6958.JPG", 1.6),
         ("IMG_6959.JPG", 0.8),
         ("IMG_6960.JPG", 0.4),
@@ -385,6 +389,13 @@ mod tests {
         ("IMG_6963.JPG", 0.05),
         ("IMG_6964.JPG", 0.025),
         ("IMG_6965.JPG", 1.0 / 80.0),
+        ("IMG_6966.JPG", 1.0 / 160.0),
+        ("IMG_6967.JPG", 1.0 / 320.0),
+        ("IMG_6968.JPG", 1.0 / 640.0),
+        ("IMG_6969.JPG", 1.0 / 1250.0),
+        ("IMG_6970.JPG", 1.0 / 2500.0),
+        ("IMG_6971.JPG", 1.0 / 5000.0),
+        ("IMG_6972.JPG", 1.0 / 8000.0),
     ];
 
     fn jpeg(name: &str) -> Vec<u8> {
@@ -449,6 +460,19 @@ mod tests {
                 held: None,
                 pending: None,
             }
+        }
+
+        /// A camera whose speeds are exactly the bracket's 18, so every
+        /// frame's file states the speed set.
+        fn bracket_speeds() -> Self {
+            let mut s = Self::canon("30");
+            let labels = [
+                "13", "6", "3.2", "1.6", "0.8", "0.4", "1/5", "1/10", "1/20", "1/40", "1/80", "1/160", "1/320",
+                "1/640", "1/1250", "1/2500", "1/5000", "1/8000",
+            ];
+            s.settings
+                .insert("shutterspeed".into(), (strings(&labels), "1/5".into()));
+            s
         }
 
         fn exposure_s(&self) -> f64 {
@@ -685,5 +709,37 @@ mod tests {
         );
         assert!(cam.tether().held.unwrap().as_secs_f64() >= 0.4);
         assert_eq!(f.exposure_actual.seconds(), 0.4);
+    }
+
+    /// The camera conformance suite (`campanile devices test`) on the
+    /// scripted camera through its thread. With the bracket's 18 speeds
+    /// (no bulb toggle) every file states the speed set, and the suite
+    /// passes: 1/800 s asked is the 1/640 s entry, 0.0375 s the 1/20 s one,
+    /// twice the longest (26 s) is refused. With the 5D Mark II's ⅓-stop
+    /// list the scripted camera delivers only the bracket's files, a third
+    /// of a stop off at 1/800 s, and the suite says so.
+    #[tokio::test]
+    async fn the_camera_conformance_suite_checks_the_table() {
+        let mut cam = crate::driver::camera_thread::ThreadedCamera::spawn("scripted EOS", || {
+            let mut s = Scripted::bracket_speeds();
+            s.toggles.clear();
+            TetheredCamera::new(s, &config())
+        })
+        .unwrap();
+        let report = crate::conformance::camera::run(&mut cam).await;
+        assert!(report.passed(), "{:?}", report.failures());
+        assert_eq!(report.checks.len(), 3);
+        let mut cam = crate::driver::camera_thread::ThreadedCamera::spawn("scripted EOS", || {
+            TetheredCamera::new(Scripted::canon("30"), &config())
+        })
+        .unwrap();
+        let report = crate::conformance::camera::run(&mut cam).await;
+        let failures = report.failures();
+        assert_eq!(failures.len(), 2, "{failures:?}");
+        let why = failures[0].failure.as_deref().unwrap_or_default();
+        assert!(
+            why.contains("the camera's table gives 0.00125 s, the camera reports 0.0015625 s applied (+0.32 stops)"),
+            "{why}"
+        );
     }
 }
