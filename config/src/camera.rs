@@ -22,6 +22,12 @@ pub enum CameraDriver {
     /// "127.0.0.1:7624", device: "CCD Simulator")`); DSLRs reach INDI
     /// through `indi_gphoto_ccd`.
     Indi,
+    /// A tethered DSLR or mirrorless body through libgphoto2 (cargo
+    /// feature `gphoto2`): `device` absent for the first camera found,
+    /// `Path("usb:001,004")` for a gphoto2 port, `Path("Canon EOS 5D Mark
+    /// II")` for a model as `gphoto2 --auto-detect` lists it, or
+    /// `Index(n)` for the n-th camera found.
+    Gphoto2,
 }
 
 /// How to find the camera device.
@@ -197,7 +203,10 @@ pub struct Camera {
     /// The file each frame arrives as (`Png` when absent): `Jpeg` or `Dng`
     /// makes the simulated camera deliver what a DSLR would, `Fits` what an
     /// astro camera would, kept byte for byte by the session and decoded by
-    /// `campanile process`. Only the `Sim` driver takes it.
+    /// `campanile process`. The `Sim` driver takes it, and `Gphoto2` (`Jpeg`
+    /// or `Dng`), which sets the camera's image format to its largest
+    /// finest JPEG (`Jpeg`) or its RAW (`Dng`: whatever RAW the camera
+    /// writes, DNG, CR2, NEF, …), or leaves it as the camera has it (`Png`).
     #[serde(default, skip_serializing_if = "FrameFileFormat::is_png")]
     pub file_format: FrameFileFormat,
 }
@@ -227,6 +236,7 @@ impl Validate for Camera {
                 "Indi(...)".into(),
                 "a Path or an Index for this driver (an INDI device needs `driver: Indi`)",
             ),
+            (CameraDriver::Gphoto2, None) => {}
             (_, None) => v.invalid(
                 "device",
                 "nothing".into(),
@@ -315,11 +325,16 @@ impl Validate for Camera {
                 "a gain in dB (at least min_db)",
             );
         });
-        if self.driver != CameraDriver::Sim && self.file_format != FrameFileFormat::Png {
+        let takes = match self.driver {
+            CameraDriver::Sim => true,
+            CameraDriver::Gphoto2 => self.file_format != FrameFileFormat::Fits,
+            _ => self.file_format == FrameFileFormat::Png,
+        };
+        if !takes {
             v.invalid(
                 "file_format",
                 format!("{:?}", self.file_format),
-                "Png (the default) for a real camera driver: only the simulated camera delivers JPEG, DNG or FITS files",
+                "Png (the default) for this camera driver: the simulated camera takes Jpeg, Dng or Fits, Gphoto2 Jpeg or Dng",
             );
         }
         if let Some(p) = &self.response_curve {

@@ -55,6 +55,7 @@ fn station_summary(s: &Station) -> String {
         CameraDriver::V4l => "V4L2".to_owned(),
         CameraDriver::Nokhwa => "nokhwa".to_owned(),
         CameraDriver::Indi => "INDI".to_owned(),
+        CameraDriver::Gphoto2 => "gphoto2".to_owned(),
     };
     let device = match &c.device {
         Some(DeviceRef::Path(p)) => format!(" at {p}"),

@@ -35,6 +35,24 @@ fn the_indi_station_runs_its_plan() {
     check_plan_on_station(&plan, &station.value).unwrap_or_else(|e| panic!("{e}"));
 }
 
+/// The gphoto2 station (`examples/gphoto2/`) is valid, and the sky and
+/// campanile plans run on its ⅓-stop shutter.
+#[test]
+fn the_gphoto2_station_runs_the_plans() {
+    let station = load_station(&example("gphoto2/station.ron")).expect("valid gphoto2 station");
+    assert_eq!(
+        station.value.camera.driver,
+        campanile_config::camera::CameraDriver::Gphoto2
+    );
+    assert_eq!(station.value.camera.device, None);
+    for plan in ["campanile-day.ron", "sky-day.ron", "sky-station.ron"] {
+        let Ok(Document::Plan(plan)) = load(&example(plan)) else {
+            panic!("{plan} is a plan")
+        };
+        check_plan_on_station(&plan, &station.value).unwrap_or_else(|e| panic!("{e}"));
+    }
+}
+
 #[test]
 fn plans_run_on_every_station() {
     for station in ["sim-station.ron", "real-station.ron", "sky-sim-station.ron"] {

@@ -13,10 +13,16 @@
 //! | `v4l2::V4l2Camera` (feature `v4l`) | V4L2 | `Camera`, through [`camera_thread`] |
 //! | `nokhwa_camera::NokhwaCamera` (feature `nokhwa`) | nokhwa (V4L2 backend) | `Camera`, through [`camera_thread`] |
 //! | [`indi::IndiCamera`], [`indi::IndiWheel`] | INDI over TCP (`indiserver`) | `Camera`, `FilterWheel` |
+//! | [`tethered_camera::TetheredCamera`] over `gphoto2_camera::Gphoto2Tether` (feature `gphoto2`) | libgphoto2 (tethered DSLRs); **has never met a camera** | `Camera`, through [`camera_thread`] |
 //!
 //! The cameras share [`exposure_control`] (V4L2 exposure and gain
 //! controls) and [`pixel_format`] (buffers to RGB codes), which need no
-//! camera and are tested in every build.
+//! camera and are tested in every build; so are [`gphoto_settings`]
+//! (gphoto2's shutter, aperture, ISO and image-format choices, bulb, and
+//! the exposure read from a delivered file's EXIF) and [`tethered_camera`]
+//! (the stills-camera logic over a small [`tethered_camera::Tether`]
+//! trait, tested against a scripted camera delivering real JPEGs), of
+//! which the gphoto2 driver is only the libgphoto2 calls.
 //!
 //! A link that drops is reopened by [`backoff::reopen`] (exponential
 //! backoff, capped, logged); [`crate::station`] does so for every serial
@@ -28,12 +34,16 @@ pub mod enttec;
 pub mod exposure_control;
 pub mod flir_ptu;
 pub mod fw102c;
+#[cfg(feature = "gphoto2")]
+pub mod gphoto2_camera;
+pub mod gphoto_settings;
 pub mod indi;
 pub mod link;
 #[cfg(feature = "nokhwa")]
 pub mod nokhwa_camera;
 pub mod pelco_d;
 pub mod pixel_format;
+pub mod tethered_camera;
 #[cfg(feature = "v4l")]
 pub mod v4l2;
 

@@ -19,6 +19,7 @@ pub fn open_camera(config: &CameraConfig) -> Result<ThreadedCamera, DeviceError>
         CameraDriver::Indi => Err(DeviceError::Camera(
             "an INDI camera is opened over the network: open_station_camera".into(),
         )),
+        CameraDriver::Gphoto2 => open_gphoto2(config),
     }
 }
 
@@ -88,6 +89,7 @@ pub fn driver_built(driver: CameraDriver) -> bool {
     match driver {
         CameraDriver::V4l => cfg!(feature = "v4l"),
         CameraDriver::Nokhwa => cfg!(feature = "nokhwa"),
+        CameraDriver::Gphoto2 => cfg!(feature = "gphoto2"),
         CameraDriver::Sim | CameraDriver::Indi => true,
     }
 }
@@ -114,6 +116,19 @@ fn open_nokhwa(config: &CameraConfig) -> Result<ThreadedCamera, DeviceError> {
 fn open_nokhwa(_: &CameraConfig) -> Result<ThreadedCamera, DeviceError> {
     Err(DeviceError::Camera(
         "this campanile was built without the nokhwa camera driver; rebuild with `--features nokhwa` (needs libclang)"
+            .into(),
+    ))
+}
+
+#[cfg(feature = "gphoto2")]
+fn open_gphoto2(config: &CameraConfig) -> Result<ThreadedCamera, DeviceError> {
+    crate::driver::gphoto2_camera::open(config)
+}
+
+#[cfg(not(feature = "gphoto2"))]
+fn open_gphoto2(_: &CameraConfig) -> Result<ThreadedCamera, DeviceError> {
+    Err(DeviceError::Camera(
+        "this campanile was built without the gphoto2 camera driver; rebuild with `--features gphoto2` (needs libgphoto2-dev)"
             .into(),
     ))
 }
@@ -227,6 +242,12 @@ mod tests {
         {
             let e = open_camera(&station.camera).unwrap_err().to_string();
             assert!(e.contains("rebuild with `--features v4l`"), "{e}");
+        }
+        #[cfg(not(feature = "gphoto2"))]
+        {
+            cfg.driver = CameraDriver::Gphoto2;
+            let e = open_camera(&cfg).unwrap_err().to_string();
+            assert!(e.contains("rebuild with `--features gphoto2`"), "{e}");
         }
     }
 }

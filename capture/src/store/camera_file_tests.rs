@@ -1,4 +1,4 @@
-//! Tests of frames delivered as the camera's file (JPEG, DNG): kept byte
+//! Tests of frames delivered as the camera's file (JPEG, DNG, a maker's RAW): kept byte
 //! for byte, journaled with their format, decoded through the HDR readers,
 //! checked by `verify`; and journals from before the format field.
 
@@ -157,6 +157,43 @@ fn a_dng_reads_as_the_linear_frame_in_logarithmic_codes_with_clipping_at_the_top
     let q = 5 * W + W - 2;
     assert_eq!(&codes.data[q * 3..q * 3 + 3], &[65_535, 65_535, 65_535]);
     assert_eq!(store.verify().unwrap().problems.len(), 0);
+}
+
+/// A maker's RAW format is kept under its own extension and name in the
+/// journal, and read through the same RAW reader. No maker's RAW file is
+/// in the repository, so the bytes are the DNG's (rawler knows a file by
+/// its content): what is tested is the store's handling of the format.
+#[test]
+fn a_makers_raw_is_kept_under_its_own_format_and_read_like_a_dng() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (mut f, _) = dng_frame();
+    let (dng_store, dng_entry) = record(&tmp.path().join("d"), "sky@2026-08-28/s0/t0/f1", &f);
+    let dng_codes = dng_store.read_frame(&dng_entry).unwrap();
+    if let Some(file) = f.file.as_mut() {
+        file.format = FrameFormat::Nef;
+    }
+    let dir = tmp.path().join("n");
+    let (store, entry) = record(&dir, "sky@2026-08-28/s0/t0/f1", &f);
+    assert_eq!(entry.format, FrameFormat::Nef);
+    assert!(entry.file.ends_with(".nef"), "{}", entry.file);
+    let journal = std::fs::read_to_string(dir.join(JOURNAL_FILE)).unwrap();
+    assert!(journal.contains("\"format\":\"nef\""), "{journal}");
+    assert_eq!(store.read_frame(&entry).unwrap().data, dng_codes.data);
+    assert_eq!(store.verify().unwrap().problems.len(), 0);
+    // A "CR3" that is a TIFF is refused by its first bytes.
+    if let Some(file) = f.file.as_mut() {
+        file.format = FrameFormat::Cr3;
+    }
+    let mut store = SessionStore::create(&tmp.path().join("c"), snapshot()).unwrap();
+    let err = store
+        .record_frame(
+            "sky@2026-08-28/s0/t0/f1",
+            &FrameMeta::from_frame(&f, ShotKind::Data),
+            &f,
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("CR3"), "{err}");
 }
 
 #[test]

@@ -151,9 +151,10 @@ pub(crate) fn read_checked_bytes<S: Storage + ?Sized>(
 ///   significant bits;
 /// - JPEG ([`image_file::read_frame_bytes`]): 8-bit codes, turned upright
 ///   by the EXIF orientation;
-/// - DNG ([`raw_file::read_raw_bytes`]): the linear frame (black level
-///   removed, white level 1, clipped samples flagged) as the logarithmic
-///   16-bit codes of [`linear_codes`], whose response is known;
+/// - DNG and the makers' RAW files ([`raw_file::read_raw_bytes`], through
+///   `rawler`): the linear frame (black level removed, white level 1,
+///   clipped samples flagged) as the logarithmic 16-bit codes of
+///   [`linear_codes`], whose response is known;
 /// - FITS ([`fits_file::read_fits`]): the integer codes, `bits` (from the
 ///   journal: the camera's stated depth) significant bits.
 ///
@@ -174,7 +175,16 @@ pub fn decode_frame(path: &Path, bytes: &[u8], format: FrameFormat, bits: u8) ->
         FrameFormat::Jpeg => image_file::read_frame_bytes(path, bytes)
             .map(|(image, _)| image)
             .map_err(bad),
-        FrameFormat::Dng => raw_file::read_raw_bytes(path, bytes.to_vec())
+        FrameFormat::Dng
+        | FrameFormat::Cr2
+        | FrameFormat::Cr3
+        | FrameFormat::Nef
+        | FrameFormat::Arw
+        | FrameFormat::Raf
+        | FrameFormat::Rw2
+        | FrameFormat::Orf
+        | FrameFormat::Pef
+        | FrameFormat::Srw => raw_file::read_raw_bytes(path, bytes.to_vec())
             .map(|frame| linear_codes::log_codes(&frame))
             .map_err(bad),
         FrameFormat::Fits => fits_file::read_fits(bytes, &path.display().to_string())

@@ -80,6 +80,33 @@ pub fn log_codes(frame: &LinearFrame) -> CodeImage {
     }
 }
 
+/// `frame` as 16-bit linear codes, `z = v · z_max` (a clipped sample at
+/// `z_max`): what a tethered camera's RAW frame gives the capture
+/// controller to meter (as a linear camera's codes), while processing reads
+/// the file itself through [`log_codes`].
+pub fn linear_codes16(frame: &LinearFrame) -> CodeImage {
+    let zmax = max_code(16);
+    let data = frame
+        .rgb
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| {
+            if frame.is_clipped(i / 3, i % 3) {
+                zmax
+            } else {
+                (f64::from(v).clamp(0.0, 1.0) * f64::from(zmax)).round() as u16
+            }
+        })
+        .collect();
+    CodeImage {
+        width: frame.width,
+        height: frame.height,
+        bits: 16,
+        data,
+        label: frame.label.clone(),
+    }
+}
+
 /// A linear sensor's codes (an astro or machine-vision camera's FITS
 /// frame: code ∝ exposure above `black`, its largest code the white level)
 /// as logarithmic codes: `v = (z − black) / (z_max − black)`, a code at

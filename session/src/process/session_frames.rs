@@ -172,7 +172,7 @@ impl SessionInputs {
                     exposure_s: e.meta.exposure_actual_s,
                     filter_transmittance,
                     codes,
-                    linear: matches!(e.format, FrameFormat::Dng | FrameFormat::Fits),
+                    linear: e.format.is_raw() || e.format == FrameFormat::Fits,
                 })
             })
             .collect();
