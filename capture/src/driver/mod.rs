@@ -13,21 +13,27 @@
 //! | `v4l2::V4l2Camera` (feature `v4l`) | V4L2 | `Camera`, through [`camera_thread`] |
 //! | `nokhwa_camera::NokhwaCamera` (feature `nokhwa`) | nokhwa (V4L2 backend) | `Camera`, through [`camera_thread`] |
 //! | [`indi::IndiCamera`], [`indi::IndiWheel`] | INDI over TCP (`indiserver`) | `Camera`, `FilterWheel` |
+//! | `aravis_camera::AravisCamera` (feature `aravis`) | GenICam (GigE Vision, USB3 Vision) through Aravis | `Camera`, through [`camera_thread`] |
 //!
-//! The cameras share [`exposure_control`] (V4L2 exposure and gain
-//! controls) and [`pixel_format`] (buffers to RGB codes), which need no
-//! camera and are tested in every build.
+//! The V4L2 and nokhwa cameras share [`exposure_control`] (V4L2 exposure
+//! and gain controls) and [`pixel_format`] (buffers to RGB codes); the
+//! Aravis camera has [`genicam_format`] (GenICam pixel formats, Bayer
+//! demosaicing, exposure and gain features). They need no camera and are
+//! tested in every build.
 //!
 //! A link that drops is reopened by [`backoff::reopen`] (exponential
 //! backoff, capped, logged); [`crate::station`] does so for every serial
 //! device of a real station.
 
+#[cfg(feature = "aravis")]
+pub mod aravis_camera;
 pub mod backoff;
 pub mod camera_thread;
 pub mod enttec;
 pub mod exposure_control;
 pub mod flir_ptu;
 pub mod fw102c;
+pub mod genicam_format;
 pub mod indi;
 pub mod link;
 #[cfg(feature = "nokhwa")]
