@@ -259,22 +259,32 @@ fn bayer_frames_demosaic_to_the_fakes_colours_in_all_four_patterns() {
     }
 }
 
-/// The frame's time is the buffer's system timestamp less the exposure:
-/// within the capture call, shifted back by the exposure; and it grows.
+/// The frame's time is the buffer's system timestamp less the exposure,
+/// but not before the acquisition started: within the capture call, and
+/// growing. At 5 ms (an eighth of the fake's 40 ms frame period) the
+/// kept frame, the second after the start, is stamped at least one frame
+/// period after the acquisition started, so its time is the buffer's
+/// (less 5 ms), not the start's: later than the call began by 30 ms.
 #[test]
 fn timestamps_fall_within_the_capture_and_increase() {
     let mut camera = open(Some("Mono8"), 32, 32);
     let mut last = None;
-    for _ in 0..4 {
+    for exposure in [0.005, 0.2, 0.005, 0.05] {
         let before = chrono::Utc::now();
-        let f = camera.capture(settings(0.05, 0.0)).unwrap();
+        let f = camera.capture(settings(exposure, 0.0)).unwrap();
         let after = chrono::Utc::now();
-        let exposure = chrono::Duration::milliseconds(50);
         assert!(
-            f.timestamp >= before - exposure && f.timestamp <= after - exposure,
-            "{} not within {before} − 50 ms .. {after} − 50 ms",
+            f.timestamp >= before && f.timestamp <= after,
+            "{} not within {before} .. {after}",
             f.timestamp
         );
+        if exposure == 0.005 {
+            assert!(
+                f.timestamp - before >= chrono::TimeDelta::milliseconds(30),
+                "{} is not the buffer's stamp ({before})",
+                f.timestamp
+            );
+        }
         if let Some(t) = last {
             assert!(f.timestamp > t, "{} after {t}", f.timestamp);
         }
@@ -328,17 +338,24 @@ async fn errors_are_clear() {
             ..
         })
     ));
-    // A frame that does not come: one every 10 s, 0.3 s allowed.
+    // Frames that do not come in time: one a second, two needed (the
+    // settle frame and the kept one), 0.2 s allowed. (Dropping the camera
+    // waits for the fake's stream thread, asleep until its next frame: a
+    // longer period makes the test slower, not stricter.)
     let slow = AravisOptions {
-        frame_timeout: Duration::from_millis(300),
-        features: "AcquisitionFramePeriod=10000000".into(),
+        frame_timeout: Duration::from_millis(200),
+        features: "AcquisitionFramePeriod=1000000".into(),
         ..AravisOptions::default()
     };
     let mut camera = AravisCamera::open(&config(Some("Mono8"), 16, 16), slow).unwrap();
     let started = std::time::Instant::now();
     let e = camera.capture(settings(1e-4, 0.0)).unwrap_err();
     assert!(matches!(e, DeviceError::Timeout(_)), "{e}");
-    assert!(started.elapsed() < Duration::from_secs(2), "{:?}", started.elapsed());
+    assert!(
+        started.elapsed() < Duration::from_millis(900),
+        "{:?}",
+        started.elapsed()
+    );
 }
 
 #[test]
@@ -346,4 +363,153 @@ fn the_fake_camera_is_listed_once_its_interface_is_on() {
     let found = list_genicam_cameras(true).expect("built with aravis");
     let fake = found.iter().find(|c| c.id == FAKE_ID).expect("Fake_1 listed");
     assert_eq!(fake.description, "Aravis Fake (Fake at 0.0.0.0)");
+}
+
+/// The serial head of `examples/aravis/station.ron` (/dev/ttyUSB0), a
+/// Pelco-D emulator behind an in-memory link, for the controller test.
+struct PelcoBench(std::sync::Mutex<Vec<campanile_firmware_link::emulator::Emulator<PelcoDevice>>>);
+
+use campanile_firmware_link::pelco_d::device::{PelcoConfig, PelcoDevice};
+
+impl campanile_capture::station::PortOpener for PelcoBench {
+    type Port = tokio::io::DuplexStream;
+
+    async fn open(&self, link: &campanile_config::link::SerialLink) -> std::io::Result<Self::Port> {
+        assert_eq!(link.port, "/dev/ttyUSB0", "only the head is serial");
+        let (host, dev) = campanile_firmware_link::transport::memory::duplex(4096);
+        let cfg = PelcoConfig {
+            speed: 90_000,
+            pan_range: (-18_000, 17_999),
+            ..PelcoConfig::default()
+        };
+        let emu =
+            campanile_firmware_link::emulator::Emulator::spawn(PelcoDevice::new(cfg), dev, Duration::from_millis(2));
+        self.0.lock().unwrap().push(emu);
+        Ok(host)
+    }
+}
+
+/// A plan run by the session controller on the wall clock through the
+/// GenICam station of `examples/aravis/station.ron` (Aravis's fake camera
+/// in BayerGR8, the head emulated): every promised frame is stored, with
+/// the exposure the camera reported (whole µs, within 1 µs of the asked)
+/// and the camera's time in the journal, and reads back through the
+/// session reader at the station's size and depth; the 10 ms frame (ramp
+/// scale 1) holds the fake's codes exactly at every photosite's own colour.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_plan_runs_through_the_controller_on_the_aravis_station() {
+    use campanile_capture::clock::SystemClock;
+    use campanile_capture::controller::{self, NoProgress, RunOptions};
+    use campanile_capture::schedule::{TimelineOptions, timeline};
+    use campanile_capture::station::{StationOptions, StationRig};
+    use campanile_capture::store::{JournalEntry, Provenance, SessionReader, SessionStore, Snapshot};
+
+    let station_file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/aravis/station.ron");
+    let text = std::fs::read_to_string(&station_file).unwrap();
+    let station = campanile_config::load_station(&station_file).unwrap().value;
+    let start = chrono::Utc::now() + chrono::TimeDelta::seconds(3);
+    let plan_text = format!(
+        r#"Plan(
+    name: "aravis test",
+    start_date: "{}",
+    sessions: [(
+        name: "one",
+        trigger: Clock(time: "{}"),
+        steps: [
+            Bracket(aim: PanTilt(pan_deg: 20.0, tilt_deg: 10.0), exposures_s: [0.01, 0.04, 0.16],
+                    on_error: (retries: 2, then: Continue)),
+            Bracket(aim: PanTilt(pan_deg: 40.0, tilt_deg: 30.0), exposures_s: [0.02, 0.08],
+                    on_error: (retries: 2, then: Continue)),
+        ],
+    )],
+)"#,
+        start.format("%Y-%m-%d"),
+        start.format("%H:%M:%S")
+    );
+    let plan: campanile_config::Plan = ron::from_str(&plan_text).unwrap();
+    let t = timeline(&plan, &station, None, &TimelineOptions { days: Some(1) }).unwrap();
+    assert_eq!(t.frames_promised(), 5, "{:?}", t.uncovered);
+    let jet = tokio::task::spawn_blocking(|| {
+        jet_from_rgb8(&open(Some("RGB8"), 256, 8).capture(settings(0.01, 0.0)).unwrap())
+    })
+    .await
+    .unwrap();
+    let camera = open_station_camera(&station.camera).await.unwrap();
+    let bench = PelcoBench(std::sync::Mutex::new(Vec::new()));
+    let mut rig = StationRig::connect(&station, bench, camera, StationOptions::default())
+        .await
+        .unwrap();
+    let snapshot = Snapshot {
+        plan_ron: plan_text.clone(),
+        station_ron: text.clone(),
+        scene_ron: None,
+        provenance: Provenance {
+            campanile_version: "test".into(),
+            created_utc: chrono::DateTime::default(),
+            calibration: Vec::new(),
+            sources: None,
+        },
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("session");
+    let mut store = SessionStore::create(&dir, snapshot).unwrap();
+    let report = controller::run(
+        &t,
+        &plan,
+        &station,
+        &mut store,
+        &mut rig,
+        &SystemClock,
+        &RunOptions::default(),
+        &mut NoProgress,
+    )
+    .await
+    .unwrap();
+    assert_eq!((report.frames, report.missed), (5, 0), "{report:?}");
+    let frames: Vec<_> = store
+        .entries()
+        .iter()
+        .filter_map(|e| match e {
+            JournalEntry::Done(f) | JournalEntry::Late(f) => Some(f.clone()),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(frames.len(), 5, "{:?}", store.entries());
+    let mut asked: Vec<f64> = frames.iter().map(|f| f.meta.exposure_requested_s).collect();
+    asked.sort_by(f64::total_cmp);
+    assert_eq!(asked, [0.01, 0.02, 0.04, 0.08, 0.16]);
+    for pair in frames.windows(2) {
+        assert!(
+            pair[1].meta.time > pair[0].meta.time,
+            "{} then {}",
+            pair[0].key,
+            pair[1].key
+        );
+    }
+    for f in &frames {
+        let us = f.meta.exposure_actual_s * 1e6;
+        assert!((us - us.round()).abs() < 1e-6, "{}: {us} µs", f.key);
+        assert!(
+            (us - f.meta.exposure_requested_s * 1e6).abs() <= 1.0,
+            "{}: {us} µs",
+            f.key
+        );
+        assert!(f.meta.time >= start - chrono::TimeDelta::seconds(1), "{}", f.key);
+    }
+    drop(store);
+    let reader = SessionReader::open(&dir).unwrap();
+    for f in reader.frames() {
+        let image = reader.read_frame(f).unwrap();
+        assert_eq!((image.width, image.height, image.bits), (512, 384, 8), "{}", f.key);
+        if f.meta.exposure_requested_s == 0.01 {
+            let (w, h) = (image.width, image.height);
+            let own = |x: usize, y: usize| image.data[(y * w + x) * 3 + CfaPattern::Grbg.color_at(x, y)];
+            let fits = (0..255)
+                .filter(|&s| {
+                    (0..h).all(|y| (0..w).all(|x| own(x, y) == jet[(x + y + s) % 255][CfaPattern::Grbg.color_at(x, y)]))
+                })
+                .count();
+            assert_eq!(fits, 1, "{}: the fake's GR mosaic at every photosite", f.key);
+        }
+    }
 }

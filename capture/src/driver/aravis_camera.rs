@@ -30,11 +30,15 @@
 //! host's clock, UTC, when Aravis received the frame; for the fake camera,
 //! when it filled it) minus the exposure read back: the start of the
 //! exposure if the frame is stamped as its exposure ends (readout time is
-//! not known and not subtracted). The buffer's own *timestamp* counts the
-//! camera's clock from an unknown origin (for GigE Vision, ticks since the
-//! camera was reset), so it is not a UTC time; it is logged with each
+//! not known and not subtracted). It is never earlier than the host's clock
+//! when the acquisition was started, since no exposure of the kept frame
+//! began before that (the fake camera delivers frames at its frame rate
+//! whatever the exposure, so without this bound a long exposure would date
+//! its frame before the previous one). The buffer's own *timestamp* counts
+//! the camera's clock from an unknown origin (for GigE Vision, ticks since
+//! the camera was reset), so it is not a UTC time; it is logged with each
 //! frame, not used. A buffer without a system timestamp takes the host's
-//! clock when the capture started.
+//! clock when the acquisition started.
 //!
 //! **Gain** is in dB when the camera's `Gain` feature says so; otherwise
 //! (`GainRaw`, a unitless `Gain`) its range is spread over the station's
@@ -389,10 +393,12 @@ impl AravisCamera {
         }
     }
 
-    /// Start the acquisition, keep the frame after the settle frames, stop.
-    fn grab(&self, exposure: Duration) -> Result<Buffer, DeviceError> {
+    /// Start the acquisition, keep the frame after the settle frames, stop;
+    /// with the host's clock when the acquisition started.
+    fn grab(&self, exposure: Duration) -> Result<(Buffer, chrono::DateTime<chrono::Utc>), DeviceError> {
         let name = &self.name;
         self.drain();
+        let started = chrono::Utc::now();
         self.camera
             .start_acquisition()
             .map_err(|e| fail(name, "cannot start the acquisition", &e))?;
@@ -423,7 +429,7 @@ impl AravisCamera {
             self.stream.push_buffer(buffer);
             return Err(fail(name, "cannot stop the acquisition", &e));
         }
-        Ok(buffer)
+        Ok((buffer, started))
     }
 
     /// The frame's codes from `buffer`, checked against the layout.
@@ -485,17 +491,15 @@ impl BlockingCamera for AravisCamera {
         let gain_read = self
             .read_gain()
             .map_err(|e| fail(&name, "cannot read the gain back", &e))?;
-        let started = chrono::Utc::now();
-        let buffer = self.grab(actual.duration())?;
+        let (buffer, started) = self.grab(actual.duration())?;
         let decoded = self.decode(&buffer);
         let (system_ns, camera_ns, frame_id) = (buffer.system_timestamp(), buffer.timestamp(), buffer.frame_id());
         self.stream.push_buffer(buffer);
         let data = decoded?;
         let timestamp = match i64::try_from(system_ns) {
-            Ok(ns) if ns > 0 => {
-                chrono::DateTime::from_timestamp_nanos(ns)
-                    - chrono::Duration::from_std(actual.duration()).unwrap_or_default()
-            }
+            Ok(ns) if ns > 0 => (chrono::DateTime::from_timestamp_nanos(ns)
+                - chrono::Duration::from_std(actual.duration()).unwrap_or_default())
+            .max(started),
             _ => started,
         };
         tracing::debug!(camera = %name, frame_id, camera_timestamp_ns = camera_ns, system_timestamp_ns = system_ns, "GenICam frame");

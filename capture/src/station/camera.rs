@@ -273,5 +273,20 @@ mod tests {
             let e = open_camera(&station.camera).unwrap_err().to_string();
             assert!(e.contains("rebuild with `--features v4l`"), "{e}");
         }
+        cfg.driver = CameraDriver::Aravis;
+        cfg.device = Some(DeviceRef::Aravis {
+            id: "Fake_1".into(),
+            pixel_format: None,
+        });
+        assert_eq!(driver_built(CameraDriver::Aravis), cfg!(feature = "aravis"));
+        #[cfg(not(feature = "aravis"))]
+        {
+            let e = open_camera(&cfg).unwrap_err().to_string();
+            assert!(
+                e.contains("rebuild with `--features aravis` (needs libaravis-dev)"),
+                "{e}"
+            );
+            assert_eq!(list_genicam_cameras(true), None);
+        }
     }
 }
