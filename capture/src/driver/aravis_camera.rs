@@ -107,19 +107,34 @@ pub struct GenicamEntry {
 /// Aravis's fake camera's device id.
 pub const FAKE_ID: &str = "Fake_1";
 
+/// Held while this module touches Aravis's global device lists: Aravis
+/// locks each call, but the strings `arv_get_device_id` and its siblings
+/// return belong to the interfaces' lists, which the next update (by
+/// `arv_update_device_list` or by opening a camera) frees. Code outside
+/// this module that calls Aravis's system functions is not covered.
+static SYSTEM: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn system_lock() -> std::sync::MutexGuard<'static, ()> {
+    // A panic while listing leaves nothing half-done that matters here.
+    SYSTEM.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
 /// Turn on Aravis's `Fake` interface (off by default), so that
 /// [`FAKE_ID`] opens and [`list`] shows it.
 pub fn enable_fake_interface() {
-    // SAFETY: a NUL-terminated string that outlives the call; Aravis copies
-    // nothing and only flips the interface's flag.
+    let _guard = system_lock();
+    // SAFETY: a NUL-terminated string that outlives the call; Aravis only
+    // compares it with its interfaces' names and sets a flag (under
+    // `SYSTEM`, against this module's other calls).
     unsafe { aravis_sys::arv_enable_interface(c"Fake".as_ptr()) }
 }
 
 /// The GenICam cameras Aravis finds (GigE Vision discovery waits about a
 /// second for answers).
 pub fn list() -> Vec<GenicamEntry> {
-    // SAFETY: Aravis guards its device list with its own lock; the strings
-    // are copied before the next update.
+    let _guard = system_lock();
+    // SAFETY: the list is updated and its strings copied under `SYSTEM`, so
+    // no camera opened through this module frees them meanwhile.
     unsafe { aravis::get_device_list() }
         .into_iter()
         .map(|d| GenicamEntry {
@@ -196,7 +211,11 @@ impl AravisCamera {
         if id.starts_with("Fake") {
             enable_fake_interface();
         }
-        let camera = ArvCamera::new(Some(&id)).map_err(|e| {
+        let opened = {
+            let _guard = system_lock();
+            ArvCamera::new(Some(&id))
+        };
+        let camera = opened.map_err(|e| {
             DeviceError::Camera(format!(
                 "no GenICam camera {id:?} ({e}); `campanile devices` lists the ones Aravis finds"
             ))
