@@ -644,6 +644,13 @@ mod tests {
         // 0x0ABC and 0x0001, little-endian, LSB-aligned.
         let codes = to_rgb_codes(&[0xBC, 0x0A, 0x01, 0x00], &GenicamLayout::packed(mono12, 2, 1)).unwrap();
         assert_eq!(codes, [0xABC, 0xABC, 0xABC, 1, 1, 1]);
+        // Mono10: 1023 is its top code, 1024 is beyond it.
+        let mono10 = GenicamLayout::packed(GenicamFormat::Mono { bits: 10 }, 1, 1);
+        assert_eq!(to_rgb_codes(&[0xFF, 0x03], &mono10).unwrap(), [1023; 3]);
+        assert!(matches!(
+            to_rgb_codes(&[0x00, 0x04], &mono10),
+            Err(GenicamError::SampleTooLarge { value: 1024, .. })
+        ));
         let mono16 = GenicamFormat::Mono { bits: 16 };
         let codes = to_rgb_codes(&[0xFF, 0xFF], &GenicamLayout::packed(mono16, 1, 1)).unwrap();
         assert_eq!(codes, [65535; 3]);
@@ -684,22 +691,26 @@ mod tests {
         assert!(matches!(to_rgb_codes(&[0; 6], &l), Err(GenicamError::BadStride { .. })));
     }
 
-    /// A flat colour patch, R = 1000, G = 2000, B = 3000, in each of the
-    /// four patterns and at 12 bits, comes back exactly everywhere
-    /// (including the borders, which average fewer photosites).
+    /// A flat colour patch, R = 1000, G = 2000, B = 3000 at 12 bits (and
+    /// R = 65535, G = 0, B = 40000 at 16), in each of the four patterns,
+    /// comes back exactly everywhere (including the borders, which average
+    /// fewer photosites).
     #[test]
     fn a_flat_patch_demosaics_to_its_colour_in_every_pattern() {
         let (w, h) = (6, 4);
-        for pattern in CfaPattern::ALL {
-            let format = GenicamFormat::Bayer { pattern, bits: 12 };
-            let mosaic: Vec<u16> = (0..w * h)
-                .map(|i| [1000u16, 2000, 3000][pattern.color_at(i % w, i / w)])
-                .collect();
+        for (pattern, bits) in CfaPattern::ALL.into_iter().flat_map(|p| [(p, 12u8), (p, 16)]) {
+            let format = GenicamFormat::Bayer { pattern, bits };
+            let colour = if bits == 12 {
+                [1000u16, 2000, 3000]
+            } else {
+                [65535, 0, 40000]
+            };
+            let mosaic: Vec<u16> = (0..w * h).map(|i| colour[pattern.color_at(i % w, i / w)]).collect();
             let bytes: Vec<u8> = mosaic.iter().flat_map(|v| v.to_le_bytes()).collect();
             let codes = to_rgb_codes(&bytes, &GenicamLayout::packed(format, w, h)).unwrap();
             assert_eq!(codes.len(), w * h * 3);
             for px in codes.chunks_exact(3) {
-                assert_eq!(px, [1000, 2000, 3000], "{}", format.name());
+                assert_eq!(px, colour, "{}", format.name());
             }
         }
     }
