@@ -41,6 +41,14 @@ fn lists_serial_ports_and_cameras() {
         let p = port.trim();
         assert!(p == "(none found)" || Path::new(p).exists(), "{p}");
     }
+    // GenICam cameras are listed through Aravis, or the build says it has no Aravis.
+    assert!(
+        lines.contains(&"GenICam cameras (Aravis):")
+            || lines
+                .iter()
+                .any(|l| l.starts_with("note: built without the `aravis` feature")),
+        "{stdout}"
+    );
 }
 
 /// The three serial devices pass their suites over ptys; the V4L2 camera

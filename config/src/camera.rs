@@ -28,6 +28,10 @@ pub enum CameraDriver {
     /// II")` for a model as `gphoto2 --auto-detect` lists it, or
     /// `Index(n)` for the n-th camera found.
     Gphoto2,
+    /// A GenICam machine-vision camera (GigE Vision, USB3 Vision) through
+    /// Aravis (cargo feature `aravis`; `device: Aravis(id: "Basler-21234567")`,
+    /// the id `campanile devices` lists; Aravis's fake camera is `"Fake_1"`).
+    Aravis,
 }
 
 /// How to find the camera device.
@@ -53,7 +57,46 @@ pub enum DeviceRef {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         iso: Option<String>,
     },
+    /// A GenICam camera, for the `Aravis` driver.
+    Aravis {
+        /// Aravis's device id (`Vendor-Serial`, e.g. "Basler-21234567"),
+        /// its physical id, or its address, as `campanile devices` lists
+        /// them; `"Fake_1"` is Aravis's fake camera.
+        id: String,
+        /// The GenICam pixel format to capture in (one of
+        /// [`GENICAM_PIXEL_FORMATS`]); when absent the driver takes the
+        /// deepest raw format the camera offers.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pixel_format: Option<String>,
+    },
 }
+
+/// The GenICam (PFNC) pixel formats the `Aravis` driver reads: unpacked
+/// monochrome, unpacked Bayer mosaics (demosaiced by the driver) and
+/// packed 8-bit RGB.
+pub const GENICAM_PIXEL_FORMATS: [&str; 21] = [
+    "Mono8",
+    "Mono10",
+    "Mono12",
+    "Mono16",
+    "BayerRG8",
+    "BayerGR8",
+    "BayerGB8",
+    "BayerBG8",
+    "BayerRG10",
+    "BayerGR10",
+    "BayerGB10",
+    "BayerBG10",
+    "BayerRG12",
+    "BayerGR12",
+    "BayerGB12",
+    "BayerBG12",
+    "BayerRG16",
+    "BayerGR16",
+    "BayerGB16",
+    "BayerBG16",
+    "RGB8",
+];
 
 /// Checks an INDI server address and device name under `v`.
 pub(crate) fn validate_indi(v: &mut Validator, server: &str, device: &str) {
@@ -231,12 +274,39 @@ impl Validate for Camera {
                 format!("{other:?}"),
                 "an INDI device for the Indi driver, e.g. `device: Indi(server: \"127.0.0.1:7624\", device: \"CCD Simulator\")`",
             ),
+            (CameraDriver::Aravis, Some(DeviceRef::Aravis { id, pixel_format })) => {
+                v.at("device", |v| {
+                    v.non_empty("id", id);
+                    if let Some(f) = pixel_format
+                        && !GENICAM_PIXEL_FORMATS.contains(&f.as_str())
+                    {
+                        v.invalid(
+                            "pixel_format",
+                            format!("{f:?}"),
+                            &format!(
+                                "a GenICam pixel format the Aravis driver reads: one of {}",
+                                GENICAM_PIXEL_FORMATS.join(", ")
+                            ),
+                        );
+                    }
+                });
+            }
+            (CameraDriver::Aravis, other) => v.invalid(
+                "device",
+                format!("{other:?}"),
+                "a GenICam camera for the Aravis driver, e.g. `device: Aravis(id: \"Fake_1\")` (the ids `campanile devices` lists)",
+            ),
             (_, Some(DeviceRef::Indi { .. })) => v.invalid(
                 "device",
                 "Indi(...)".into(),
                 "a Path or an Index for this driver (an INDI device needs `driver: Indi`)",
             ),
             (CameraDriver::Gphoto2, None) => {}
+            (_, Some(DeviceRef::Aravis { .. })) => v.invalid(
+                "device",
+                "Aravis(...)".into(),
+                "a Path or an Index for this driver (a GenICam camera needs `driver: Aravis`)",
+            ),
             (_, None) => v.invalid(
                 "device",
                 "nothing".into(),

@@ -56,11 +56,16 @@ fn station_summary(s: &Station) -> String {
         CameraDriver::Nokhwa => "nokhwa".to_owned(),
         CameraDriver::Indi => "INDI".to_owned(),
         CameraDriver::Gphoto2 => "gphoto2".to_owned(),
+        CameraDriver::Aravis => "GenICam (Aravis)".to_owned(),
     };
     let device = match &c.device {
         Some(DeviceRef::Path(p)) => format!(" at {p}"),
         Some(DeviceRef::Index(i)) => format!(" #{i}"),
         Some(DeviceRef::Indi { server, device, .. }) => format!(" {device:?} on {server}"),
+        Some(DeviceRef::Aravis { id, pixel_format }) => match pixel_format {
+            Some(f) => format!(" {id:?} in {f}"),
+            None => format!(" {id:?}"),
+        },
         None => String::new(),
     };
     let focal = c.intrinsics.focal.pixels(c.resolution.width);

@@ -53,6 +53,22 @@ fn the_gphoto2_station_runs_the_plans() {
     }
 }
 
+/// The GenICam station (`examples/aravis/station.ron`) is valid and names
+/// Aravis's fake camera in a format the driver reads.
+#[test]
+fn the_aravis_station_is_valid() {
+    let station = load_station(&example("aravis/station.ron")).expect("valid Aravis station");
+    let camera = &station.value.camera;
+    assert_eq!(camera.driver, campanile_config::camera::CameraDriver::Aravis);
+    assert_eq!(
+        camera.device,
+        Some(campanile_config::camera::DeviceRef::Aravis {
+            id: "Fake_1".into(),
+            pixel_format: Some("BayerGR8".into()),
+        })
+    );
+}
+
 #[test]
 fn plans_run_on_every_station() {
     for station in ["sim-station.ron", "real-station.ron", "sky-sim-station.ron"] {

@@ -52,6 +52,29 @@ pub fn list(out: &mut dyn Write) -> Result<()> {
              rebuild with `--features v4l` to open them"
         )?;
     }
+    list_genicam(out, false)
+}
+
+/// Writes the GenICam cameras Aravis finds (with `fake`, Aravis's fake
+/// camera too) to `out`, each with the id a station's `Aravis(id: …)`
+/// takes; in a build without the `aravis` feature, a note saying so.
+pub fn list_genicam(out: &mut dyn Write, fake: bool) -> Result<()> {
+    match campanile_capture::station::camera::list_genicam_cameras(fake) {
+        Some(found) => {
+            writeln!(out, "GenICam cameras (Aravis):")?;
+            if found.is_empty() {
+                writeln!(out, "  (none found)")?;
+            }
+            for c in &found {
+                writeln!(out, "  {:?}  {}", c.id, c.description)?;
+            }
+        }
+        None => writeln!(
+            out,
+            "note: built without the `aravis` feature: GenICam cameras are not listed; \
+             rebuild with `--features aravis` (needs libaravis-dev) to list and open them"
+        )?,
+    }
     Ok(())
 }
 
@@ -251,6 +274,7 @@ fn test_real(station: &Station, head_options: conformance::pan_tilt::Options) ->
             Some(campanile_config::camera::DeviceRef::Indi { server, device, .. }) => {
                 format!("camera (INDI {device:?} on {server})")
             }
+            Some(campanile_config::camera::DeviceRef::Aravis { id, .. }) => format!("camera (GenICam {id:?})"),
             None => format!("camera ({:?}, its first device)", cam.driver),
         };
         let outcome = if cam.driver != CameraDriver::Sim && driver_built(cam.driver) {

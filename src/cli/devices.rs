@@ -15,9 +15,11 @@ use super::{EXIT_FAILURE, EXIT_OK, EXIT_USAGE};
 
 /// List serial ports and cameras, or test a station's devices.
 ///
-/// Without a subcommand: the serial ports the system lists (through /sys)
-/// and the cameras (through V4L2 when built with the `v4l` feature,
-/// otherwise the /dev/video* nodes named from /sys); with --indi, the
+/// Without a subcommand: the serial ports the system lists (through /sys),
+/// the cameras (through V4L2 when built with the `v4l` feature,
+/// otherwise the /dev/video* nodes named from /sys) and, when built with
+/// the `aravis` feature, the GenICam cameras Aravis finds, each with the id
+/// a station's `driver: Aravis, device: Aravis(id: …)` takes; with --indi, the
 /// devices an INDI server offers (a CCD is a station camera, a filter wheel
 /// a station wheel: `driver: Indi, device: Indi(server: …, device: …)`).
 ///

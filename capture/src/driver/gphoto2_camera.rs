@@ -56,6 +56,7 @@ fn device_label(device: Option<&DeviceRef>) -> String {
         Some(DeviceRef::Path(p)) => p.clone(),
         Some(DeviceRef::Index(i)) => format!("camera number {i}"),
         Some(DeviceRef::Indi { device, .. }) => device.clone(),
+        Some(DeviceRef::Aravis { id, .. }) => id.clone(),
     }
 }
 
@@ -75,6 +76,11 @@ fn pick<'a>(found: &'a [CameraDescriptor], device: Option<&DeviceRef>) -> Result
         Some(DeviceRef::Indi { .. }) => {
             return Err(DeviceError::Camera(
                 "an INDI device names no gphoto2 camera: use driver Indi, or a port or model".into(),
+            ));
+        }
+        Some(DeviceRef::Aravis { .. }) => {
+            return Err(DeviceError::Camera(
+                "a GenICam camera names no gphoto2 camera: use driver Aravis, or a port or model".into(),
             ));
         }
     };

@@ -34,8 +34,8 @@ pub fn camera_index(device: Option<&DeviceRef>) -> CameraIndex {
             Some(n) => CameraIndex::Index(n),
             None => CameraIndex::String(p.clone()),
         },
-        // An INDI device names no local camera (the config refuses it here).
-        None | Some(DeviceRef::Indi { .. }) => CameraIndex::Index(0),
+        // An INDI or GenICam device names no V4L2 camera (the config refuses it here).
+        None | Some(DeviceRef::Indi { .. } | DeviceRef::Aravis { .. }) => CameraIndex::Index(0),
     }
 }
 

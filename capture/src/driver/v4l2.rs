@@ -90,8 +90,8 @@ fn device_name(device: Option<&DeviceRef>) -> String {
     match device {
         Some(DeviceRef::Path(p)) => p.clone(),
         Some(DeviceRef::Index(i)) => format!("/dev/video{i}"),
-        // An INDI device names no local camera (the config refuses it here).
-        None | Some(DeviceRef::Indi { .. }) => "/dev/video0".to_owned(),
+        // An INDI or GenICam device names no V4L2 node (the config refuses it here).
+        None | Some(DeviceRef::Indi { .. } | DeviceRef::Aravis { .. }) => "/dev/video0".to_owned(),
     }
 }
 

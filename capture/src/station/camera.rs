@@ -1,5 +1,6 @@
 //! Opening the station's camera with the driver its config names, as far
-//! as this build has it (the V4L2 and nokhwa drivers are cargo features).
+//! as this build has it (the V4L2, nokhwa and Aravis drivers are cargo
+//! features).
 
 use crate::device::{Camera, CameraInfo, CaptureSettings, DeviceError, Frame};
 use crate::driver::camera_thread::ThreadedCamera;
@@ -12,10 +13,12 @@ use campanile_config::camera::{Camera as CameraConfig, CameraDriver};
 pub fn open_camera(config: &CameraConfig) -> Result<ThreadedCamera, DeviceError> {
     match config.driver {
         CameraDriver::Sim => Err(DeviceError::Camera(
-            "the `Sim` camera exists only in the simulator; a real station names `V4l` or `Nokhwa`".into(),
+            "the `Sim` camera exists only in the simulator; a real station names `V4l`, `Nokhwa`, `Indi` or `Aravis`"
+                .into(),
         )),
         CameraDriver::V4l => open_v4l(config),
         CameraDriver::Nokhwa => open_nokhwa(config),
+        CameraDriver::Aravis => open_aravis(config),
         CameraDriver::Indi => Err(DeviceError::Camera(
             "an INDI camera is opened over the network: open_station_camera".into(),
         )),
@@ -25,7 +28,7 @@ pub fn open_camera(config: &CameraConfig) -> Result<ThreadedCamera, DeviceError>
 
 /// A real station's camera, whichever driver its config names.
 pub enum StationCamera {
-    /// A V4L2 or nokhwa camera on its own thread.
+    /// A V4L2, nokhwa or GenICam (Aravis) camera on its own thread.
     Threaded(ThreadedCamera),
     /// An INDI CCD.
     Indi(Box<IndiCamera>),
@@ -55,7 +58,8 @@ impl Camera for StationCamera {
 }
 
 /// The camera `config` describes: an INDI CCD over the network (its frame
-/// the configured resolution), or a V4L2 or nokhwa camera on its thread.
+/// the configured resolution), or a V4L2, nokhwa or GenICam camera on its
+/// thread.
 pub async fn open_station_camera(config: &CameraConfig) -> Result<StationCamera, DeviceError> {
     match (&config.driver, &config.device) {
         (
@@ -83,13 +87,14 @@ pub async fn open_station_camera(config: &CameraConfig) -> Result<StationCamera,
     }
 }
 
-/// Whether this build holds `driver` (the V4L2 and nokhwa drivers are
-/// cargo features; the simulator's camera always is).
+/// Whether this build holds `driver` (the V4L2, nokhwa and Aravis drivers
+/// are cargo features; the simulator's camera always is).
 pub fn driver_built(driver: CameraDriver) -> bool {
     match driver {
         CameraDriver::V4l => cfg!(feature = "v4l"),
         CameraDriver::Nokhwa => cfg!(feature = "nokhwa"),
         CameraDriver::Gphoto2 => cfg!(feature = "gphoto2"),
+        CameraDriver::Aravis => cfg!(feature = "aravis"),
         CameraDriver::Sim | CameraDriver::Indi => true,
     }
 }
@@ -131,6 +136,65 @@ fn open_gphoto2(_: &CameraConfig) -> Result<ThreadedCamera, DeviceError> {
         "this campanile was built without the gphoto2 camera driver; rebuild with `--features gphoto2` (needs libgphoto2-dev)"
             .into(),
     ))
+}
+
+#[cfg(feature = "aravis")]
+fn open_aravis(config: &CameraConfig) -> Result<ThreadedCamera, DeviceError> {
+    crate::driver::aravis_camera::open(config, crate::driver::aravis_camera::AravisOptions::default())
+}
+
+#[cfg(not(feature = "aravis"))]
+fn open_aravis(_: &CameraConfig) -> Result<ThreadedCamera, DeviceError> {
+    Err(DeviceError::Camera(
+        "this campanile was built without the Aravis (GenICam) camera driver; rebuild with `--features aravis` (needs libaravis-dev)"
+            .into(),
+    ))
+}
+
+/// A GenICam camera Aravis finds: its id (what `Aravis(id: …)` takes) and
+/// a description (vendor, model, protocol, address).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GenicamCamera {
+    /// Aravis's device id.
+    pub id: String,
+    /// Vendor, model, protocol and address.
+    pub description: String,
+}
+
+/// The GenICam cameras Aravis finds (with `fake`, Aravis's fake camera
+/// too), or `None` in a build without the `aravis` feature.
+pub fn list_genicam_cameras(fake: bool) -> Option<Vec<GenicamCamera>> {
+    #[cfg(feature = "aravis")]
+    {
+        use crate::driver::aravis_camera;
+        if fake {
+            aravis_camera::enable_fake_interface();
+        }
+        Some(
+            aravis_camera::list()
+                .into_iter()
+                .map(|e| GenicamCamera {
+                    description: format!(
+                        "{} {} ({}{})",
+                        e.vendor,
+                        e.model,
+                        e.protocol,
+                        if e.address.is_empty() {
+                            String::new()
+                        } else {
+                            format!(" at {}", e.address)
+                        }
+                    ),
+                    id: e.id,
+                })
+                .collect(),
+        )
+    }
+    #[cfg(not(feature = "aravis"))]
+    {
+        let _ = fake;
+        None
+    }
 }
 
 /// A video device found on the system.
@@ -248,6 +312,21 @@ mod tests {
             cfg.driver = CameraDriver::Gphoto2;
             let e = open_camera(&cfg).unwrap_err().to_string();
             assert!(e.contains("rebuild with `--features gphoto2`"), "{e}");
+        }
+        cfg.driver = CameraDriver::Aravis;
+        cfg.device = Some(DeviceRef::Aravis {
+            id: "Fake_1".into(),
+            pixel_format: None,
+        });
+        assert_eq!(driver_built(CameraDriver::Aravis), cfg!(feature = "aravis"));
+        #[cfg(not(feature = "aravis"))]
+        {
+            let e = open_camera(&cfg).unwrap_err().to_string();
+            assert!(
+                e.contains("rebuild with `--features aravis` (needs libaravis-dev)"),
+                "{e}"
+            );
+            assert_eq!(list_genicam_cameras(true), None);
         }
     }
 }
