@@ -74,7 +74,7 @@ fn station() -> Station {
 }
 
 #[test]
-fn a_session_completes_through_link_faults_a_disconnect_and_camera_timeouts() {
+fn a_session_completes_through_link_faults_a_disconnect_and_camera_timeouts_and_journals_the_outages() {
     let st = station();
     let plan: Plan = ron::from_str(PLAN).unwrap();
     let t = timeline(&plan, &st, None, &TimelineOptions::default()).unwrap();
@@ -147,7 +147,7 @@ fn a_session_completes_through_link_faults_a_disconnect_and_camera_timeouts() {
     });
     println!("report: {report:?}");
     println!("head link retries since the reconnect: {link_retries:?}");
-    let (mut late, mut missed) = (0, Vec::new());
+    let (mut late, mut missed, mut outages) = (0, Vec::new(), Vec::new());
     for e in store.entries() {
         match e {
             JournalEntry::Late(f) => {
@@ -156,12 +156,27 @@ fn a_session_completes_through_link_faults_a_disconnect_and_camera_timeouts() {
             }
             JournalEntry::Done(f) => panic!("{} is not journaled late", f.key),
             JournalEntry::Missed(m) => missed.push((m.key.clone(), m.reason.clone())),
-            JournalEntry::Pruned(_) | JournalEntry::Outage(_) => {
-                panic!("nothing is pruned, no outage is journaled: {e:?}")
-            }
+            JournalEntry::Outage(o) => outages.push(o.clone()),
+            JournalEntry::Pruned(_) => panic!("nothing is pruned: {e:?}"),
         }
     }
     println!("late frames {late}, missed {missed:?}");
+    for o in &outages {
+        println!("outage: {} {} s", o.device, (o.end - o.start).as_seconds_f64());
+    }
+    // The journal's outages: the camera's two timeouts, each until its next
+    // frame (under 2 s), and the head's 20 s disconnect, from its first
+    // failed call to its first answer after the reconnect, which backs off
+    // 1, 2, 4, 8, 16 s (so 20 s plus at most one 16 s wait and a shot).
+    let length = |o: &campanile_capture::store::OutageEntry| (o.end - o.start).as_seconds_f64();
+    let camera: Vec<f64> = outages.iter().filter(|o| o.device == "camera").map(length).collect();
+    let head: Vec<f64> = outages.iter().filter(|o| o.device == "head").map(length).collect();
+    assert_eq!(camera.len(), 2, "{outages:?}");
+    assert!(camera.iter().all(|&s| s > 0.0 && s < 2.0), "{camera:?}");
+    assert_eq!(head.len(), 1, "{outages:?}");
+    assert!((20.0..=38.0).contains(&head[0]), "head outage {} s", head[0]);
+    assert!(outages.iter().all(|o| !o.open), "{outages:?}");
+    assert_eq!(outages.len(), 3, "{outages:?}");
     assert_eq!(missed.len(), 1, "{missed:?}");
     assert_eq!(missed[0].0, keys[1]);
     assert!(missed[0].1.contains("camera"), "{}", missed[0].1);

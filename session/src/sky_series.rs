@@ -89,9 +89,11 @@ pub struct ScanRun {
 
 /// Whether every step of `plan` is a sky or sun step (sun shots, sky scans,
 /// and brackets aimed at head angles or the sun, e.g. a calibration
-/// bracket), with at least one sun shot or sky scan: such a session is
-/// processed as a sky time series. Brackets alone have no scan to make a
-/// series of; they are merged into HDR views as any session's are.
+/// bracket): such a session is processed as a sky time series. Brackets
+/// alone are one too when the plan names a scene (a sky station's
+/// calibration day, which gives the series its response); with no scene
+/// and no scan (an astro camera's bracket) they are merged into HDR views
+/// as any session's brackets are.
 pub fn is_sky_only(plan: &Plan) -> bool {
     let steps = || plan.sessions.iter().flat_map(|s| &s.steps);
     let sky_or_sun = steps().all(|step| match step {
@@ -99,7 +101,8 @@ pub fn is_sky_only(plan: &Plan) -> bool {
         Step::Bracket { aim, .. } | Step::AutoBracket { aim, .. } => !matches!(aim, Aim::Pose(_)),
         _ => false,
     });
-    sky_or_sun && steps().any(|step| matches!(step, Step::SunShot { .. } | Step::SkyScan { .. }))
+    sky_or_sun
+        && (plan.scene.is_some() || steps().any(|step| matches!(step, Step::SunShot { .. } | Step::SkyScan { .. })))
 }
 
 /// The occurrence and plan step of a frame key `"{occurrence}/s{step}/…"`.
