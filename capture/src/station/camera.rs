@@ -13,7 +13,7 @@ use campanile_config::camera::{Camera as CameraConfig, CameraDriver};
 pub fn open_camera(config: &CameraConfig) -> Result<ThreadedCamera, DeviceError> {
     match config.driver {
         CameraDriver::Sim => Err(DeviceError::Camera(
-            "the `Sim` camera exists only in the simulator; a real station names `V4l`, `Nokhwa`, `Indi` or `Aravis`"
+            "the `Sim` camera exists only in the simulator; a real station names `V4l`, `Nokhwa`, `Indi`, `Aravis` or `Gphoto2`"
                 .into(),
         )),
         CameraDriver::V4l => open_v4l(config),
