@@ -13,6 +13,8 @@
 //! reported, so each check finds the offset `b` that fits and then requires
 //! every pixel to fit it exactly (tolerance 0).
 
+mod common;
+
 use std::path::Path;
 use std::time::Duration;
 
@@ -365,30 +367,6 @@ fn the_fake_camera_is_listed_once_its_interface_is_on() {
     assert_eq!(fake.description, "Aravis Fake (Fake at 0.0.0.0)");
 }
 
-/// The serial head of `examples/aravis/station.ron` (/dev/ttyUSB0), a
-/// Pelco-D emulator behind an in-memory link, for the controller test.
-struct PelcoBench(std::sync::Mutex<Vec<campanile_firmware_link::emulator::Emulator<PelcoDevice>>>);
-
-use campanile_firmware_link::pelco_d::device::{PelcoConfig, PelcoDevice};
-
-impl campanile_capture::station::PortOpener for PelcoBench {
-    type Port = tokio::io::DuplexStream;
-
-    async fn open(&self, link: &campanile_config::link::SerialLink) -> std::io::Result<Self::Port> {
-        assert_eq!(link.port, "/dev/ttyUSB0", "only the head is serial");
-        let (host, dev) = campanile_firmware_link::transport::memory::duplex(4096);
-        let cfg = PelcoConfig {
-            speed: 90_000,
-            pan_range: (-18_000, 17_999),
-            ..PelcoConfig::default()
-        };
-        let emu =
-            campanile_firmware_link::emulator::Emulator::spawn(PelcoDevice::new(cfg), dev, Duration::from_millis(2));
-        self.0.lock().unwrap().push(emu);
-        Ok(host)
-    }
-}
-
 /// A plan run by the session controller on the wall clock through the
 /// GenICam station of `examples/aravis/station.ron` (Aravis's fake camera
 /// in BayerGR8, the head emulated): every promised frame is stored, with
@@ -398,83 +376,26 @@ impl campanile_capture::station::PortOpener for PelcoBench {
 /// scale 1) holds the fake's codes exactly at every photosite's own colour.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_plan_runs_through_the_controller_on_the_aravis_station() {
-    use campanile_capture::clock::SystemClock;
-    use campanile_capture::controller::{self, NoProgress, RunOptions};
-    use campanile_capture::schedule::{TimelineOptions, timeline};
-    use campanile_capture::station::{StationOptions, StationRig};
-    use campanile_capture::store::{JournalEntry, Provenance, SessionReader, SessionStore, Snapshot};
+    use campanile_capture::store::SessionReader;
 
-    let station_file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/aravis/station.ron");
-    let text = std::fs::read_to_string(&station_file).unwrap();
-    let station = campanile_config::load_station(&station_file).unwrap().value;
-    let start = chrono::Utc::now() + chrono::TimeDelta::seconds(3);
-    let plan_text = format!(
-        r#"Plan(
-    name: "aravis test",
-    start_date: "{}",
-    sessions: [(
-        name: "one",
-        trigger: Clock(time: "{}"),
-        steps: [
-            Bracket(aim: PanTilt(pan_deg: 20.0, tilt_deg: 10.0), exposures_s: [0.01, 0.04, 0.16],
-                    on_error: (retries: 2, then: Continue)),
-            Bracket(aim: PanTilt(pan_deg: 40.0, tilt_deg: 30.0), exposures_s: [0.02, 0.08],
-                    on_error: (retries: 2, then: Continue)),
-        ],
-    )],
-)"#,
-        start.format("%Y-%m-%d"),
-        start.format("%H:%M:%S")
-    );
-    let plan: campanile_config::Plan = ron::from_str(&plan_text).unwrap();
-    let t = timeline(&plan, &station, None, &TimelineOptions { days: Some(1) }).unwrap();
-    assert_eq!(t.frames_promised(), 5, "{:?}", t.uncovered);
     let jet = tokio::task::spawn_blocking(|| {
         jet_from_rgb8(&open(Some("RGB8"), 256, 8).capture(settings(0.01, 0.0)).unwrap())
     })
     .await
     .unwrap();
-    let camera = open_station_camera(&station.camera).await.unwrap();
-    let bench = PelcoBench(std::sync::Mutex::new(Vec::new()));
-    let mut rig = StationRig::connect(&station, bench, camera, StationOptions::default())
-        .await
-        .unwrap();
-    let snapshot = Snapshot {
-        plan_ron: plan_text.clone(),
-        station_ron: text.clone(),
-        scene_ron: None,
-        provenance: Provenance {
-            campanile_version: "test".into(),
-            created_utc: chrono::DateTime::default(),
-            calibration: Vec::new(),
-            sources: None,
-        },
-    };
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("session");
-    let mut store = SessionStore::create(&dir, snapshot).unwrap();
-    let report = controller::run(
-        &t,
-        &plan,
-        &station,
-        &mut store,
-        &mut rig,
-        &SystemClock,
-        &RunOptions::default(),
-        &mut NoProgress,
+    let run = common::run_plan(
+        &common::example("aravis/station.ron"),
+        r#"
+            Bracket(aim: PanTilt(pan_deg: 20.0, tilt_deg: 10.0), exposures_s: [0.01, 0.04, 0.16],
+                    on_error: (retries: 2, then: Continue)),
+            Bracket(aim: PanTilt(pan_deg: 40.0, tilt_deg: 30.0), exposures_s: [0.02, 0.08],
+                    on_error: (retries: 2, then: Continue)),"#,
+        |_| {},
     )
-    .await
-    .unwrap();
-    assert_eq!((report.frames, report.missed), (5, 0), "{report:?}");
-    let frames: Vec<_> = store
-        .entries()
-        .iter()
-        .filter_map(|e| match e {
-            JournalEntry::Done(f) | JournalEntry::Late(f) => Some(f.clone()),
-            _ => None,
-        })
-        .collect();
-    assert_eq!(frames.len(), 5, "{:?}", store.entries());
+    .await;
+    assert_eq!((run.report.frames, run.report.missed), (5, 0), "{:?}", run.report);
+    let (frames, start) = (&run.frames, run.start);
+    assert_eq!(frames.len(), 5, "{:?}", run.entries);
     let mut asked: Vec<f64> = frames.iter().map(|f| f.meta.exposure_requested_s).collect();
     asked.sort_by(f64::total_cmp);
     assert_eq!(asked, [0.01, 0.02, 0.04, 0.08, 0.16]);
@@ -486,7 +407,7 @@ async fn a_plan_runs_through_the_controller_on_the_aravis_station() {
             pair[1].key
         );
     }
-    for f in &frames {
+    for f in frames {
         let us = f.meta.exposure_actual_s * 1e6;
         assert!((us - us.round()).abs() < 1e-6, "{}: {us} µs", f.key);
         assert!(
@@ -496,8 +417,7 @@ async fn a_plan_runs_through_the_controller_on_the_aravis_station() {
         );
         assert!(f.meta.time >= start - chrono::TimeDelta::seconds(1), "{}", f.key);
     }
-    drop(store);
-    let reader = SessionReader::open(&dir).unwrap();
+    let reader = SessionReader::open(&run.dir).unwrap();
     for f in reader.frames() {
         let image = reader.read_frame(f).unwrap();
         assert_eq!((image.width, image.height, image.bits), (512, 384, 8), "{}", f.key);

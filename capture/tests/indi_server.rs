@@ -7,6 +7,8 @@
 //! Each test starts its own server on a free loopback port and stops it by
 //! its PID when done.
 
+mod common;
+
 use std::time::Duration;
 
 use campanile_capture::conformance;
@@ -14,6 +16,7 @@ use campanile_capture::device::{Camera, CaptureSettings, DeviceError, ExposureTi
 use campanile_capture::driver::backoff::{Backoff, reopen};
 use campanile_capture::driver::indi::{IndiCamera, IndiClient, IndiWheel, LocalServer};
 use campanile_capture::store::{FrameMeta, ShotKind, decode_frame};
+use common::run_plan;
 
 const CCD: &str = "CCD Simulator";
 const WHEEL: &str = "Filter Simulator";
@@ -215,131 +218,9 @@ async fn the_client_lists_the_servers_devices() {
     );
 }
 
-/// The serial head of `examples/indi/station.ron` (/dev/ttyUSB0), a Pelco-D
-/// emulator behind an in-memory link, for the controller test.
-struct PelcoBench(std::sync::Mutex<Vec<campanile_firmware_link::emulator::Emulator<PelcoDevice>>>);
-
-use campanile_firmware_link::pelco_d::device::{PelcoConfig, PelcoDevice};
-
-impl campanile_capture::station::PortOpener for PelcoBench {
-    type Port = tokio::io::DuplexStream;
-
-    async fn open(&self, link: &campanile_config::link::SerialLink) -> std::io::Result<Self::Port> {
-        assert_eq!(link.port, "/dev/ttyUSB0", "only the head is serial");
-        let (host, dev) = campanile_firmware_link::transport::memory::duplex(4096);
-        let cfg = PelcoConfig {
-            speed: 90_000,
-            pan_range: (-18_000, 17_999),
-            ..PelcoConfig::default()
-        };
-        let emu =
-            campanile_firmware_link::emulator::Emulator::spawn(PelcoDevice::new(cfg), dev, Duration::from_millis(2));
-        self.0.lock().unwrap().push(emu);
-        Ok(host)
-    }
-}
-
-/// What a plan run on the INDI station left: the controller's report and
-/// the journal.
-struct PlanRun {
-    report: campanile_capture::controller::RunReport,
-    entries: Vec<campanile_capture::store::JournalEntry>,
-    dir: std::path::PathBuf,
-    _tmp: tempfile::TempDir,
-}
-
-/// Runs a one-session plan of `steps` (RON) on `examples/indi/station.ron`
-/// through the session controller on the wall clock: the INDI CCD and
-/// filter wheel on the server at `address`, the head emulated. `during`
-/// runs on a thread of its own beside the run, given the session
-/// directory.
-async fn run_plan(address: &str, steps: &str, during: impl FnOnce(std::path::PathBuf) + Send + 'static) -> PlanRun {
-    use campanile_capture::clock::SystemClock;
-    use campanile_capture::controller::{self, NoProgress, RunOptions};
-    use campanile_capture::schedule::{TimelineOptions, timeline};
-    use campanile_capture::station::{StationOptions, StationRig};
-    use campanile_capture::store::{Provenance, SessionStore, Snapshot};
-
-    let example = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/indi/station.ron");
-    let text = std::fs::read_to_string(&example)
-        .unwrap()
-        .replace("127.0.0.1:7624", address);
-    let tmp = tempfile::tempdir().unwrap();
-    let station_file = tmp.path().join("indi-station.ron");
-    std::fs::write(&station_file, &text).unwrap();
-    let station = campanile_config::load_station(&station_file).unwrap().value;
-    let start = chrono::Utc::now() + chrono::TimeDelta::seconds(3);
-    let plan_text = format!(
-        r#"Plan(
-    name: "indi test",
-    start_date: "{}",
-    sessions: [(
-        name: "one",
-        trigger: Clock(time: "{}"),
-        steps: [{steps}],
-    )],
-)"#,
-        start.format("%Y-%m-%d"),
-        start.format("%H:%M:%S")
-    );
-    let plan: campanile_config::Plan = ron::from_str(&plan_text).unwrap();
-    let t = timeline(&plan, &station, None, &TimelineOptions { days: Some(1) }).unwrap();
-    assert!(t.uncovered.is_empty(), "{:?}", t.uncovered);
-    let camera = campanile_capture::station::open_station_camera(&station.camera)
-        .await
-        .unwrap();
-    let bench = PelcoBench(std::sync::Mutex::new(Vec::new()));
-    let mut rig = StationRig::connect(&station, bench, camera, StationOptions::default())
-        .await
-        .unwrap();
-    let snapshot = Snapshot {
-        plan_ron: plan_text.clone(),
-        station_ron: text.clone(),
-        scene_ron: None,
-        provenance: Provenance {
-            campanile_version: "test".into(),
-            created_utc: chrono::DateTime::default(),
-            calibration: Vec::new(),
-            sources: None,
-        },
-    };
-    let dir = tmp.path().join("session");
-    let mut store = SessionStore::create(&dir, snapshot).unwrap();
-    let beside = {
-        let dir = dir.clone();
-        std::thread::spawn(move || during(dir))
-    };
-    let report = controller::run(
-        &t,
-        &plan,
-        &station,
-        &mut store,
-        &mut rig,
-        &SystemClock,
-        &RunOptions::default(),
-        &mut NoProgress,
-    )
-    .await
-    .unwrap();
-    beside.join().unwrap();
-    PlanRun {
-        report,
-        entries: store.entries().to_vec(),
-        dir,
-        _tmp: tmp,
-    }
-}
-
-/// The frames a journal holds.
-fn frames_of(entries: &[campanile_capture::store::JournalEntry]) -> Vec<campanile_capture::store::FrameEntry> {
-    use campanile_capture::store::JournalEntry;
-    entries
-        .iter()
-        .filter_map(|e| match e {
-            JournalEntry::Done(f) | JournalEntry::Late(f) => Some(f.clone()),
-            _ => None,
-        })
-        .collect()
+/// `examples/indi/station.ron` on the server at `address`.
+fn indi_station(address: &str) -> String {
+    common::example("indi/station.ron").replace("127.0.0.1:7624", address)
 }
 
 /// A plan run by the session controller on the wall clock through the INDI
@@ -353,7 +234,7 @@ async fn a_plan_runs_through_the_controller_on_the_indi_station() {
 
     let server = server();
     let run = run_plan(
-        &server.address(),
+        &indi_station(&server.address()),
         r#"
             Bracket(aim: PanTilt(pan_deg: 20.0, tilt_deg: 10.0), exposures_s: [0.01, 0.04, 0.16],
                     filter: Some("nd1"), on_error: (retries: 2, then: Continue)),
@@ -363,10 +244,17 @@ async fn a_plan_runs_through_the_controller_on_the_indi_station() {
     )
     .await;
     assert_eq!((run.report.frames, run.report.missed), (5, 0), "{:?}", run.report);
-    let frames = frames_of(&run.entries);
+    let frames = &run.frames;
     assert_eq!(frames.len(), 5, "{:?}", run.entries);
-    for f in &frames {
+    for f in frames {
         assert_eq!(f.format, FrameFormat::Fits, "{}", f.key);
+        // The camera's DATE-OBS, not before the session's trigger.
+        assert!(
+            f.meta.time >= run.start - chrono::TimeDelta::seconds(1),
+            "{}: {}",
+            f.key,
+            f.meta.time
+        );
         assert!(f.file.ends_with(".fits"), "{}", f.file);
         let exptime = f
             .meta
@@ -436,7 +324,7 @@ async fn a_server_restarted_mid_plan_is_journaled_and_nothing_is_lost_or_doubled
         }
     };
     let run = run_plan(
-        &address,
+        &indi_station(&address),
         r#"
             Bracket(aim: PanTilt(pan_deg: 20.0, tilt_deg: 10.0), exposures_s: [0.01, 2.0, 0.04],
                     filter: Some("nd1"), on_error: (retries: 4, then: Continue)),"#,
@@ -445,7 +333,7 @@ async fn a_server_restarted_mid_plan_is_journaled_and_nothing_is_lost_or_doubled
     .await;
     assert_eq!((run.report.frames, run.report.missed), (3, 0), "{:?}", run.entries);
     assert!(run.report.reconnects >= 1, "{:?}", run.report);
-    let frames = frames_of(&run.entries);
+    let frames = &run.frames;
     let mut keys: Vec<&str> = frames.iter().map(|f| f.key.as_str()).collect();
     keys.sort_unstable();
     keys.dedup();

@@ -240,7 +240,8 @@ struct Controller<'a, R, C, S: Storage> {
     last_pose: Option<(Pose, PoseDeg)>,
     /// The wheel's last slot, while nothing failed since.
     last_slot: Option<u8>,
-    /// Which devices are down since when, for the journal's `outage` lines.
+    /// Which devices are down since when, for the journal's `outage` lines
+    /// (kept only when the supervisor leaves those to the controller).
     health: DeviceHealth,
     /// The camera's codes are linear ([`crate::device::CameraInfo::linear`]).
     linear_camera: bool,
@@ -632,24 +633,26 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
     /// result on.
     fn noted<T>(&mut self, kind: DeviceKind, r: Result<T, ShotError>) -> Result<T, ShotError> {
         let now = self.clock.now();
+        let journals = self.supervisor.journals_outages();
         match &r {
             Ok(_) => {
                 self.supervisor.device_answered(kind, now);
-                self.health.answered(kind, now);
+                if journals {
+                    self.health.answered(kind, now);
+                }
             }
             Err(ShotError::Device(k, e)) => {
                 self.supervisor.device_failed(*k, now, e);
-                self.health.failed(*k, now, &e.to_string());
+                if journals {
+                    self.health.failed(*k, now, &e.to_string());
+                }
             }
             Err(_) => {}
         }
-        let ended = self.health.take_ended();
-        if self.supervisor.journals_outages() {
-            for o in ended {
-                self.store
-                    .record_outage(&o.device.to_string(), o.start, o.end, false)
-                    .map_err(ShotError::Store)?;
-            }
+        for o in self.health.take_ended() {
+            self.store
+                .record_outage(&o.device.to_string(), o.start, o.end, false)
+                .map_err(ShotError::Store)?;
         }
         r
     }
@@ -657,9 +660,6 @@ impl<R: Rig, C: Clock, S: Storage> Controller<'_, R, C, S> {
     /// Journal the outages of devices still down as the run ends (`open`:
     /// their end is the run's, not the device's return).
     fn journal_open_outages(&mut self) -> Result<(), StoreError> {
-        if !self.supervisor.journals_outages() {
-            return Ok(());
-        }
         let now = self.clock.now();
         for kind in WATCHED {
             if let Some(since) = self.health.down_since(kind) {

@@ -58,7 +58,13 @@ pub fn log_code(v: f64) -> u16 {
 /// `frame` as logarithmic codes (module doc), clipped samples at the
 /// largest code; the label is the frame's.
 pub fn log_codes(frame: &LinearFrame) -> CodeImage {
-    let zmax = max_code(LOG_CODE_BITS);
+    codes_of(frame, LOG_CODE_BITS, log_code)
+}
+
+/// `frame`'s samples as `bits`-bit codes through `code` (of the linear
+/// value), a clipped sample at the top code.
+fn codes_of(frame: &LinearFrame, bits: u8, code: impl Fn(f64) -> u16) -> CodeImage {
+    let zmax = max_code(bits);
     let data = frame
         .rgb
         .iter()
@@ -67,14 +73,14 @@ pub fn log_codes(frame: &LinearFrame) -> CodeImage {
             if frame.is_clipped(i / 3, i % 3) {
                 zmax
             } else {
-                log_code(f64::from(v))
+                code(f64::from(v))
             }
         })
         .collect();
     CodeImage {
         width: frame.width,
         height: frame.height,
-        bits: LOG_CODE_BITS,
+        bits,
         data,
         label: frame.label.clone(),
     }
@@ -85,26 +91,8 @@ pub fn log_codes(frame: &LinearFrame) -> CodeImage {
 /// controller to meter (as a linear camera's codes), while processing reads
 /// the file itself through [`log_codes`].
 pub fn linear_codes16(frame: &LinearFrame) -> CodeImage {
-    let zmax = max_code(16);
-    let data = frame
-        .rgb
-        .iter()
-        .enumerate()
-        .map(|(i, &v)| {
-            if frame.is_clipped(i / 3, i % 3) {
-                zmax
-            } else {
-                (f64::from(v).clamp(0.0, 1.0) * f64::from(zmax)).round() as u16
-            }
-        })
-        .collect();
-    CodeImage {
-        width: frame.width,
-        height: frame.height,
-        bits: 16,
-        data,
-        label: frame.label.clone(),
-    }
+    let zmax = f64::from(max_code(16));
+    codes_of(frame, 16, |v| (v.clamp(0.0, 1.0) * zmax).round() as u16)
 }
 
 /// A linear sensor's codes (an astro or machine-vision camera's FITS
@@ -184,6 +172,23 @@ mod tests {
         // Unclipped white stays below the top code; the top code is exposure 1.
         assert_eq!(log_code(1.0), 65_534);
         assert!(curve.ln_exposure(1, 65_535.0).abs() < 1e-12);
+    }
+
+    /// Linear codes: v · 65535, a flagged sample at the top code, noise
+    /// below black at 0.
+    #[test]
+    fn linear_codes_scale_the_white_level_to_the_top_code() {
+        let frame = LinearFrame {
+            label: "f.cr2".into(),
+            width: 1,
+            height: 2,
+            rgb: vec![0.5, -0.01, 0.25, 0.9, 0.1, 1.0],
+            clipped: vec![0, 0b001],
+            meta: FrameMetadata::default(),
+        };
+        let codes = linear_codes16(&frame);
+        assert_eq!(codes.bits, 16);
+        assert_eq!(codes.data, vec![32768, 0, 16384, 65535, 6554, 65535]);
     }
 
     /// A 16-bit linear frame: half the white level is one stop below it,
