@@ -301,7 +301,7 @@ fn main() {
         .and_then(|v| v.parse().ok())
         .unwrap_or(1);
     for view in &input.views {
-        let mut camera = view.camera.clone();
+        let mut camera = view.camera;
         camera.width *= scale;
         camera.height *= scale;
         let view = &campanile_process::igi::View { camera, ..view.clone() };
