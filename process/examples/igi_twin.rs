@@ -371,11 +371,15 @@ fn main() {
                             .is_some_and(|h| scene.triangles()[h.triangle].material as usize == s)
                     });
                 // And away from the lamps' spheres (a pixel the sphere
-                // covers in part is the lamp's in the reference).
+                // covers in part is the lamp's in the reference): beyond
+                // four radii plus two pixels at the lamp's distance.
+                let pixel_rad = 2.0 * (0.5 * view.camera.vfov_rad).tan() / h as f64;
                 let near_lamp = input.lights.iter().any(|l| {
                     let to = l.position - ray.origin;
                     let t = to.dot(&ray.direction);
-                    t > 0.0 && t < hit.t && (to - ray.direction * t).norm() < 4.0 * l.radius.max(0.01)
+                    t > 0.0
+                        && t < hit.t
+                        && (to - ray.direction * t).norm() < 4.0 * l.radius.max(0.01) + 2.0 * pixel_rad * t
                 });
                 if !same || near_lamp {
                     continue;
