@@ -66,9 +66,19 @@ fn rendered_sun_shots_calibrate_the_mis_set_fisheye_within_0_05_degrees() {
     );
     let sightings: Vec<_> = shots.iter().map(|s| s.sighting).collect();
     let clock = std::time::Instant::now();
-    let cal = calibrate_sky_camera(&sightings, &observer, s.delta_t_s, &nominal, &CalibrationOptions::default()).unwrap();
+    let cal = calibrate_sky_camera(
+        &sightings,
+        &observer,
+        s.delta_t_s,
+        &nominal,
+        &CalibrationOptions::default(),
+    )
+    .unwrap();
     let fit_s = clock.elapsed().as_secs_f64();
-    let (before, after) = (nominal.orientation_error_deg(&truth), cal.model.orientation_error_deg(&truth));
+    let (before, after) = (
+        nominal.orientation_error_deg(&truth),
+        cal.model.orientation_error_deg(&truth),
+    );
     let (_, field_before) = direction_error_deg(&truth, &nominal, (512, 512), 4, 90.0);
     let (field_rms, field_max) = direction_error_deg(&truth, &cal.model, (512, 512), 4, 90.0);
     println!(
@@ -77,7 +87,10 @@ fn rendered_sun_shots_calibrate_the_mis_set_fisheye_within_0_05_degrees() {
         shots.len(),
         calibration_report(&cal)
     );
-    assert!(worst_centroid < 0.3, "a measured centroid {worst_centroid} px from the true image");
+    assert!(
+        worst_centroid < 0.3,
+        "a measured centroid {worst_centroid} px from the true image"
+    );
     assert!(before > 3.0 && field_before > 5.0, "the nominal camera is mis-set");
     assert!(after < 0.05, "orientation off by {after}°");
     assert!(field_max < 0.05, "a ray of the field off by {field_max}°");

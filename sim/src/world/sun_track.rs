@@ -60,7 +60,10 @@ pub fn sun_shots(
             continue;
         }
         let c = rig.mount.to_camera(rig.head, sun.direction());
-        let Some(true_pixel) = rig.pinhole.project(c).filter(|(u, v)| (0.0..w as f64).contains(u) && (0.0..h as f64).contains(v))
+        let Some(true_pixel) = rig
+            .pinhole
+            .project(c)
+            .filter(|(u, v)| (0.0..w as f64).contains(u) && (0.0..h as f64).contains(v))
         else {
             missed.push(MissedShot {
                 time,
@@ -69,7 +72,11 @@ pub fn sun_shots(
             continue;
         };
         let image = world.render(time, &rig, &[], seed.wrapping_add(k as u64))?;
-        let green: Vec<f32> = image.data.chunks_exact(3).map(|p| p[1] * transmittance as f32).collect();
+        let green: Vec<f32> = image
+            .data
+            .chunks_exact(3)
+            .map(|p| p[1] * transmittance as f32)
+            .collect();
         let frame = SunFrame {
             width: w,
             height: h,
