@@ -7,6 +7,8 @@
 
 use campanile_process::pose::{HeadPose, Mount, Pinhole};
 use campanile_process::quality::Verdict;
+use campanile_process::render::Sky;
+use campanile_process::sky::{SkyFrame, sky_samples};
 use campanile_process::sky_camera_calibration::{
     CalibrationOptions, SkyCameraModel, calibrate_sky_camera, calibration_report, direction_error_deg,
 };
@@ -95,4 +97,56 @@ fn rendered_sun_shots_calibrate_the_mis_set_fisheye_within_0_05_degrees() {
     assert!(after < 0.05, "orientation off by {after}°");
     assert!(field_max < 0.05, "a ray of the field off by {field_max}°");
     assert_eq!(cal.verdict, Verdict::Ok, "{:?}", cal.reasons);
+
+    // Used: the sun's direction from each measured centroid, and the sky
+    // sampled from a frame at 20:00 UTC, through the nominal camera and
+    // through the calibrated one, against the world's truth.
+    let sun_error = |m: &SkyCameraModel| {
+        shots
+            .iter()
+            .map(|s| {
+                let (u, v) = s.sighting.centroid_px;
+                let d = m.ray(u, v).unwrap();
+                let t = world.sun(s.sighting.time).unwrap().direction();
+                let dot: f64 = (0..3).map(|k| d[k] * t[k]).sum();
+                dot.clamp(-1.0, 1.0).acos().to_degrees()
+            })
+            .fold(0.0, f64::max)
+    };
+    let (sun_before, sun_after) = (sun_error(&nominal), sun_error(&cal.model));
+    world.quality.samples_per_pixel = 4;
+    let time: DateTime<Utc> = "2026-06-21T20:00:00Z".parse().unwrap();
+    let rig = world.rig(zenith(), [0.0, 0.0, 2.0], 512, 512);
+    let image = world.render(time, &rig, &[], 11).unwrap();
+    let daylight = world.daylight(time).unwrap().unwrap();
+    let sun = world.sun(time).unwrap().direction();
+    let sky_error = |m: &SkyCameraModel| {
+        let frame = SkyFrame {
+            width: 512,
+            height: 512,
+            rgb: &image.data,
+            valid: None,
+            camera: m.camera,
+            mount: m.mount,
+            pose: m.head,
+        };
+        let table = sky_samples(&[frame], sun, 4, 5f64.to_radians()).unwrap();
+        let mut sum = 0.0;
+        for (k, (zenith_rad, azimuth_rad)) in table.directions.iter().enumerate() {
+            let d = campanile_process::sky::direction(*zenith_rad, *azimuth_rad);
+            let truth = Sky::radiance(&daylight, &nalgebra::Vector3::from(d))[1];
+            sum += (table.values[1][k] / truth - 1.0).powi(2);
+        }
+        ((sum / table.directions.len() as f64).sqrt(), table.directions.len())
+    };
+    let ((sky_before, n_before), (sky_after, n_after)) = (sky_error(&nominal), sky_error(&cal.model));
+    println!(
+        "sun direction from the centroids: ≤ {sun_before:.3}° nominal, ≤ {sun_after:.4}° calibrated\n\
+         sky radiance (green) at the sampled directions: {:.2}% RMS nominal ({n_before} samples), {:.2}% calibrated ({n_after})",
+        100.0 * sky_before,
+        100.0 * sky_after
+    );
+    assert!(sun_after < 0.05 && sun_before > 3.0, "{sun_before} → {sun_after}");
+    assert!(sky_after < 0.02, "sky {sky_after} RMS through the calibrated camera");
+    assert!(sky_before > 3.0 * sky_after, "sky {sky_before} → {sky_after}");
 }
