@@ -144,6 +144,7 @@ fn process_each_scan(
     let mut processor = SkySeriesProcessor {
         response: response.to_path_buf(),
         thresholds,
+        camera_calibration: None,
     };
     move |dir: &Path, occurrence: &Occurrence| {
         let why = match processor.process(dir, &occurrence.key) {

@@ -124,6 +124,62 @@ pub struct Resolution {
     pub height: u32,
 }
 
+/// How the lens maps a ray's angle θ off the optical axis to its ideal
+/// normalized image radius ρ (image radius over the focal length, before
+/// the radial terms): the central (pinhole) projection, or one of the two
+/// fisheye projections all-sky cameras are built to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(test, derive(proptest_derive::Arbitrary))]
+pub enum Projection {
+    /// ρ = tan θ: the rectilinear (pinhole) lens, field under 180°.
+    #[default]
+    Pinhole,
+    /// ρ = θ (radians): the equidistant ("f-theta") fisheye.
+    Equidistant,
+    /// ρ = 2 sin(θ/2): the equisolid-angle (equal-area) fisheye.
+    Equisolid,
+}
+
+impl Projection {
+    /// Whether this is the central projection (the default).
+    pub fn is_pinhole(&self) -> bool {
+        *self == Projection::Pinhole
+    }
+
+    /// Whether this is one of the fisheye projections.
+    pub fn is_fisheye(&self) -> bool {
+        !self.is_pinhole()
+    }
+
+    /// The ideal normalized radius ρ of a ray `theta` radians off the axis
+    /// (infinite for a pinhole at or past 90°).
+    pub fn radius(self, theta: f64) -> f64 {
+        match self {
+            Projection::Pinhole if theta >= std::f64::consts::FRAC_PI_2 => f64::INFINITY,
+            Projection::Pinhole => theta.tan(),
+            Projection::Equidistant => theta,
+            Projection::Equisolid => 2.0 * (0.5 * theta).sin(),
+        }
+    }
+
+    /// The angle off the axis of ideal normalized radius `rho` ≥ 0 (the
+    /// inverse of [`Projection::radius`]); `None` past the projection's
+    /// largest radius (equisolid: ρ > 2).
+    pub fn angle(self, rho: f64) -> Option<f64> {
+        match self {
+            Projection::Pinhole => Some(rho.atan()),
+            Projection::Equidistant => (rho <= std::f64::consts::PI).then_some(rho),
+            Projection::Equisolid => (rho <= 2.0).then(|| 2.0 * (0.5 * rho).asin()),
+        }
+    }
+
+    /// The widest field of view, degrees, a lens of this projection can
+    /// have across the image (a pinhole's is under 180°, a fisheye's under 360°).
+    pub fn max_field_deg(self) -> f64 {
+        if self.is_pinhole() { 180.0 } else { 360.0 }
+    }
+}
+
 /// The focal length, either directly in pixels or through a field of view.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(test, derive(proptest_derive::Arbitrary))]
@@ -135,28 +191,43 @@ pub enum Focal {
 }
 
 impl Focal {
-    /// The focal length in pixels for an image `width` pixels wide.
+    /// The focal length in pixels for an image `width` pixels wide, of a
+    /// pinhole lens (a field of view is ideal: radial terms left out).
     pub fn pixels(self, width: u32) -> f64 {
+        self.pixels_for(Projection::Pinhole, width)
+    }
+
+    /// The focal length in pixels for an image `width` pixels wide through
+    /// `projection`: a horizontal field of view 2θ puts the image's side
+    /// edges at ideal radius ρ(θ), so f = (width / 2) / ρ(θ).
+    pub fn pixels_for(self, projection: Projection, width: u32) -> f64 {
         match self {
             Focal::Pixels(f) => f,
-            Focal::HorizontalFovDeg(fov) => 0.5 * f64::from(width) / (0.5 * fov.to_radians()).tan(),
+            Focal::HorizontalFovDeg(fov) => 0.5 * f64::from(width) / projection.radius(0.5 * fov.to_radians()),
         }
     }
 }
 
-/// Pinhole intrinsics with radial distortion and vignetting falloff.
+/// Camera intrinsics: a projection (pinhole or fisheye) with radial
+/// distortion, and vignetting falloff.
 ///
-/// Distortion: with `r` the distance from the principal point divided by
-/// the focal length, a point at ideal normalized radius `r` is imaged at
-/// `r (1 + k1 r² + k2 r⁴)`. Falloff: with `ρ` the distance from the image
+/// Distortion: a ray θ off the axis has the ideal normalized radius
+/// `r = ρ(θ)` of the projection (`tan θ`, `θ` or `2 sin(θ/2)`); it is
+/// imaged at `r (1 + k1 r² + k2 r⁴)` focal lengths from the principal
+/// point. Falloff: with `ρ` the distance from the image
 /// centre normalized to 1 at the corners (as `campanile hdr lens` fits it),
 /// the recorded intensity is scaled by `1 + a ρ² + b ρ⁴` (thesis §4.7.2).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(test, derive(proptest_derive::Arbitrary))]
 #[serde(deny_unknown_fields)]
 pub struct Intrinsics {
-    /// The focal length.
+    /// The focal length (a field of view is through `projection`).
     pub focal: Focal,
+    /// The lens's projection: `Pinhole` (the default), `Equidistant` or
+    /// `Equisolid` (fisheyes, whose field may reach 90° off the axis and
+    /// beyond).
+    #[serde(default, skip_serializing_if = "Projection::is_pinhole")]
+    pub projection: Projection,
     /// Principal point `(x, y)` in pixels; the image centre when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub principal_point_px: Option<(f64, f64)>,
@@ -166,6 +237,32 @@ pub struct Intrinsics {
     /// Falloff coefficients `(a, b)` of `1 + a ρ² + b ρ⁴` (ρ = 1 at the corners), each in [-2, 2].
     #[serde(default)]
     pub falloff: (f64, f64),
+}
+
+/// The smallest ideal radius in (0, `rho_max`] at which the distorted
+/// radius `r (1 + k1 r² + k2 r⁴)` stops growing (its derivative
+/// `1 + 3 k1 r² + 5 k2 r⁴` reaches zero), or `None` when it grows all the
+/// way out: where the lens model would fold the image over.
+pub fn fold_radius((k1, k2): (f64, f64), rho_max: f64) -> Option<f64> {
+    // The derivative as a quadratic in s = r²: 1 + 3 k1 s + 5 k2 s².
+    let (a, b) = (5.0 * k2, 3.0 * k1);
+    let s_max = rho_max * rho_max;
+    let roots: Vec<f64> = if a.abs() < 1e-300 {
+        if b < 0.0 { vec![-1.0 / b] } else { vec![] }
+    } else {
+        let disc = b * b - 4.0 * a;
+        if disc < 0.0 {
+            vec![]
+        } else {
+            let q = disc.sqrt();
+            vec![(-b - q) / (2.0 * a), (-b + q) / (2.0 * a)]
+        }
+    };
+    roots
+        .into_iter()
+        .filter(|&s| s > 0.0 && s <= s_max)
+        .min_by(f64::total_cmp)
+        .map(f64::sqrt)
 }
 
 /// A closed interval of exposure times in seconds.
@@ -340,7 +437,12 @@ impl Validate for Camera {
                     v.range_open_low(0, f, 0.0, 1e6, "a focal length in pixels")
                 }),
                 Focal::HorizontalFovDeg(fov) => v.at("focal", |v| {
-                    v.range_open(0, fov, 0.0, 180.0, "a horizontal field of view in degrees")
+                    let what = if i.projection.is_pinhole() {
+                        "a horizontal field of view in degrees (a fisheye projection takes up to 360)"
+                    } else {
+                        "a horizontal field of view in degrees"
+                    };
+                    v.range_open(0, fov, 0.0, i.projection.max_field_deg(), what)
                 }),
             }
             if let Some((x, y)) = i.principal_point_px {
@@ -354,6 +456,23 @@ impl Validate for Camera {
                 v.range(0, i.distortion.0, -2.0, 2.0, "a radial distortion coefficient k1");
                 v.range(1, i.distortion.1, -2.0, 2.0, "a radial distortion coefficient k2");
             });
+            if i.projection.is_fisheye() {
+                let rho = i.projection.radius(std::f64::consts::FRAC_PI_2);
+                if let Some(fold) = fold_radius(i.distortion, rho) {
+                    v.invalid(
+                        "distortion",
+                        format!("{:?}", i.distortion),
+                        &format!(
+                            "radial terms whose image radius grows out to 90° off the axis for a fisheye \
+                             (these fold the image over at {:.1}° off the axis)",
+                            i.projection
+                                .angle(fold)
+                                .unwrap_or(std::f64::consts::FRAC_PI_2)
+                                .to_degrees()
+                        ),
+                    );
+                }
+            }
             v.at("falloff", |v| {
                 v.range(0, i.falloff.0, -2.0, 2.0, "a falloff coefficient a");
                 v.range(1, i.falloff.1, -2.0, 2.0, "a falloff coefficient b");

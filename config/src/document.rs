@@ -62,6 +62,14 @@ pub fn load_station(path: &Path) -> Result<Loaded<Station>, ConfigErrors> {
     load_valid(expect_kind(SourceFile::read(path)?, "Station")?)
 }
 
+/// Reads and validates a camera calibration file (`CameraCalibration(...)`,
+/// as `campanile sky calibrate` writes it).
+pub fn load_camera_calibration(
+    path: &Path,
+) -> Result<Loaded<crate::camera_calibration::CameraCalibration>, ConfigErrors> {
+    load_valid(expect_kind(SourceFile::read(path)?, "CameraCalibration")?)
+}
+
 /// Reads and validates a scene file, including its OBJ geometry's groups.
 pub fn load_scene(path: &Path) -> Result<Loaded<Scene>, ConfigErrors> {
     load_valid(expect_kind(SourceFile::read(path)?, "Scene")?)

@@ -165,30 +165,34 @@ impl Validate for PanTiltHead {
             );
             v.range("settle_s", d.settle_s, 0.0, 60.0, "a settle time in seconds");
         });
-        v.at("mount", |v| {
-            let m = self.mount;
-            v.range_open_high(
-                "pan_zero_azimuth_deg",
-                m.pan_zero_azimuth_deg,
-                0.0,
-                360.0,
-                "an azimuth in degrees",
-            );
-            v.range("tilt_zero_deg", m.tilt_zero_deg, -90.0, 90.0, "a tilt angle in degrees");
-            v.range(
-                "level_roll_deg",
-                m.level_roll_deg,
-                -10.0,
-                10.0,
-                "a level offset in degrees",
-            );
-            v.range(
-                "level_pitch_deg",
-                m.level_pitch_deg,
-                -10.0,
-                10.0,
-                "a level offset in degrees",
-            );
-        });
+        v.at("mount", |v| self.mount.validate(v));
+    }
+}
+
+impl Validate for MountCalibration {
+    fn validate(&self, v: &mut Validator) {
+        let m = self;
+        v.range_open_high(
+            "pan_zero_azimuth_deg",
+            m.pan_zero_azimuth_deg,
+            0.0,
+            360.0,
+            "an azimuth in degrees",
+        );
+        v.range("tilt_zero_deg", m.tilt_zero_deg, -90.0, 90.0, "a tilt angle in degrees");
+        v.range(
+            "level_roll_deg",
+            m.level_roll_deg,
+            -10.0,
+            10.0,
+            "a level offset in degrees",
+        );
+        v.range(
+            "level_pitch_deg",
+            m.level_pitch_deg,
+            -10.0,
+            10.0,
+            "a level offset in degrees",
+        );
     }
 }

@@ -14,6 +14,7 @@
 //! ```
 
 pub mod camera;
+pub mod camera_calibration;
 pub mod document;
 pub mod error;
 pub mod filter_wheel;

@@ -22,6 +22,13 @@ pub struct Simulation {
     /// Chance that a byte on a simulated serial link is corrupted, in [0, 0.5].
     #[serde(default)]
     pub link_corrupt_chance: f64,
+    /// The camera as it truly is, when it differs from the configured
+    /// one: a lens and mount the station does not know (a mis-set
+    /// orientation, a focal length a few percent off), which the simulated
+    /// world renders with while the station and processing keep the
+    /// configured camera, so that a calibration has something to find.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub true_camera: Option<crate::camera_calibration::CameraCalibration>,
 }
 
 /// A station: where it stands and what it drives.
@@ -75,6 +82,21 @@ impl Validate for Station {
             Some(s) => v.at("simulation", |v| {
                 v.range("link_drop_chance", s.link_drop_chance, 0.0, 0.5, "a probability");
                 v.range("link_corrupt_chance", s.link_corrupt_chance, 0.0, 0.5, "a probability");
+                if let Some(t) = &s.true_camera {
+                    v.at("true_camera", |v| {
+                        t.validate(v);
+                        if t.resolution != self.camera.resolution {
+                            v.invalid(
+                                "resolution",
+                                format!("{}×{}", t.resolution.width, t.resolution.height),
+                                &format!(
+                                    "the configured camera's resolution, {}×{}",
+                                    self.camera.resolution.width, self.camera.resolution.height
+                                ),
+                            );
+                        }
+                    });
+                }
             }),
             None if self.uses_simulation() => v.invalid(
                 "simulation",

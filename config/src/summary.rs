@@ -68,14 +68,25 @@ fn station_summary(s: &Station) -> String {
         },
         None => String::new(),
     };
-    let focal = c.intrinsics.focal.pixels(c.resolution.width);
+    let focal = c
+        .intrinsics
+        .focal
+        .pixels_for(c.intrinsics.projection, c.resolution.width);
     let fov = match c.intrinsics.focal {
         Focal::HorizontalFovDeg(f) => f,
-        Focal::Pixels(f) => 2.0 * (0.5 * f64::from(c.resolution.width) / f).atan().to_degrees(),
+        Focal::Pixels(f) => {
+            let theta = c.intrinsics.projection.angle(0.5 * f64::from(c.resolution.width) / f);
+            2.0 * theta.unwrap_or(std::f64::consts::PI).to_degrees()
+        }
+    };
+    let lens = match c.intrinsics.projection {
+        crate::camera::Projection::Pinhole => "",
+        crate::camera::Projection::Equidistant => " equidistant fisheye,",
+        crate::camera::Projection::Equisolid => " equisolid fisheye,",
     };
     let _ = writeln!(
         o,
-        "  camera     {driver}{device}, {}×{} px, {}-bit, focal {focal:.1} px ({fov:.1}° across), exposure {}–{} s",
+        "  camera     {driver}{device},{lens} {}×{} px, {}-bit, focal {focal:.1} px ({fov:.1}° across), exposure {}–{} s",
         c.resolution.width,
         c.resolution.height,
         c.bit_depth,

@@ -30,6 +30,7 @@ pub mod report;
 pub mod rgbe_file;
 pub mod scene_geometry;
 pub mod sky;
+pub mod sky_camera_calibration;
 pub mod sky_series;
 pub mod sun;
 pub mod visibility;

@@ -20,6 +20,7 @@ fn camera_at(position: Vector3<f64>, tilt_rad: f64, size: usize) -> CameraRig {
             principal_px: (size as f64 / 2.0, size as f64 / 2.0),
             k1: 0.0,
             k2: 0.0,
+            projection: campanile_process::pose::Projection::Pinhole,
         },
         mount: Mount::default(),
         head: HeadPose { pan_rad: 0.0, tilt_rad },
@@ -354,6 +355,7 @@ fn a_sun_smaller_than_a_pixel_is_integrated_exactly() {
         principal_px: (32.0, 24.0),
         k1: -0.05,
         k2: 0.01,
+        projection: campanile_process::pose::Projection::Pinhole,
     };
     let empty = Scene::new(Vec::new(), Vec::new(), Vec::new()).unwrap();
     let irradiance_seen = |scene: &Scene, direction: Vector3<f64>| {

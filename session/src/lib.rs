@@ -65,6 +65,7 @@ pub mod run;
 pub mod scan_processor;
 pub mod scene_render;
 pub mod site;
+pub mod sky_camera_files;
 pub mod sky_files;
 pub mod sky_series;
 pub mod station_run;

@@ -43,6 +43,9 @@ pub struct ProcessOptions {
     pub grid_spacing_m: f64,
     /// Sky-only sessions: the response curve (CSV).
     pub response: Option<PathBuf>,
+    /// Sky-only sessions: a calibrated camera (`campanile sky calibrate`'s
+    /// file) used instead of the station's camera intrinsics and mount.
+    pub camera_calibration: Option<PathBuf>,
     /// Sky-only sessions: process only this share of the scans.
     pub shard: Option<Shard>,
     /// Sky-only sessions: merge these shard output directories instead.
@@ -78,9 +81,14 @@ pub fn kind(opts: &ProcessOptions) -> Result<SessionKind> {
         let q = crate::verdicts::thresholds(opts.thresholds.as_deref(), Some(&inputs.plan))?;
         return Ok(SessionKind::SkyOnly(Box::new(q)));
     }
-    if opts.response.is_some() || opts.shard.is_some() || opts.merge_shards.is_some() || opts.occurrence.is_some() {
+    if opts.response.is_some()
+        || opts.shard.is_some()
+        || opts.merge_shards.is_some()
+        || opts.occurrence.is_some()
+        || opts.camera_calibration.is_some()
+    {
         return Err(Error::input(format!(
-            "{}: --response, --shard, --merge-shards and --occurrence are for sky-only sessions (sun shots, sky scans and brackets at head angles); this session's plan has views of a scene",
+            "{}: --response, --shard, --merge-shards, --occurrence and --camera-calibration are for sky-only sessions (sun shots, sky scans and brackets at head angles); this session's plan has views of a scene",
             opts.session.display()
         )));
     }
@@ -242,6 +250,7 @@ pub fn sky_only(opts: &ProcessOptions, q: &Quality) -> Result<SkyRun> {
         response: opts.response.clone(),
         shard: opts.shard,
         debevec: opts.debevec,
+        camera_calibration: opts.camera_calibration.clone(),
     };
     std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
     let (work, series) = match (&opts.occurrence, &opts.merge_shards) {

@@ -35,6 +35,9 @@ pub struct SkySeriesProcessor {
     pub response: PathBuf,
     /// The thresholds the scans are held to.
     pub thresholds: Quality,
+    /// A calibrated camera (`campanile sky calibrate`'s file) the scans
+    /// are processed with instead of the station's camera and mount.
+    pub camera_calibration: Option<PathBuf>,
 }
 
 impl ScanProcessor for SkySeriesProcessor {
@@ -44,6 +47,7 @@ impl ScanProcessor for SkySeriesProcessor {
             response: Some(self.response.clone()),
             shard: None,
             debevec: DebevecOptions::default(),
+            camera_calibration: self.camera_calibration.clone(),
         };
         process_scan(session_dir, occurrence, &opts)?;
         let series = recompute_day(&opts.out)?;

@@ -45,6 +45,25 @@ pub struct SkySeriesOptions {
     pub shard: Option<Shard>,
     /// Response recovery options (for the session's calibration bracket).
     pub debevec: DebevecOptions,
+    /// A calibrated camera (`CameraCalibration(...)` from `campanile sky
+    /// calibrate`) that replaces the session station's camera intrinsics
+    /// and mount: a mis-set sky camera's frames are sampled through it.
+    pub camera_calibration: Option<PathBuf>,
+}
+
+/// The optics the scans are processed with: the session's station, its
+/// camera and mount replaced by `opts`' calibration where one is given.
+fn optics_of(inputs: &SessionInputs, opts: &SkySeriesOptions) -> Result<StationOptics> {
+    let Some(path) = &opts.camera_calibration else {
+        return Ok(StationOptics::of_station(&inputs.station));
+    };
+    let cal =
+        campanile_config::document::load_camera_calibration(path).map_err(|e| crate::Error::input(e.to_string()))?;
+    let station = cal
+        .value
+        .apply_to(&inputs.station)
+        .map_err(|e| crate::Error::input(format!("{}: {e}", path.display())))?;
+    Ok(StationOptics::of_station(&station))
 }
 
 impl SkySeriesOptions {
@@ -265,7 +284,7 @@ fn add_to_products(session: &Path, lock: &Mutex<()>, occurrences: &[String]) -> 
 /// Does not recompute the day: call [`recompute_day`] after.
 pub fn process_scan(session: &Path, occurrence: &str, opts: &SkySeriesOptions) -> Result<ScanProducts> {
     let inputs = SessionInputs::open(session, None)?;
-    let optics = StationOptics::of_station(&inputs.station);
+    let optics = optics_of(&inputs, opts)?;
     let (curve, _) = response(&inputs, opts)?;
     let products = scan(&inputs, &optics, &curve, occurrence).with_context(|| format!("scan {occurrence}"))?;
     write_scan(&opts.out, &products)?;
@@ -285,7 +304,7 @@ pub fn recompute_day(out: &Path) -> Result<SkySeries> {
 /// then recomputes the day.
 pub fn process_new_scans(session: &Path, opts: &SkySeriesOptions) -> Result<ScanRun> {
     let inputs = SessionInputs::open(session, None)?;
-    let optics = StationOptics::of_station(&inputs.station);
+    let optics = optics_of(&inputs, opts)?;
     let listed = ProcessedProducts::read(session)?;
     let lists = opts.lists_products(session);
     let finished = Finished::of(&inputs);

@@ -213,6 +213,7 @@ pub fn run_station(
         Some(response) => Box::new(StationHook(SkySeriesProcessor {
             response: response.to_path_buf(),
             thresholds,
+            camera_calibration: None,
         })),
         None => Box::new(NoProcessing),
     };

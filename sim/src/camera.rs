@@ -689,6 +689,7 @@ mod tests {
                 seed,
                 link_drop_chance: 0.0,
                 link_corrupt_chance: 0.0,
+                true_camera: None,
             });
             let mut sim = SimStation::start(
                 &st,

@@ -329,6 +329,7 @@ mod tests {
             seed: 11,
             link_drop_chance: 0.02,
             link_corrupt_chance: 0.02,
+            true_camera: None,
         });
         // The soak test's policy: 30 ms per attempt, up to 500 attempts.
         let options = SimOptions {

@@ -86,6 +86,11 @@ pub struct ProcessArgs {
     /// else the session's own calibration bracket.
     #[arg(long, value_name = "FILE.csv")]
     response: Option<PathBuf>,
+    /// Sky-only sessions: a calibrated camera (CameraCalibration RON from
+    /// `campanile sky calibrate`) whose intrinsics and mount replace the
+    /// station's: a mis-set sky camera's frames are sampled through it.
+    #[arg(long, value_name = "FILE.ron")]
+    camera_calibration: Option<PathBuf>,
     /// Sky-only sessions: process only share K of N of the scans, chosen by
     /// a stable hash of the occurrence id (1 ≤ K ≤ N). Shards do not write
     /// the products list; merge them with --merge-shards.
@@ -163,6 +168,7 @@ fn options(args: ProcessArgs) -> ProcessOptions {
         },
         grid_spacing_m: args.grid_spacing,
         response: args.response,
+        camera_calibration: args.camera_calibration,
         shard: args.shard,
         merge_shards: args.merge_shards,
         occurrence: args.occurrence,

@@ -184,6 +184,64 @@ pub enum SkyCommand {
         #[arg(long)]
         compare: bool,
     },
+    /// Calibrate a fixed sky camera (a fisheye at the zenith) from one day's
+    /// sun shots: its orientation and lens, by the sun's known track.
+    ///
+    /// SHOTS is a CSV with a header row and one row per sun shot:
+    ///   time       the shot's instant, RFC 3339 (or a column time_utc)
+    ///   u_px,v_px  the sun disc's centroid, pixels (pixel centres at
+    ///              half-integers), at the camera's configured resolution
+    /// Other columns are ignored. The station (--station) gives the site
+    /// (for the ephemeris: NREL SPA, refraction at the site's pressure and
+    /// temperature) and the nominal camera: its projection (Pinhole,
+    /// Equidistant or Equisolid), focal length, principal point, radial
+    /// terms and the head's mount calibration; the head is held at
+    /// --pan-deg, --tilt-deg (the zenith by default).
+    ///
+    /// Fitted by Levenberg–Marquardt on the centroids' pixel residuals:
+    /// the orientation as the mount's pan_zero_azimuth_deg, level_roll_deg
+    /// and level_pitch_deg (tilt_zero_deg held), the focal length and k1;
+    /// k2 and the principal point with --fit-k2 and --fit-principal-point
+    /// (one day's track barely separates the principal point from a tilt:
+    /// the report gives the correlation). Clouded shots far off the track
+    /// are rejected and listed; shots with the sun down are left out.
+    ///
+    /// OUTPUT (RON, to --out or standard output): CameraCalibration(
+    /// resolution, intrinsics, mount), the camera and mount the station
+    /// file takes (copy them into `camera.intrinsics` and `head.mount`, or
+    /// give the file to `campanile process --camera-calibration`). The
+    /// report (residual in degrees, each parameter ± σ, the strongest
+    /// correlation, rejected shots) goes to standard error; the verdict
+    /// (ok, poor or failed: too few shots, a track too short, a residual
+    /// over threshold, ill-conditioned) to OUT's stem + .quality.json; a
+    /// failed calibration exits 3.
+    ///
+    /// Example:
+    ///   campanile sky calibrate shots.csv --station examples/sky-fisheye-sim-station.ron \
+    ///       --out camera.ron
+    #[command(verbatim_doc_comment)]
+    Calibrate {
+        /// Sun centroids (CSV: time, u_px, v_px).
+        shots: PathBuf,
+        /// The station file: site, nominal camera and mount.
+        #[arg(long)]
+        station: PathBuf,
+        /// The head's pan while the shots were taken, degrees.
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        pan_deg: f64,
+        /// The head's tilt while the shots were taken, degrees (90: the zenith).
+        #[arg(long, default_value_t = 90.0, allow_negative_numbers = true)]
+        tilt_deg: f64,
+        /// Fit k2 too (else held at the station's).
+        #[arg(long)]
+        fit_k2: bool,
+        /// Fit the principal point too (else held at the station's).
+        #[arg(long)]
+        fit_principal_point: bool,
+        /// Where to write the calibration (RON); standard output when absent.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
 }
 
 /// The sun: given, or from the ephemeris for a time and a site.
@@ -280,6 +338,30 @@ pub fn run(cmd: SkyCommand) -> Result<()> {
             let (sky, quality) = sky_files::predict_files(&skies, sun.given().resolve()?)?;
             super::ron_output::write_ron(&sky, out.as_deref())?;
             finish(&quality, out.as_deref())
+        }
+        SkyCommand::Calibrate {
+            shots,
+            station,
+            pan_deg,
+            tilt_deg,
+            fit_k2,
+            fit_principal_point,
+            out,
+        } => {
+            let options = campanile_process::sky_camera_calibration::CalibrationOptions {
+                fit_k2,
+                fit_principal_point,
+                ..Default::default()
+            };
+            let cal =
+                campanile_session::sky_camera_files::calibrate_files(&shots, &station, (pan_deg, tilt_deg), &options)?;
+            eprint!("{}", cal.report);
+            let text = campanile_session::sky_camera_files::calibration_ron(&cal.file)?;
+            match out.as_deref() {
+                Some(path) => campanile_session::partial_file::write(path, text.as_bytes())?,
+                None => print!("{text}"),
+            }
+            finish(&cal.quality, out.as_deref())
         }
         SkyCommand::Map { sky, out, width } => Ok(sky_files::map_file(&sky, width as usize, &out)?),
         SkyCommand::Eval {

@@ -16,19 +16,12 @@ pub fn mount(station: &Station) -> Mount {
     }
 }
 
-/// The pinhole intrinsics of `station`'s camera at `width` × `height`.
+/// The camera model of `station`'s camera (its projection and radial
+/// terms) at `width` × `height`.
 pub fn pinhole(station: &Station, width: usize, height: usize) -> Pinhole {
     let c = &station.camera;
-    let (w, h) = (f64::from(c.resolution.width), f64::from(c.resolution.height));
-    let i = &c.intrinsics;
-    let (sx, sy) = (width as f64 / w, height as f64 / h);
-    let pp = i.principal_point_px.unwrap_or((w / 2.0, h / 2.0));
-    Pinhole {
-        focal_px: i.focal.pixels(c.resolution.width) * sx,
-        principal_px: (pp.0 * sx, pp.1 * sy),
-        k1: i.distortion.0,
-        k2: i.distortion.1,
-    }
+    let full = (c.resolution.width as usize, c.resolution.height as usize);
+    Pinhole::of_camera(c).rescaled(full, width, height)
 }
 
 /// Unit world direction (x east, y north, z up) of azimuth and elevation in degrees.

@@ -9,6 +9,11 @@ use campanile_process::pose::Pinhole;
 /// Points sampled along each image edge.
 const EDGE_SAMPLES: usize = 33;
 
+/// The largest half-angle a tiling takes, radians (80°): a fisheye whose
+/// image reaches 90° off the axis and beyond covers a rectangle in tangent
+/// space only this far.
+pub const MAX_HALF_ANGLE_RAD: f64 = 80.0 * std::f64::consts::PI / 180.0;
+
 /// Half-angles of the camera's usable field of view, radians.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FieldOfView {
@@ -18,16 +23,9 @@ pub struct FieldOfView {
     pub half_vertical_rad: f64,
 }
 
-/// The configuration's camera as a pinhole with its radial distortion.
+/// The configuration's camera model (projection and radial distortion).
 pub fn pinhole(camera: &Camera) -> Pinhole {
-    let (w, h) = (f64::from(camera.resolution.width), f64::from(camera.resolution.height));
-    let i = &camera.intrinsics;
-    Pinhole {
-        focal_px: i.focal.pixels(camera.resolution.width),
-        principal_px: i.principal_point_px.unwrap_or((0.5 * w, 0.5 * h)),
-        k1: i.distortion.0,
-        k2: i.distortion.1,
-    }
+    Pinhole::of_camera(camera)
 }
 
 impl FieldOfView {
@@ -39,7 +37,18 @@ impl FieldOfView {
         let p = pinhole(camera);
         let (w, h) = (f64::from(camera.resolution.width), f64::from(camera.resolution.height));
         let along = |k: usize, len: f64| len * k as f64 / (EDGE_SAMPLES - 1) as f64;
-        let tangent = |u: f64, v: f64, axis: usize| p.unproject(u, v).map(|d| (d[axis] / d[2]).abs());
+        // The tangent of the ray's angle from the optical axis in the
+        // plane of `axis` and the axis: infinite at or past 90° (a fisheye's
+        // edge), where the rectangle is then capped below.
+        let tangent = |u: f64, v: f64, axis: usize| {
+            p.unproject(u, v).map(|d| {
+                if d[2] > 0.0 {
+                    (d[axis] / d[2]).abs()
+                } else {
+                    f64::INFINITY
+                }
+            })
+        };
         let mut tx = Some(f64::INFINITY);
         let mut ty = Some(f64::INFINITY);
         for k in 0..EDGE_SAMPLES {
@@ -51,15 +60,21 @@ impl FieldOfView {
             }
         }
         let (px, py) = p.principal_px;
-        let ideal_x = px.min(w - px) / p.focal_px;
-        let ideal_y = py.min(h - py) / p.focal_px;
+        let ideal = |half: f64| {
+            p.projection
+                .angle(half / p.focal_px)
+                .unwrap_or(MAX_HALF_ANGLE_RAD)
+                .min(MAX_HALF_ANGLE_RAD)
+                .tan()
+        };
+        let (ideal_x, ideal_y) = (ideal(px.min(w - px)), ideal(py.min(h - py)));
         let (tx, ty) = match (tx, ty) {
-            (Some(x), Some(y)) if x.is_finite() && y.is_finite() => (x, y),
+            (Some(x), Some(y)) if x.is_finite() || y.is_finite() => (x, y),
             _ => (ideal_x, ideal_y),
         };
         FieldOfView {
-            half_horizontal_rad: tx.atan(),
-            half_vertical_rad: ty.atan(),
+            half_horizontal_rad: tx.atan().min(MAX_HALF_ANGLE_RAD),
+            half_vertical_rad: ty.atan().min(MAX_HALF_ANGLE_RAD),
         }
     }
 
@@ -88,6 +103,7 @@ pub(crate) mod tests {
             intrinsics: Intrinsics {
                 focal: Focal::HorizontalFovDeg(hfov_deg),
                 principal_point_px: None,
+                projection: Default::default(),
                 distortion,
                 falloff: (0.0, 0.0),
             },

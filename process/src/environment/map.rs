@@ -153,6 +153,7 @@ mod tests {
             principal_px: (32.0, 24.0),
             k1: 0.0,
             k2: 0.0,
+            projection: crate::pose::Projection::Pinhole,
         };
         let (mount, pose) = (
             Mount::default(),

@@ -205,6 +205,7 @@ mod tests {
                 principal_px: (32.0, 24.0),
                 k1: 0.0,
                 k2: 0.0,
+                projection: crate::pose::Projection::Pinhole,
             },
             mount: Mount::default(),
             head: HeadPose { pan_rad, tilt_rad: 0.2 },

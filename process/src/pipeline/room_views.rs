@@ -218,6 +218,7 @@ mod tests {
             principal_px: (130.0, 95.0),
             k1: -0.05,
             k2: 0.01,
+            projection: crate::pose::Projection::Pinhole,
         };
         let mount = Mount {
             pan_zero_azimuth_rad: 0.0,

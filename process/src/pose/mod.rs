@@ -10,4 +10,4 @@ mod head;
 mod pinhole;
 
 pub use head::{HeadPose, Mount, OrientedMount};
-pub use pinhole::Pinhole;
+pub use pinhole::{Pinhole, Projection};

@@ -114,6 +114,7 @@ impl CameraRig {
                 principal_px: (0.5 * width as f64, 0.5 * height as f64),
                 k1: 0.0,
                 k2: 0.0,
+                projection: crate::pose::Projection::Pinhole,
             },
             mount: Mount {
                 pan_zero_azimuth_rad: 0.0,

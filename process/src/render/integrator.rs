@@ -445,10 +445,32 @@ fn sun_coverage(scene: &Scene, camera: &CameraRig, lighting: &Lighting, disc: &S
         return Vec::new();
     };
     // Half-width in pixels: the disc's radius with room for the lens's
-    // distortion (a few percent) and the off-axis stretch of the projection.
-    let (pu, pv) = camera.pinhole.principal_px;
-    let off_axis = ((cu - pu).hypot(cv - pv) / camera.pinhole.focal_px).atan().cos();
-    let half = 1.25 * camera.pinhole.focal_px * disc.angular_radius_rad.tan() / (off_axis * off_axis);
+    // distortion (a few percent) and the stretch of the projection (a
+    // fisheye's: the farthest of the disc's rim's images from its centre's).
+    let axis = disc.direction;
+    let helper = if axis.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+    let (e1, e2) = {
+        let a = axis.cross(&helper).normalize();
+        (a, axis.cross(&a))
+    };
+    let (sr, cr) = disc.angular_radius_rad.sin_cos();
+    let mut rim = 0.0f64;
+    for k in 0..16 {
+        let (s, c) = (f64::from(k) * std::f64::consts::TAU / 16.0).sin_cos();
+        let d = axis * cr + (e1 * c + e2 * s) * sr;
+        match camera.project(&(camera.position + d * 1e9)) {
+            Some((u, v)) => rim = rim.max((u - cu).hypot(v - cv)),
+            None => rim = rim.max(2.0 * camera.pinhole.focal_px * disc.angular_radius_rad),
+        }
+    }
+    let half = if camera.pinhole.projection.is_pinhole() {
+        // The pinhole's off-axis stretch (1 / cos² θ) in closed form.
+        let (pu, pv) = camera.pinhole.principal_px;
+        let off_axis = ((cu - pu).hypot(cv - pv) / camera.pinhole.focal_px).atan().cos();
+        1.25 * camera.pinhole.focal_px * disc.angular_radius_rad.tan() / (off_axis * off_axis)
+    } else {
+        1.25 * rim.max(1e-9)
+    };
     let (w, h) = (camera.width as f64, camera.height as f64);
     if cu + half < 0.0 || cv + half < 0.0 || cu - half > w || cv - half > h {
         return Vec::new();
@@ -504,7 +526,16 @@ pub fn render(scene: &Scene, camera: &CameraRig, lighting: &Lighting, settings: 
     // of tens of percent.
     let caster = camera.rays();
     let sun = lighting.sky.and_then(|s| s.sun());
-    let pixel_rad = camera.pinhole.focal_px.recip();
+    let pixel_rad = match sun.as_ref().and_then(|d| {
+        let c = camera
+            .mount
+            .to_camera(camera.head, [d.direction.x, d.direction.y, d.direction.z]);
+        let theta = c[0].hypot(c[1]).atan2(c[2]);
+        theta.is_finite().then_some(theta)
+    }) {
+        Some(theta) if camera.pinhole.projection.is_fisheye() => camera.pinhole.max_pixel_angle_rad(theta + 0.05),
+        _ => camera.pinhole.focal_px.recip(),
+    };
     let near_sun = |u: f64, v: f64| {
         sun.as_ref().is_some_and(|disc| {
             caster.ray(u, v).is_some_and(|r| {

@@ -226,6 +226,7 @@ mod tests {
             principal_px: (64.0, 48.0),
             k1: -0.05,
             k2: 0.01,
+            projection: crate::pose::Projection::Pinhole,
         };
         let mount = Mount {
             pan_zero_azimuth_rad: 0.05,
@@ -297,6 +298,7 @@ mod tests {
             principal_px: (4.0, 4.0),
             k1: 0.0,
             k2: 0.0,
+            projection: crate::pose::Projection::Pinhole,
         };
         let rgb = vec![0f32; 10];
         let f = SkyFrame {

@@ -12,6 +12,7 @@ pub mod igi_photograph;
 pub mod rig;
 pub mod room_igi;
 pub mod scene_file;
+pub mod sun_track;
 pub mod truth;
 pub mod zoom_truth;
 
@@ -102,9 +103,10 @@ pub struct World {
     pub atmosphere: Atmosphere,
     /// Cloud cover: fraction of sunlight blocked and the overcast zenith radiance per channel.
     pub clouds: Option<(f64, [f64; 3])>,
-    /// The station's camera.
+    /// The station's camera, as it truly is (the simulation's `true_camera`
+    /// lens where one is given).
     pub camera: campanile_config::Camera,
-    /// The head's mount.
+    /// The head's mount, as it truly is (the `true_camera`'s where given).
     pub mount: Mount,
     /// The station's lamps.
     pub lamps: Vec<Lamp>,
@@ -115,6 +117,14 @@ pub struct World {
 impl World {
     /// The world of `scene` seen by `station`.
     pub fn new(station: &campanile_config::Station, scene: LoadedScene) -> World {
+        // The camera as it truly is: the simulation's true camera where it
+        // has one (a lens and mount the station's configuration does not know).
+        let truly = station
+            .simulation
+            .as_ref()
+            .and_then(|s| s.true_camera.as_ref())
+            .and_then(|t| t.apply_to(station).ok());
+        let station = truly.as_ref().unwrap_or(station);
         let s = &station.site;
         let lamps = station
             .lights
