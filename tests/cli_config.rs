@@ -36,9 +36,10 @@ fn config_check_passes_on_every_example_and_summarizes_them() {
         "stdout:\n{stdout}\nstderr:\n{}",
         text(&out.stderr)
     );
-    assert_eq!(stdout.matches(": valid ").count(), 13, "{stdout}");
-    // The six plans were checked against the three stations.
-    assert_eq!(stdout.matches("  runs on station").count(), 18, "{stdout}");
+    assert_eq!(stdout.matches(": valid ").count(), 14, "{stdout}");
+    // The six plans were checked against the four stations.
+    assert_eq!(stdout.matches("  runs on station").count(), 24, "{stdout}");
+    assert!(stdout.contains("equidistant fisheye, 512×512 px"), "{stdout}");
     assert!(stdout.contains("37.8721°N, 122.2578°W"), "{stdout}");
     assert!(stdout.contains("session \"held-out\" (held out)"), "{stdout}");
 }

@@ -92,6 +92,18 @@ fn a_day_of_sun_shots_gives_the_calibrated_camera_the_station_takes() {
         "{cal:?}"
     );
     assert!((cal.intrinsics.distortion.0 - 0.02).abs() < 2e-4, "{cal:?}");
+    let check = campanile(&["config", "check", out.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&check.stdout);
+    assert_eq!(
+        check.status.code(),
+        Some(0),
+        "{text}{}",
+        String::from_utf8_lossy(&check.stderr)
+    );
+    assert!(
+        text.contains("valid camera calibration") && text.contains("Equidistant"),
+        "{text}"
+    );
     let calibrated = cal.apply_to(&station()).unwrap();
     assert_eq!(calibrated.head.mount, cal.mount);
     let quality = std::fs::read_to_string(dir.path().join("camera.quality.json")).unwrap();

@@ -40,6 +40,8 @@ pub enum Document {
     Plan(Box<LoadedPlan>),
     /// A scene description.
     Scene(Box<Loaded<Scene>>),
+    /// A calibrated camera (`campanile sky calibrate`'s file).
+    CameraCalibration(Box<Loaded<crate::camera_calibration::CameraCalibration>>),
 }
 
 fn load_valid<T>(source: SourceFile) -> Result<Loaded<T>, ConfigErrors>
@@ -159,10 +161,13 @@ fn load_source(source: SourceFile) -> Result<Document, ConfigErrors> {
         Some((name, _)) if name == "Station" => Ok(Document::Station(Box::new(load_valid(source)?))),
         Some((name, _)) if name == "Plan" => Ok(Document::Plan(Box::new(load_plan_source(source)?))),
         Some((name, _)) if name == "Scene" => Ok(Document::Scene(Box::new(load_valid(source)?))),
+        Some((name, _)) if name == "CameraCalibration" => {
+            Ok(Document::CameraCalibration(Box::new(load_valid(source)?)))
+        }
         found => Err(kind_error(
             &source,
             found,
-            "a named top-level value: `Station(...)`, `Plan(...)` or `Scene(...)`",
+            "a named top-level value: `Station(...)`, `Plan(...)`, `Scene(...)` or `CameraCalibration(...)`",
         )
         .into()),
     }

@@ -17,6 +17,7 @@ impl Document {
             Document::Station(s) => station_summary(&s.value),
             Document::Plan(p) => plan_summary(p),
             Document::Scene(s) => scene_summary(s),
+            Document::CameraCalibration(c) => calibration_summary(&c.value),
         }
     }
 
@@ -26,8 +27,29 @@ impl Document {
             Document::Station(_) => "station",
             Document::Plan(_) => "plan",
             Document::Scene(_) => "scene",
+            Document::CameraCalibration(_) => "camera calibration",
         }
     }
+}
+
+fn calibration_summary(c: &crate::camera_calibration::CameraCalibration) -> String {
+    let (i, m) = (&c.intrinsics, &c.mount);
+    let focal = i.focal.pixels_for(i.projection, c.resolution.width);
+    let pp = i
+        .principal_point_px
+        .map_or("the image centre".to_owned(), |(x, y)| format!("({x:.2}, {y:.2}) px"));
+    format!(
+        "camera calibration for {}×{} px\n  lens       {:?}, focal {focal:.3} px, principal point {pp}, k1 {:.6}, k2 {:.6}\n  mount      pan 0 faces azimuth {:.4}°, tilt zero {:.4}°, roll {:.4}°, pitch {:.4}°\n",
+        c.resolution.width,
+        c.resolution.height,
+        i.projection,
+        i.distortion.0,
+        i.distortion.1,
+        m.pan_zero_azimuth_deg,
+        m.tilt_zero_deg,
+        m.level_roll_deg,
+        m.level_pitch_deg
+    )
 }
 
 fn station_summary(s: &Station) -> String {

@@ -14,7 +14,10 @@ use chrono::{DateTime, Utc};
 
 #[test]
 fn the_ephemeris_to_pixel_chain_matches_pvlib_and_an_independent_projection() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../validation/sky_camera/fixtures/sun_track.csv");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../validation/sky_camera/fixtures/sun_track.csv"
+    );
     let text = std::fs::read_to_string(path).unwrap();
     // The site and true camera the generator used (its SITE, CAMERA, MOUNT, HEAD).
     let site = Observer::from_degrees(37.8721, -122.2578, 90.0, 1010.0, 18.0);
