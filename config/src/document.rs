@@ -73,6 +73,12 @@ pub fn load_quality(path: &Path) -> Result<Loaded<crate::quality::Quality>, Conf
     load_valid(expect_kind(SourceFile::read(path)?, "Quality")?)
 }
 
+/// Reads and validates a surveyed-targets file (`Targets(...)`, see
+/// [`crate::targets`]).
+pub fn load_targets(path: &Path) -> Result<Loaded<crate::targets::Targets>, ConfigErrors> {
+    load_valid(expect_kind(SourceFile::read(path)?, "Targets")?)
+}
+
 /// Reads and validates a plan file and the scene it names.
 pub fn load_plan(path: &Path) -> Result<LoadedPlan, ConfigErrors> {
     load_plan_source(expect_kind(SourceFile::read(path)?, "Plan")?)
