@@ -11,7 +11,7 @@ use crate::station::Station;
 use crate::validate::{Validate, Validator};
 
 /// The kinds of configuration file, named by their top-level value.
-pub const KINDS: [&str; 3] = ["Station", "Plan", "Scene"];
+pub const KINDS: [&str; 4] = ["Station", "Plan", "Scene", "Targets"];
 
 /// A value with the file it came from.
 #[derive(Debug, Clone)]
@@ -40,6 +40,8 @@ pub enum Document {
     Plan(Box<LoadedPlan>),
     /// A scene description.
     Scene(Box<Loaded<Scene>>),
+    /// Surveyed coded targets (`campanile register`).
+    Targets(Box<Loaded<crate::targets::Targets>>),
 }
 
 fn load_valid<T>(source: SourceFile) -> Result<Loaded<T>, ConfigErrors>
@@ -157,10 +159,11 @@ fn load_source(source: SourceFile) -> Result<Document, ConfigErrors> {
         Some((name, _)) if name == "Station" => Ok(Document::Station(Box::new(load_valid(source)?))),
         Some((name, _)) if name == "Plan" => Ok(Document::Plan(Box::new(load_plan_source(source)?))),
         Some((name, _)) if name == "Scene" => Ok(Document::Scene(Box::new(load_valid(source)?))),
+        Some((name, _)) if name == "Targets" => Ok(Document::Targets(Box::new(load_valid(source)?))),
         found => Err(kind_error(
             &source,
             found,
-            "a named top-level value: `Station(...)`, `Plan(...)` or `Scene(...)`",
+            "a named top-level value: `Station(...)`, `Plan(...)`, `Scene(...)` or `Targets(...)`",
         )
         .into()),
     }

@@ -17,6 +17,7 @@ impl Document {
             Document::Station(s) => station_summary(&s.value),
             Document::Plan(p) => plan_summary(p),
             Document::Scene(s) => scene_summary(s),
+            Document::Targets(t) => targets_summary(&t.value),
         }
     }
 
@@ -26,6 +27,7 @@ impl Document {
             Document::Station(_) => "station",
             Document::Plan(_) => "plan",
             Document::Scene(_) => "scene",
+            Document::Targets(_) => "targets",
         }
     }
 }
@@ -255,6 +257,14 @@ fn plan_summary(p: &LoadedPlan) -> String {
             let _ = writeln!(o, "    - {}", step_text(step));
         }
     }
+    o
+}
+
+fn targets_summary(t: &crate::targets::Targets) -> String {
+    let mut o = String::new();
+    let _ = writeln!(o, "targets: {} {:?} tags", t.targets.len(), t.family);
+    let ids: Vec<String> = t.targets.iter().map(|t| t.id.to_string()).collect();
+    let _ = writeln!(o, "  ids        {}", ids.join(", "));
     o
 }
 

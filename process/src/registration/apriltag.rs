@@ -61,13 +61,14 @@ impl std::fmt::Debug for TagDetector {
 }
 
 impl TagDetector {
-    /// A detector for `width` × `height` images, at full resolution
-    /// (no decimation: corners are fitted on every pixel).
+    /// A detector for `width` × `height` images, with the crate's defaults:
+    /// quads are segmented at half resolution, then their edges refined
+    /// and the bits decoded at full resolution. (Segmenting at full
+    /// resolution found fewer tags in the simulator's noisy photos: 4 of
+    /// 7 where half resolution found 6.)
     pub fn new(width: usize, height: usize) -> Result<TagDetector, TagError> {
-        let mut config =
+        let config =
             DecodeTagsConfig::new(vec![TagFamilyKind::Tag36H11]).map_err(|e| TagError::Detector(e.to_string()))?;
-        config.downscale_factor = 1;
-        config.min_tag_width = 6;
         let decoder =
             AprilTagDecoder::new(config, ImageSize { width, height }).map_err(|e| TagError::Detector(e.to_string()))?;
         Ok(TagDetector { decoder, width, height })

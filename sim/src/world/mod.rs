@@ -12,6 +12,7 @@ pub mod igi_photograph;
 pub mod rig;
 pub mod room_igi;
 pub mod scene_file;
+pub mod target_photos;
 pub mod truth;
 pub mod zoom_truth;
 
