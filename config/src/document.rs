@@ -11,7 +11,7 @@ use crate::station::Station;
 use crate::validate::{Validate, Validator};
 
 /// The kinds of configuration file, named by their top-level value.
-pub const KINDS: [&str; 3] = ["Station", "Plan", "Scene"];
+pub const KINDS: [&str; 4] = ["Station", "Plan", "Scene", "Targets"];
 
 /// A value with the file it came from.
 #[derive(Debug, Clone)]
@@ -42,6 +42,8 @@ pub enum Document {
     Scene(Box<Loaded<Scene>>),
     /// A calibrated camera (`campanile sky calibrate`'s file).
     CameraCalibration(Box<Loaded<crate::camera_calibration::CameraCalibration>>),
+    /// Surveyed coded targets (`campanile register`).
+    Targets(Box<Loaded<crate::targets::Targets>>),
 }
 
 fn load_valid<T>(source: SourceFile) -> Result<Loaded<T>, ConfigErrors>
@@ -81,6 +83,12 @@ pub fn load_scene(path: &Path) -> Result<Loaded<Scene>, ConfigErrors> {
 /// subset of the fields of [`crate::quality::Quality`]).
 pub fn load_quality(path: &Path) -> Result<Loaded<crate::quality::Quality>, ConfigErrors> {
     load_valid(expect_kind(SourceFile::read(path)?, "Quality")?)
+}
+
+/// Reads and validates a surveyed-targets file (`Targets(...)`, see
+/// [`crate::targets`]).
+pub fn load_targets(path: &Path) -> Result<Loaded<crate::targets::Targets>, ConfigErrors> {
+    load_valid(expect_kind(SourceFile::read(path)?, "Targets")?)
 }
 
 /// Reads and validates a plan file and the scene it names.
@@ -164,10 +172,11 @@ fn load_source(source: SourceFile) -> Result<Document, ConfigErrors> {
         Some((name, _)) if name == "CameraCalibration" => {
             Ok(Document::CameraCalibration(Box::new(load_valid(source)?)))
         }
+        Some((name, _)) if name == "Targets" => Ok(Document::Targets(Box::new(load_valid(source)?))),
         found => Err(kind_error(
             &source,
             found,
-            "a named top-level value: `Station(...)`, `Plan(...)`, `Scene(...)` or `CameraCalibration(...)`",
+            "a named top-level value: `Station(...)`, `Plan(...)`, `Scene(...)`, `CameraCalibration(...)` or `Targets(...)`",
         )
         .into()),
     }

@@ -30,6 +30,7 @@ pub mod source;
 pub mod span_tree;
 pub mod station;
 pub mod summary;
+pub mod targets;
 pub mod validate;
 
 #[cfg(test)]
@@ -40,7 +41,7 @@ mod roundtrip;
 pub use camera::Camera;
 pub use document::{
     Document, Loaded, LoadedPlan, check_plan_on_station, load, load_plan, load_quality, load_scene, load_station,
-    load_text,
+    load_targets, load_text,
 };
 pub use error::{ConfigError, ConfigErrors};
 pub use filter_wheel::FilterWheel;

@@ -18,6 +18,7 @@ impl Document {
             Document::Plan(p) => plan_summary(p),
             Document::Scene(s) => scene_summary(s),
             Document::CameraCalibration(c) => calibration_summary(&c.value),
+            Document::Targets(t) => targets_summary(&t.value),
         }
     }
 
@@ -28,6 +29,7 @@ impl Document {
             Document::Plan(_) => "plan",
             Document::Scene(_) => "scene",
             Document::CameraCalibration(_) => "camera calibration",
+            Document::Targets(_) => "targets",
         }
     }
 }
@@ -288,6 +290,14 @@ fn plan_summary(p: &LoadedPlan) -> String {
             let _ = writeln!(o, "    - {}", step_text(step));
         }
     }
+    o
+}
+
+fn targets_summary(t: &crate::targets::Targets) -> String {
+    let mut o = String::new();
+    let _ = writeln!(o, "targets: {} {:?} tags", t.targets.len(), t.family);
+    let ids: Vec<String> = t.targets.iter().map(|t| t.id.to_string()).collect();
+    let _ = writeln!(o, "  ids        {}", ids.join(", "));
     o
 }
 

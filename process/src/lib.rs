@@ -25,6 +25,7 @@ pub mod pipeline;
 pub mod pose;
 pub mod quality;
 pub mod radiance_file;
+pub mod registration;
 pub mod render;
 pub mod report;
 pub mod rgbe_file;

@@ -60,6 +60,7 @@ pub mod photo_import;
 pub mod plan_check;
 pub mod process;
 pub mod progress;
+pub mod register_files;
 pub mod report_summary;
 pub mod run;
 pub mod scan_processor;

@@ -12,7 +12,7 @@ pub enum ConfigCommand {
     /// Validate station, plan, scene and camera calibration files, and print what they describe.
     ///
     /// The kind of each file is told by its top-level value: `Station(...)`,
-    /// `Plan(...)`, `Scene(...)` or `CameraCalibration(...)`. A plan's scene (its `scene` field) is
+    /// `Plan(...)`, `Scene(...)` `CameraCalibration(...)` or `Targets(...)`. A plan's scene (its `scene` field) is
     /// read and checked with it. Every plan is also checked against every
     /// station given in the same command: filter slots, lights and poses it
     /// names must exist there, exposures must be within the camera's limits,

@@ -14,6 +14,7 @@ mod logging;
 mod outdoor;
 mod plan;
 mod process;
+mod register;
 mod render;
 mod ron_output;
 mod session;
@@ -101,6 +102,7 @@ pub enum Command {
     Process(process::ProcessArgs),
     Devices(devices::DevicesArgs),
     Render(render::RenderArgs),
+    Register(register::RegisterArgs),
     /// Plans: simulate one forward without devices (timeline, frames, durations, what it will not cover).
     Plan {
         #[command(subcommand)]
@@ -151,6 +153,7 @@ pub fn run() -> ExitCode {
         Command::Process(args) => report(process::run(args)),
         Command::Devices(args) => finish(devices::run(args)),
         Command::Render(args) => report(render::run(args)),
+        Command::Register(args) => finish(register::run(args)),
         Command::Igi(args) => report(igi::run(args)),
         Command::Outdoor { action } => report(outdoor::run(action)),
     };

@@ -48,6 +48,28 @@ pub enum Texture {
         /// Seed of the cells.
         seed: u64,
     },
+    /// A printed square pattern, such as a coded target (an AprilTag):
+    /// `width` × `width` cells of side `cell_m`, row-major from the
+    /// pattern's top-left, `true` for `white`, `false` for `black`; white
+    /// beyond the pattern (the target's plate). The pattern's axes need not
+    /// be the face's: `axes` gives the pattern's right and up directions
+    /// in (s, t), so a tag can hang at any angle on a face.
+    Pattern {
+        /// The pattern's centre, texture coordinates (metres).
+        centre_st: [f64; 2],
+        /// The pattern's right and up unit directions in (s, t).
+        axes: [[f64; 2]; 2],
+        /// Cell side, metres.
+        cell_m: f64,
+        /// Cells per side.
+        width: usize,
+        /// The cells, `width²`, row-major from the top-left, `true` white.
+        cells: Vec<bool>,
+        /// Albedo of black cells.
+        black: [f64; 3],
+        /// Albedo of white cells and of the plate around the pattern.
+        white: [f64; 3],
+    },
 }
 
 /// A uniform number in [−1, 1] for integer cell `(i, j)` and `seed`
@@ -113,6 +135,28 @@ impl Texture {
                 let (i, j) = ((st[0] / cell_m).floor() as i64, (st[1] / cell_m).floor() as i64);
                 scale(*mean, 1.0 + amplitude * cell_noise(i, j, *seed))
             }
+            Texture::Pattern {
+                centre_st,
+                axes,
+                cell_m,
+                width,
+                cells,
+                black,
+                white,
+            } => {
+                let (ds, dt) = (st[0] - centre_st[0], st[1] - centre_st[1]);
+                let right = ds * axes[0][0] + dt * axes[0][1];
+                let up = ds * axes[1][0] + dt * axes[1][1];
+                let half = *width as f64 / 2.0;
+                let (a, b) = (right / cell_m + half, half - up / cell_m);
+                if a < 0.0 || b < 0.0 || a >= *width as f64 || b >= *width as f64 {
+                    return *white;
+                }
+                match cells.get(b as usize * width + a as usize) {
+                    Some(false) => *black,
+                    _ => *white,
+                }
+            }
         }
     }
 
@@ -134,6 +178,13 @@ impl Texture {
             }
             Texture::Stripes { colours, .. } => [0, 1, 2].map(|c| 0.5 * (colours[0][c] + colours[1][c])),
             Texture::Noise { mean, .. } => *mean,
+            // Over the pattern itself; the plate around it is white.
+            Texture::Pattern {
+                cells, black, white, ..
+            } => {
+                let f = cells.iter().filter(|c| **c).count() as f64 / cells.len().max(1) as f64;
+                [0, 1, 2].map(|c| f * white[c] + (1.0 - f) * black[c])
+            }
         }
     }
 }
@@ -180,6 +231,28 @@ mod tests {
                 mean[c]
             );
         }
+    }
+
+    #[test]
+    fn a_pattern_turned_a_quarter_turn_reads_its_cells_in_place() {
+        // 2 × 2 cells: only the top-left is white.
+        let t = Texture::Pattern {
+            centre_st: [10.0, 5.0],
+            axes: [[0.0, 1.0], [-1.0, 0.0]],
+            cell_m: 0.5,
+            width: 2,
+            cells: vec![true, false, false, false],
+            black: [0.05; 3],
+            white: [0.9; 3],
+        };
+        // The pattern's right is +t and its up is −s: its top-left cell
+        // lies towards −s (up) and −t (left).
+        assert_eq!(t.albedo([9.75, 4.75]), [0.9; 3]);
+        assert_eq!(t.albedo([10.25, 4.75]), [0.05; 3]);
+        assert_eq!(t.albedo([9.75, 5.25]), [0.05; 3]);
+        // Beyond the pattern: the white plate.
+        assert_eq!(t.albedo([12.0, 5.0]), [0.9; 3]);
+        assert_eq!(t.mean_albedo(), [0.25 * 0.9 + 0.75 * 0.05; 3]);
     }
 
     #[test]

@@ -13,6 +13,7 @@ pub mod rig;
 pub mod room_igi;
 pub mod scene_file;
 pub mod sun_track;
+pub mod target_photos;
 pub mod truth;
 pub mod zoom_truth;
 
