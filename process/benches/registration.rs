@@ -27,6 +27,7 @@ fn lens() -> Pinhole {
         principal_px: (1024.0, 768.0),
         k1: -0.05,
         k2: 0.01,
+        projection: campanile_config::camera::Projection::Pinhole,
     }
 }
 

@@ -49,6 +49,7 @@ fn poses_agree_with_opencv_solvepnp_on_the_same_correspondences() {
             principal_px: (case.principal_px[0], case.principal_px[1]),
             k1: case.k1,
             k2: case.k2,
+            projection: campanile_config::camera::Projection::Pinhole,
         };
         let points: Vec<Correspondence> = case
             .points

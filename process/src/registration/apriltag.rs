@@ -283,6 +283,7 @@ mod tests {
             principal_px: (320.0, 240.0),
             k1: -0.05,
             k2: 0.01,
+            projection: campanile_config::camera::Projection::Pinhole,
         };
         // Facing north at a wall 4 m away, turned 20° and rolled 8°.
         let (a, r) = (20f64.to_radians(), 8f64.to_radians());

@@ -198,6 +198,7 @@ mod tests {
             principal_px: (640.0, 480.0),
             k1: -0.08,
             k2: 0.02,
+            projection: campanile_config::camera::Projection::Pinhole,
         }
     }
 

@@ -187,6 +187,7 @@ mod tests {
             principal_px: (640.0, 480.0),
             k1: -0.06,
             k2: 0.01,
+            projection: campanile_config::camera::Projection::Pinhole,
         }
     }
 
