@@ -200,12 +200,6 @@ fn render(
     }
 }
 
-fn hit_point(ray: &Ray, scene: &Scene) -> [f64; 3] {
-    let h = scene.intersect(ray, f64::INFINITY).expect("hit");
-    let p = ray.origin + ray.direction * h.t;
-    [p.x, p.y, p.z]
-}
-
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if args.len() < 3 {
@@ -385,15 +379,12 @@ fn main() {
                     continue;
                 }
                 if std::env::var("TWIN_SURFACE").is_ok_and(|v| v == input.surfaces[s]) {
+                    let point = ray.origin + ray.direction * hit.t;
                     let q: f64 = (0..3).map(|c| f64::from(view.image.data[i * 3 + c])).sum::<f64>()
                         / (0..3).map(|c| f64::from(ours.data[i * 3 + c])).sum::<f64>();
                     println!(
                         "{} {x} {y} {:.4} {:.3} {:.3} {:.3}",
-                        view.name,
-                        q,
-                        hit_point(&ray, &scene)[0],
-                        hit_point(&ray, &scene)[1],
-                        hit_point(&ray, &scene)[2]
+                        view.name, q, point.x, point.y, point.z
                     );
                 }
                 for c in 0..3 {
