@@ -22,6 +22,11 @@ fn the_quick_demo_runs_end_to_end_and_its_figures_match_the_simulator() {
 
     // The report: every section, every figure inline.
     let html = std::fs::read_to_string(demo.join("report.html")).unwrap();
+    // CI opens this report in headless Chromium (.ci/check-report) rather
+    // than run the quick demo a second time: it asks for a copy here.
+    if let Some(keep) = std::env::var_os("CAMPANILE_KEEP_DEMO_REPORT") {
+        std::fs::write(&keep, &html).unwrap();
+    }
     for title in [
         "Pseudo-albedos",
         "Held-out time",

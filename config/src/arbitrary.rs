@@ -30,3 +30,8 @@ pub fn small_vec<T: Arbitrary>() -> impl Strategy<Value = Vec<T>> {
 pub fn albedo() -> impl Strategy<Value = Option<(f64, f64, f64)>> {
     proptest::option::of((0.0..=1.0f64, 0.0..=1.0f64, 0.0..=1.0f64))
 }
+
+/// A head's place, metres, in the range a scene file uses.
+pub fn position() -> impl Strategy<Value = Option<(f64, f64, f64)>> {
+    proptest::option::of((-1e3..=1e3f64, -1e3..=1e3f64, -1e2..=1e2f64))
+}

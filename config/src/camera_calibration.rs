@@ -1,6 +1,8 @@
-//! A fixed camera's calibration as `campanile sky calibrate` writes it:
-//! the lens intrinsics and the mount calibration (its orientation) that a
-//! station file takes, for the resolution they were fitted at.
+//! A camera's calibration as `campanile sky calibrate` (from the sun) and
+//! `campanile station calibrate-mount` (from registered photographs of
+//! targets) write it: the lens intrinsics and the mount calibration (its
+//! orientation) that a station file takes, for the resolution they were
+//! fitted at, and where the head stood when that is measured too.
 //!
 //! ```ron
 //! CameraCalibration(
@@ -31,6 +33,14 @@ pub struct CameraCalibration {
     pub intrinsics: Intrinsics,
     /// The calibrated orientation, as the head's mount calibration.
     pub mount: MountCalibration,
+    /// Where the head stood, world frame (x east, y north, z up), metres,
+    /// when it was measured (from registered photographs): a tripod set up
+    /// away from the scene's poses. Views processed through this
+    /// calibration are taken from here rather than from their poses'
+    /// positions.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(test, proptest(strategy = "crate::arbitrary::position()"))]
+    pub head_position_m: Option<(f64, f64, f64)>,
 }
 
 impl CameraCalibration {
@@ -74,5 +84,13 @@ impl Validate for CameraCalibration {
         };
         camera.validate(v);
         v.at("mount", |v| self.mount.validate(v));
+        if let Some((x, y, z)) = self.head_position_m {
+            v.at("head_position_m", |v| {
+                let what = "a position in metres within 10 000 km of the scene's origin";
+                for (axis, value) in [("0", x), ("1", y), ("2", z)] {
+                    v.range(axis, value, -1e7, 1e7, what);
+                }
+            });
+        }
     }
 }

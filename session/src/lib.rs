@@ -54,6 +54,7 @@ pub mod env_files;
 pub mod error;
 pub mod hdr_files;
 pub mod igi;
+pub mod mount_files;
 pub mod outdoor_files;
 pub mod partial_file;
 pub mod photo_import;

@@ -43,8 +43,10 @@ pub struct ProcessOptions {
     pub grid_spacing_m: f64,
     /// Sky-only sessions: the response curve (CSV).
     pub response: Option<PathBuf>,
-    /// Sky-only sessions: a calibrated camera (`campanile sky calibrate`'s
-    /// file) used instead of the station's camera intrinsics and mount.
+    /// A calibrated camera (`campanile sky calibrate`'s or `campanile
+    /// station calibrate-mount`'s file) used instead of the station's
+    /// camera intrinsics and mount, and, when it measured the head's place,
+    /// instead of the scene poses' positions.
     pub camera_calibration: Option<PathBuf>,
     /// Sky-only sessions: process only this share of the scans.
     pub shard: Option<Shard>,
@@ -81,14 +83,9 @@ pub fn kind(opts: &ProcessOptions) -> Result<SessionKind> {
         let q = crate::verdicts::thresholds(opts.thresholds.as_deref(), Some(&inputs.plan))?;
         return Ok(SessionKind::SkyOnly(Box::new(q)));
     }
-    if opts.response.is_some()
-        || opts.shard.is_some()
-        || opts.merge_shards.is_some()
-        || opts.occurrence.is_some()
-        || opts.camera_calibration.is_some()
-    {
+    if opts.response.is_some() || opts.shard.is_some() || opts.merge_shards.is_some() || opts.occurrence.is_some() {
         return Err(Error::input(format!(
-            "{}: --response, --shard, --merge-shards, --occurrence and --camera-calibration are for sky-only sessions (sun shots, sky scans and brackets at head angles); this session's plan has views of a scene",
+            "{}: --response, --shard, --merge-shards and --occurrence are for sky-only sessions (sun shots, sky scans and brackets at head angles); this session's plan has views of a scene",
             opts.session.display()
         )));
     }
@@ -119,6 +116,7 @@ pub fn outdoor(opts: &ProcessOptions) -> Result<OutdoorRun> {
         &opts.debevec,
         Some(opts.env),
         opts.thresholds.as_deref(),
+        opts.camera_calibration.as_deref(),
     )?;
     write_outputs(&processed, out)?;
     let settings = ReflectanceSettings {
@@ -186,6 +184,7 @@ pub fn room(opts: &ProcessOptions) -> Result<RoomRun> {
         &opts.debevec,
         None,
         opts.thresholds.as_deref(),
+        opts.camera_calibration.as_deref(),
     )?;
     write_outputs(&processed, out)?;
     let products = room::room_stage(&processed, out, &opts.room)?;

@@ -135,6 +135,9 @@ pub fn calibrate_files(
             level_roll_deg: m.mount.roll_rad.to_degrees(),
             level_pitch_deg: m.mount.pitch_rad.to_degrees(),
         },
+        // The sun fixes the orientation only; the head stays where the
+        // station file puts it.
+        head_position_m: None,
     };
     let quality = QualityReport::new(vec![product_quality(&fit, options)], &Quality::default());
     Ok(SkyCalibration {

@@ -86,9 +86,11 @@ pub struct ProcessArgs {
     /// else the session's own calibration bracket.
     #[arg(long, value_name = "FILE.csv")]
     response: Option<PathBuf>,
-    /// Sky-only sessions: a calibrated camera (CameraCalibration RON from
-    /// `campanile sky calibrate`) whose intrinsics and mount replace the
-    /// station's: a mis-set sky camera's frames are sampled through it.
+    /// A calibrated camera (CameraCalibration RON from `campanile sky
+    /// calibrate` or `campanile station calibrate-mount`) whose intrinsics
+    /// and mount replace the station's: a mis-set sky camera's frames are
+    /// sampled through it, and a scene's views are taken from the head's
+    /// measured place when the file gives one (a moved tripod).
     #[arg(long, value_name = "FILE.ron")]
     camera_calibration: Option<PathBuf>,
     /// Sky-only sessions: process only share K of N of the scans, chosen by

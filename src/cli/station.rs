@@ -1,4 +1,5 @@
-//! `campanile station run|status`: the unattended station, and its heartbeat.
+//! `campanile station run|status|calibrate-mount`: the unattended station,
+//! its heartbeat, and its head's mount calibrated from targets.
 
 use std::path::PathBuf;
 use std::time::Duration;
@@ -19,6 +20,54 @@ pub enum StationCommand {
     // The variants take their help from their arguments' doc comments.
     Run(RunArgs),
     Status(StatusArgs),
+    CalibrateMount(CalibrateMountArgs),
+}
+
+/// Calibrate the head's mount and find the tripod from registered photographs.
+///
+/// Photographs taken from the head at several pans (and tilts), each
+/// registered from surveyed targets by `campanile register`, give the
+/// camera's world orientation and place. This fits the mount calibration
+/// that the station file's `head.mount` holds (the azimuth at pan 0, the
+/// tilt reading at the horizon, the base's roll and pitch) to all of them
+/// at once, each view weighted by its registration's stated uncertainty,
+/// and places the head at the registered centres' weighted mean: after a
+/// tripod was set up anywhere, `campanile process --camera-calibration
+/// OUT` takes the views from where the head really stood.
+///
+/// READINGS is a CSV with the columns photo (the photograph's file stem,
+/// as the poses file names it), pan_deg and tilt_deg (the head's reading
+/// when it was taken). Photographs whose registration failed are skipped
+/// and named.
+///
+/// OUT gets a `CameraCalibration(...)` (the station's camera intrinsics,
+/// the fitted mount, `head_position_m`); the verdict (ok, poor or failed:
+/// an angle σ over 0.025°, a view more than 0.1° from the mount's
+/// prediction, registered centres spread over 2 cm: a moved tripod or a
+/// camera off the head's axes; failed at four times those, or when the
+/// views do not fix the four angles, e.g. all at one pan) goes to OUT's
+/// stem + .quality.json; a failed calibration exits 3.
+///
+/// Example:
+///   campanile register head/*.png --targets targets.ron \
+///       --station examples/sim-station.ron --out poses.ron
+///   campanile station calibrate-mount poses.ron --readings head.csv \
+///       --station examples/sim-station.ron --out camera.ron
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub struct CalibrateMountArgs {
+    /// `campanile register`'s poses file.
+    #[arg(value_name = "POSES.ron")]
+    poses: PathBuf,
+    /// The head's reading at each photograph (CSV: photo, pan_deg, tilt_deg).
+    #[arg(long, value_name = "READINGS.csv")]
+    readings: PathBuf,
+    /// The station file whose camera and head took the photographs.
+    #[arg(long, value_name = "STATION.ron")]
+    station: PathBuf,
+    /// Where to write the calibration.
+    #[arg(long, value_name = "CAMERA.ron")]
+    out: PathBuf,
 }
 
 /// Run a plan unattended, day after day, until its days end or it is stopped.
@@ -197,6 +246,19 @@ pub fn run(command: StationCommand) -> Result<u8> {
             run_station(&run, &inputs, response, out, &mut std::io::stderr())?
         }
         StationCommand::Status(args) => station_status::status(&args.store, args.max_age, out)?,
+        StationCommand::CalibrateMount(args) => {
+            let cal = campanile_session::mount_files::calibrate_mount_files(
+                &args.poses,
+                &args.readings,
+                &args.station,
+                &campanile_process::registration::mount::MountLimits::default(),
+            )?;
+            eprint!("{}", cal.report);
+            let text = campanile_session::sky_camera_files::calibration_ron(&cal.file)?;
+            campanile_session::partial_file::write(&args.out, text.as_bytes())?;
+            super::verdicts::finish(&cal.quality, &super::verdicts::beside(&args.out))?;
+            true
+        }
     };
     Ok(if ok { EXIT_OK } else { EXIT_FAILURE })
 }

@@ -41,6 +41,23 @@ impl CameraPose {
         }
     }
 
+    /// The pose with its optical axis at `azimuth_deg` (from north through
+    /// east) and `elevation_deg`, turned `roll_deg` about it (as
+    /// [`CameraPose::roll_deg`] measures), centred at `centre`: the inverse
+    /// of those three angles, as a poses file writes them. At the zenith
+    /// or nadir the azimuth still says which way the image's right points.
+    pub fn from_angles(azimuth_deg: f64, elevation_deg: f64, roll_deg: f64, centre: Vector3<f64>) -> Self {
+        let (sa, ca) = azimuth_deg.to_radians().sin_cos();
+        let (se, ce) = elevation_deg.to_radians().sin_cos();
+        let (sr, cr) = roll_deg.to_radians().sin_cos();
+        let forward = Vector3::new(ce * sa, ce * ca, se);
+        let level_right = Vector3::new(ca, -sa, 0.0);
+        let level_down = forward.cross(&level_right);
+        let right = level_right * cr + level_down * sr;
+        let down = forward.cross(&right);
+        CameraPose::from_axes(right, down, forward, centre)
+    }
+
     /// Azimuth of the optical axis, degrees from north through east, in [0, 360).
     pub fn azimuth_deg(&self) -> f64 {
         let f = self.forward();
@@ -109,5 +126,24 @@ mod tests {
         assert!((pose.azimuth_deg() - 90.0).abs() < 1e-9);
         assert!((pose.elevation_deg() - 30.0).abs() < 1e-9);
         assert!((pose.roll_deg() - 10.0).abs() < 1e-9);
+        let back = CameraPose::from_angles(90.0, 30.0, 10.0, Vector3::zeros());
+        assert!(pose.angle_to_deg(&back) < 1e-9, "{}", pose.angle_to_deg(&back));
+    }
+
+    /// Angles written to a poses file and read back give the same pose,
+    /// rolled or not, looking down or up.
+    #[test]
+    fn angles_round_trip() {
+        for &(az, el, roll) in &[
+            (0.0, 0.0, 0.0),
+            (217.3, -12.0, 4.5),
+            (33.0, 71.0, -20.0),
+            (300.0, 5.0, 170.0),
+        ] {
+            let p = CameraPose::from_angles(az, el, roll, Vector3::new(1.0, 2.0, 3.0));
+            assert!((p.azimuth_deg() - az).abs() < 1e-9, "{az}: {}", p.azimuth_deg());
+            assert!((p.elevation_deg() - el).abs() < 1e-9);
+            assert!((p.roll_deg() - roll).abs() < 1e-9, "{roll}: {}", p.roll_deg());
+        }
     }
 }

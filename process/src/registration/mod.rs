@@ -18,6 +18,8 @@
 //!   photograph, through the pure-Rust `kornia-apriltag` crate, and the
 //!   tags' bit patterns for the simulator to paint.
 //! - [`solve`]: the whole chain, correspondences to a judged pose.
+//! - [`mount`]: the head's mount calibration from photographs registered
+//!   at known head readings.
 //!
 //! Camera frame as in [`crate::pose`]: x right, y down, z forward; world
 //! frame x east, y north, z up, metres.
@@ -26,6 +28,7 @@ pub mod apriltag;
 pub mod camera_pose;
 pub mod consensus;
 pub mod correspondence;
+pub mod mount;
 pub mod p3p;
 pub mod refine;
 pub mod solve;

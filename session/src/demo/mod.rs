@@ -126,6 +126,7 @@ pub fn run(args: &DemoOptions, host: &dyn DemoHost) -> Result<DemoRun> {
         &campanile_process::hdr::debevec::DebevecOptions::default(),
         Some((18, 36)),
         None,
+        None,
     )?;
     let products = args.out.join("campanile-processed");
     process::write_outputs(&processed, &products)?;

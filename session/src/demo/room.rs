@@ -92,6 +92,7 @@ pub fn room(dir: &Path, quick: bool, host: &dyn super::DemoHost) -> Result<RoomR
         &campanile_process::hdr::debevec::DebevecOptions::default(),
         None,
         None,
+        None,
     )?;
     let processed_dir = out.join("processed");
     process::write_outputs(&processed, &processed_dir)?;

@@ -166,17 +166,23 @@ pub fn outdoor_quality(p: &Processed, o: &Outdoor) -> ProductQuality {
 }
 
 /// Stages 1 and 2 on the session in `dir` (stage 2, the sun, sky and
-/// environment, only with `env` = its map's rows and columns).
+/// environment, only with `env` = its map's rows and columns), through the
+/// calibration file `camera_calibration` when given (see
+/// [`SessionInputs::calibrated`]).
 pub fn process_session(
     dir: &Path,
     scene: Option<&Path>,
     debevec: &DebevecOptions,
     env: Option<(usize, usize)>,
     thresholds_file: Option<&Path>,
+    camera_calibration: Option<&Path>,
 ) -> Result<Processed> {
     let mut stages = Vec::new();
     let t = Instant::now();
-    let inputs = SessionInputs::open(dir, scene)?;
+    let mut inputs = SessionInputs::open(dir, scene)?;
+    if let Some(path) = camera_calibration {
+        inputs = inputs.calibrated(path)?;
+    }
     let q = thresholds(thresholds_file, Some(&inputs.plan))?;
     let optics = StationOptics::of_station(&inputs.station);
     let b = bar(0, "reading frames");

@@ -23,6 +23,10 @@ pub struct SessionInputs {
     pub station: Station,
     /// The scene and the directory its geometry path is relative to.
     pub scene: Option<(Scene, PathBuf)>,
+    /// Where the head stood, when a calibration measured it
+    /// ([`SessionInputs::calibrated`]): every frame is taken from here,
+    /// whatever position its scene pose gives.
+    pub head_position: Option<[f64; 3]>,
 }
 
 impl SessionInputs {
@@ -65,7 +69,25 @@ impl SessionInputs {
             plan,
             station,
             scene,
+            head_position: None,
         })
+    }
+
+    /// The inputs with the station's camera intrinsics and head mount
+    /// replaced by the calibration file at `path` (`campanile sky
+    /// calibrate`'s or `campanile station calibrate-mount`'s), and the
+    /// head's place too when the calibration measured it (a tripod set up
+    /// away from the scene's poses). Bad input when the file does not
+    /// load or is for another resolution.
+    pub fn calibrated(mut self, path: &Path) -> crate::error::Result<SessionInputs> {
+        let cal = campanile_config::document::load_camera_calibration(path)
+            .map_err(|e| crate::error::Error::input(e.to_string()))?
+            .value;
+        self.station = cal
+            .apply_to(&self.station)
+            .map_err(|e| crate::error::Error::input(format!("{}: {e}", path.display())))?;
+        self.head_position = cal.head_position_m.map(|(x, y, z)| [x, y, z]);
+        Ok(self)
     }
 
     /// The OBJ geometry of the scene, checked to exist.
@@ -111,7 +133,7 @@ impl SessionInputs {
             if let Some(p) = pos {
                 position = p;
             }
-            described.push((purpose, position));
+            described.push((purpose, self.head_position.unwrap_or(position)));
         }
         let frames: Result<Vec<CapturedFrame>> = entries
             .par_iter()
