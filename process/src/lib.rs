@@ -8,6 +8,7 @@
 //! - [`exr_io`]: OpenEXR output and input of radiance maps.
 //! - [`rgbe_file`]: Radiance RGBE (`.hdr`) output of radiance maps.
 //! - [`radiance_file`]: reading an HDR radiance image (OpenEXR, RGBE, PFM).
+//! - [`texture`]: texture maps from registered photographs (thesis §3.4).
 
 pub mod brdf;
 pub mod camera;
@@ -34,4 +35,5 @@ pub mod sky;
 pub mod sky_camera_calibration;
 pub mod sky_series;
 pub mod sun;
+pub mod texture;
 pub mod visibility;

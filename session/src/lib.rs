@@ -19,6 +19,7 @@
 //! - [`outdoor_files`]: outdoor reflectance on plain files (recover, render);
 //! - [`env_files`]: environment regions on plain files (fit, predict);
 //! - [`sun_files`]: solar positions for an instant or a table;
+//! - [`texture_files`]: texture maps from registered photographs on plain files;
 //! - [`hdr_files`]: the camera response, HDR merges and lens models on
 //!   plain files;
 //! - [`site`]: the sun given as angles or from the ephemeris at a site;
@@ -73,6 +74,7 @@ pub mod sky_series;
 pub mod station_run;
 pub mod station_status;
 pub mod sun_files;
+pub mod texture_files;
 pub mod verdicts;
 
 pub use error::{Error, Result};

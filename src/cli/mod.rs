@@ -21,6 +21,7 @@ mod session;
 mod sky;
 mod station;
 mod sun;
+mod texture;
 mod verdicts;
 
 use std::process::ExitCode;
@@ -103,6 +104,7 @@ pub enum Command {
     Devices(devices::DevicesArgs),
     Render(render::RenderArgs),
     Register(register::RegisterArgs),
+    Texture(texture::TextureArgs),
     /// Plans: simulate one forward without devices (timeline, frames, durations, what it will not cover).
     Plan {
         #[command(subcommand)]
@@ -154,6 +156,7 @@ pub fn run() -> ExitCode {
         Command::Devices(args) => finish(devices::run(args)),
         Command::Render(args) => report(render::run(args)),
         Command::Register(args) => finish(register::run(args)),
+        Command::Texture(args) => finish(texture::run(args)),
         Command::Igi(args) => report(igi::run(args)),
         Command::Outdoor { action } => report(outdoor::run(action)),
     };

@@ -14,6 +14,7 @@ pub mod room_igi;
 pub mod scene_file;
 pub mod sun_track;
 pub mod target_photos;
+pub mod texture_truth;
 pub mod truth;
 pub mod zoom_truth;
 

@@ -1,0 +1,215 @@
+//! How visible the patch borders are, and the verdict on a texture.
+//!
+//! Without the truth, a seam shows where the photographs disagree: a
+//! misregistered photograph paints the neighbouring surface (or the sky)
+//! along a face's edge, and an occluder's silhouette does the same. So the
+//! figure is the photographs' weighted relative spread
+//! ([`super::synthesis::PatchTexture::spread`]) at the texels along each
+//! face's border (on the face, with an 8-neighbour off it) against the same
+//! spread inside the faces; a ratio near 1 means the borders are as
+//! consistent as the interiors.
+//!
+//! The verdict (DESIGN.md, "Verdicts"): `failed` when less than
+//! [`QualityLimits::min_coverage_poor`] of the texels on the faces were seen
+//! (or no photograph contributed), `poor` below
+//! [`QualityLimits::min_coverage_ok`] or with a border spread over
+//! [`QualityLimits::max_seam_ratio`] times the interior's, else `ok`.
+
+use serde::{Deserialize, Serialize};
+
+use super::patch::Patch;
+use super::synthesis::{PatchTexture, SynthesisReport, TexelStatus};
+
+/// The seam figures.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct SeamFigures {
+    /// RMS relative spread of the photographs at border texels seen by two or more.
+    pub border_spread: f64,
+    /// The same inside the faces.
+    pub interior_spread: f64,
+    /// Border texels counted.
+    pub border_texels: usize,
+    /// Interior texels counted.
+    pub interior_texels: usize,
+}
+
+impl SeamFigures {
+    /// `border_spread / interior_spread` (1 when either is missing or the interior is exact).
+    pub fn ratio(&self) -> f64 {
+        if self.border_texels == 0 || self.interior_texels == 0 || self.interior_spread <= 0.0 {
+            1.0
+        } else {
+            self.border_spread / self.interior_spread
+        }
+    }
+}
+
+/// Whether texel `(i, j)` of `patch` is on its face's border.
+pub fn on_border(patch: &Patch, i: usize, j: usize) -> bool {
+    for dj in -1i64..=1 {
+        for di in -1i64..=1 {
+            let (ii, jj) = (i as i64 + di, j as i64 + dj);
+            if ii < 0 || jj < 0 || ii >= patch.cols as i64 || jj >= patch.rows as i64 {
+                return true;
+            }
+            if patch.texel_triangle[jj as usize * patch.cols + ii as usize].is_none() {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// The seam figures of `textures` on `patches`.
+pub fn seam_figures(patches: &[Patch], textures: &[PatchTexture]) -> SeamFigures {
+    let (mut b, mut nb, mut i_sum, mut ni) = (0.0, 0usize, 0.0, 0usize);
+    for (patch, tex) in patches.iter().zip(textures) {
+        for j in 0..patch.rows {
+            for i in 0..patch.cols {
+                let k = j * patch.cols + i;
+                if tex.status[k] != TexelStatus::Seen || tex.photos[k] < 2 {
+                    continue;
+                }
+                let s = f64::from(tex.spread[k]);
+                if on_border(patch, i, j) {
+                    b += s * s;
+                    nb += 1;
+                } else {
+                    i_sum += s * s;
+                    ni += 1;
+                }
+            }
+        }
+    }
+    let rms = |sum: f64, n: usize| if n == 0 { 0.0 } else { (sum / n as f64).sqrt() };
+    SeamFigures {
+        border_spread: rms(b, nb),
+        interior_spread: rms(i_sum, ni),
+        border_texels: nb,
+        interior_texels: ni,
+    }
+}
+
+/// The thresholds of the verdict.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct QualityLimits {
+    /// Seen fraction of the texels on the faces for `ok`.
+    pub min_coverage_ok: f64,
+    /// Below this seen fraction the texture `failed`.
+    pub min_coverage_poor: f64,
+    /// Largest border-to-interior spread ratio for `ok`.
+    pub max_seam_ratio: f64,
+}
+
+impl Default for QualityLimits {
+    fn default() -> Self {
+        QualityLimits {
+            min_coverage_ok: 0.95,
+            min_coverage_poor: 0.5,
+            max_seam_ratio: 2.0,
+        }
+    }
+}
+
+/// The verdict with its figures and reasons.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Quality {
+    /// `ok`, `poor` or `failed`.
+    pub verdict: String,
+    /// Seen fraction of the texels on the faces.
+    pub coverage: f64,
+    /// Texels on the faces.
+    pub texels_on_faces: usize,
+    /// Of those, unseen (filled from neighbours).
+    pub unseen: usize,
+    /// The seam figures.
+    pub seams: SeamFigures,
+    /// Why the verdict is not `ok`.
+    pub reasons: Vec<String>,
+    /// The limits applied.
+    pub limits: QualityLimits,
+}
+
+/// The verdict on a synthesis.
+pub fn judge(report: &SynthesisReport, seams: &SeamFigures, limits: &QualityLimits) -> Quality {
+    let coverage = report.coverage();
+    let mut reasons = Vec::new();
+    let mut verdict = "ok";
+    if report.used.iter().all(|&u| u == 0) {
+        reasons.push("no photograph sees any texel of the surfaces".to_string());
+        verdict = "failed";
+    } else if coverage < limits.min_coverage_poor {
+        reasons.push(format!(
+            "coverage {:.1}% below {:.0}%",
+            100.0 * coverage,
+            100.0 * limits.min_coverage_poor
+        ));
+        verdict = "failed";
+    } else if coverage < limits.min_coverage_ok {
+        reasons.push(format!(
+            "coverage {:.1}% below {:.0}%: {} texels seen by no photograph were filled from their neighbours",
+            100.0 * coverage,
+            100.0 * limits.min_coverage_ok,
+            report.unseen
+        ));
+        verdict = "poor";
+    }
+    if seams.ratio() > limits.max_seam_ratio {
+        reasons.push(format!(
+            "the photographs disagree {:.1}× more along face borders than inside (limit {:.1}×): check the poses",
+            seams.ratio(),
+            limits.max_seam_ratio
+        ));
+        if verdict == "ok" {
+            verdict = "poor";
+        }
+    }
+    Quality {
+        verdict: verdict.to_string(),
+        coverage,
+        texels_on_faces: report.texels_on_faces,
+        unseen: report.unseen,
+        seams: *seams,
+        reasons,
+        limits: *limits,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn report(on: usize, unseen: usize, used: usize) -> SynthesisReport {
+        SynthesisReport {
+            texels_on_faces: on,
+            unseen,
+            per_patch: vec![(on, unseen)],
+            used: vec![used],
+            occluded: vec![0],
+            grazing: vec![0],
+        }
+    }
+
+    #[test]
+    fn the_verdict_follows_coverage_and_seams() {
+        let l = QualityLimits::default();
+        let quiet = SeamFigures {
+            border_spread: 0.02,
+            interior_spread: 0.02,
+            border_texels: 10,
+            interior_texels: 10,
+        };
+        assert_eq!(judge(&report(100, 2, 98), &quiet, &l).verdict, "ok");
+        let q = judge(&report(100, 20, 80), &quiet, &l);
+        assert_eq!(q.verdict, "poor");
+        assert!(q.reasons[0].contains("80.0%"), "{:?}", q.reasons);
+        assert_eq!(judge(&report(100, 60, 40), &quiet, &l).verdict, "failed");
+        assert_eq!(judge(&report(100, 100, 0), &quiet, &l).verdict, "failed");
+        let loud = SeamFigures {
+            border_spread: 0.1,
+            ..quiet
+        };
+        assert!((loud.ratio() - 5.0).abs() < 1e-12);
+        assert_eq!(judge(&report(100, 0, 100), &loud, &l).verdict, "poor");
+    }
+}
