@@ -98,17 +98,9 @@ pub fn pose_from_angles(
     elevation_deg: f64,
     roll_deg: f64,
 ) -> Option<CameraPose> {
-    let (az, el, roll) = (
-        azimuth_deg.to_radians(),
-        elevation_deg.to_radians(),
-        roll_deg.to_radians(),
-    );
-    let forward = Vector3::new(az.sin() * el.cos(), az.cos() * el.cos(), el.sin());
-    let level_right = forward.cross(&Vector3::z()).try_normalize(1e-9)?;
-    let level_down = forward.cross(&level_right);
-    let right = level_right * roll.cos() + level_down * roll.sin();
-    let down = forward.cross(&right);
-    Some(CameraPose::from_axes(right, down, forward, position))
+    // Straight up or down the level right vector (the axis × up) vanishes.
+    (elevation_deg.to_radians().cos() > 1e-9)
+        .then(|| CameraPose::from_angles(azimuth_deg, elevation_deg, roll_deg, position))
 }
 
 #[cfg(test)]
