@@ -179,6 +179,8 @@ fn jpeg_dng_and_fits_sessions_are_processed_like_the_png_session() {
         run(&[
             "-q",
             "capture",
+            "--sim-bounces",
+            "1",
             plan.to_str().unwrap(),
             "--station",
             station.to_str().unwrap(),

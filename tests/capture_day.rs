@@ -39,6 +39,8 @@ fn a_simulated_day_stores_every_promised_frame() {
     let out = campanile(&[
         "-q",
         "capture",
+        "--sim-bounces",
+        "1",
         "examples/campanile-day.ron",
         "--station",
         "examples/sim-station.ron",

@@ -80,6 +80,8 @@ fn a_full_disk_stops_cleanly_and_resume_alone_completes_the_session() {
     let out = campanile(&[
         "-q",
         "capture",
+        "--sim-bounces",
+        "1",
         &plan,
         "--station",
         &station,
@@ -96,6 +98,8 @@ fn a_full_disk_stops_cleanly_and_resume_alone_completes_the_session() {
     let out = campanile(&[
         "-q",
         "capture",
+        "--sim-bounces",
+        "1",
         &plan,
         "--station",
         &station,
@@ -126,6 +130,8 @@ fn a_full_disk_stops_cleanly_and_resume_alone_completes_the_session() {
     .unwrap();
     let out = campanile(&[
         "capture",
+        "--sim-bounces",
+        "1",
         &plan,
         "--station",
         other.to_str().unwrap(),
@@ -137,7 +143,7 @@ fn a_full_disk_stops_cleanly_and_resume_alone_completes_the_session() {
     assert!(stderr.contains("began with another plan or station"), "{stderr}");
 
     // Space freed: `--resume DIR` alone completes the session.
-    let out = campanile(&["-q", "capture", "--resume", dir.to_str().unwrap()]);
+    let out = campanile(&["-q", "capture", "--sim-bounces", "1", "--resume", dir.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(stderr.contains("with its own plan.ron and station.ron"), "{stderr}");
@@ -170,6 +176,8 @@ fn fault_flags_are_checked() {
     ] {
         let out = campanile(&[
             "capture",
+            "--sim-bounces",
+            "1",
             "examples/campanile-day.ron",
             "--station",
             "examples/sim-station.ron",
@@ -185,6 +193,8 @@ fn fault_flags_are_checked() {
     // Fault flags on a real station are a usage error.
     let out = campanile(&[
         "capture",
+        "--sim-bounces",
+        "1",
         "examples/campanile-day.ron",
         "--station",
         "examples/real-station.ron",
@@ -210,6 +220,8 @@ fn camera_timeouts_and_a_head_outage_from_the_command_line() {
     let out = campanile(&[
         "-q",
         "capture",
+        "--sim-bounces",
+        "1",
         &plan,
         "--station",
         &station,
@@ -250,6 +262,8 @@ fn a_real_station_without_its_camera_driver_is_refused_clearly() {
     let dir = tmp.path().join("real");
     let out = campanile(&[
         "capture",
+        "--sim-bounces",
+        "1",
         "examples/campanile-day.ron",
         "--station",
         "examples/real-station.ron",
@@ -275,6 +289,8 @@ fn link_faults_at_five_percent_start_and_the_session_completes() {
     let out = campanile(&[
         "-q",
         "capture",
+        "--sim-bounces",
+        "1",
         &plan,
         "--station",
         &station,
@@ -308,6 +324,8 @@ fn a_start_that_fails_leaves_no_session_behind() {
         let out = campanile(&[
             "-q",
             "capture",
+            "--sim-bounces",
+            "1",
             &plan,
             "--station",
             &station,
@@ -339,6 +357,8 @@ fn a_quota_too_small_to_start_leaves_nothing_and_a_new_capture_starts() {
     let out = campanile(&[
         "-q",
         "capture",
+        "--sim-bounces",
+        "1",
         &plan,
         "--station",
         &station,
@@ -351,7 +371,17 @@ fn a_quota_too_small_to_start_leaves_nothing_and_a_new_capture_starts() {
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("quota of 100 bytes reached"), "{stderr}");
     assert!(!dir.exists(), "{:?}", std::fs::read_dir(&dir).map(|d| d.count()));
-    let out = campanile(&["-q", "capture", &plan, "--station", &station, "--out", d]);
+    let out = campanile(&[
+        "-q",
+        "capture",
+        "--sim-bounces",
+        "1",
+        &plan,
+        "--station",
+        &station,
+        "--out",
+        d,
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert_eq!(frames(&dir).len(), 8);
 }
@@ -368,6 +398,8 @@ fn resume_repairs_are_printed_under_quiet_and_logged_in_words() {
     let out = campanile(&[
         "-q",
         "capture",
+        "--sim-bounces",
+        "1",
         &plan,
         "--station",
         &station,
@@ -386,7 +418,16 @@ fn resume_repairs_are_printed_under_quiet_and_logged_in_words() {
         j.write_all(b"{\"status\":\"do").unwrap();
     };
     tear();
-    let out = campanile(&["-q", "capture", "--resume", d, "--sim-disk-quota", "20000"]);
+    let out = campanile(&[
+        "-q",
+        "capture",
+        "--sim-bounces",
+        "1",
+        "--resume",
+        d,
+        "--sim-disk-quota",
+        "20000",
+    ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
         stderr.contains("repaired: cut a torn journal line of 13 bytes"),
@@ -394,7 +435,15 @@ fn resume_repairs_are_printed_under_quiet_and_logged_in_words() {
     );
     assert!(!stderr.contains("see the log"), "{stderr}");
     tear();
-    let out = campanile(&["capture", "--resume", d, "--sim-disk-quota", "20000"]);
+    let out = campanile(&[
+        "capture",
+        "--sim-bounces",
+        "1",
+        "--resume",
+        d,
+        "--sim-disk-quota",
+        "20000",
+    ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("resumed"), "{stderr}");
     assert!(
@@ -414,7 +463,17 @@ fn resumes_that_miss_the_same_shots_add_no_missed_lines() {
     let dir = tmp.path().join("missed");
     let d = dir.to_str().unwrap();
     let faults = ["--sim-camera-error-chance", "0.6"];
-    let mut args = vec!["-q", "capture", &plan, "--station", &station, "--out", d];
+    let mut args = vec![
+        "-q",
+        "capture",
+        "--sim-bounces",
+        "1",
+        &plan,
+        "--station",
+        &station,
+        "--out",
+        d,
+    ];
     args.extend(faults);
     let first = campanile(&args);
     assert_eq!(
@@ -425,7 +484,7 @@ fn resumes_that_miss_the_same_shots_add_no_missed_lines() {
     );
     let mut summaries = Vec::new();
     for _ in 0..2 {
-        let mut args = vec!["-q", "capture", "--resume", d];
+        let mut args = vec!["-q", "capture", "--sim-bounces", "1", "--resume", d];
         args.extend(faults);
         let out = campanile(&args);
         let stdout = String::from_utf8_lossy(&out.stdout).into_owned();

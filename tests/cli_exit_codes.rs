@@ -341,6 +341,8 @@ fn every_command_exits_2_on_bad_input_1_on_failure_and_0_on_success() {
         case(
             &[
                 "capture",
+                "--sim-bounces",
+                "1",
                 &missing,
                 "--station",
                 "examples/sim-station.ron",

@@ -68,6 +68,8 @@ fn an_indi_bracket_is_captured_and_processed() {
     let session = tmp.path().join("session");
     let out = campanile(&[
         "capture",
+        "--sim-bounces",
+        "1",
         plan_file.to_str().unwrap(),
         "--station",
         station_file.to_str().unwrap(),

@@ -131,6 +131,8 @@ fn a_sky_day_is_processed_incrementally_sharded_and_matches_the_simulator() {
     run(&[
         "-q",
         "capture",
+        "--sim-bounces",
+        "1",
         plan_path.to_str().unwrap(),
         "--station",
         station_path.to_str().unwrap(),

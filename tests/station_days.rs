@@ -557,6 +557,8 @@ fn sigterm_stops_the_cli_at_a_frame_boundary_and_the_same_command_continues() {
         "-q",
         "station",
         "run",
+        "--sim-bounces",
+        "1",
         plan.to_str().unwrap(),
         "--station",
         "examples/sky-sim-station.ron",

@@ -104,6 +104,8 @@ fn station_run_processes_each_scan_and_the_budget_deletes_only_processed_frames(
     let base = [
         "station",
         "run",
+        "--sim-bounces",
+        "1",
         plan.to_str().unwrap(),
         "--station",
         station_path.to_str().unwrap(),

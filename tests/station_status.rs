@@ -49,6 +49,8 @@ fn a_killed_station_is_reported_not_running_and_a_live_one_running() {
             "-q",
             "station",
             "run",
+            "--sim-bounces",
+            "1",
             plan.to_str().unwrap(),
             "--station",
             "examples/sky-sim-station.ron",

@@ -48,6 +48,8 @@ fn plans_and_auto_brackets_snap_to_the_third_stop_table() {
     let out = campanile(&[
         "-q",
         "capture",
+        "--sim-bounces",
+        "1",
         plan_file.to_str().unwrap(),
         "--station",
         station.to_str().unwrap(),
