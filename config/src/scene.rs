@@ -73,6 +73,17 @@ pub struct CameraPose {
     pub azimuth_deg: f64,
     /// Elevation of the optical axis above the horizon, degrees, in [-90, 90].
     pub elevation_deg: f64,
+    /// Roll about the optical axis, degrees in [-180, 180], positive when
+    /// the image turns clockwise as seen by the photographer: a hand-held
+    /// photograph's (`campanile register` writes it). Zero (the default)
+    /// for the head, whose views are level up to its mount calibration.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    #[cfg_attr(test, proptest(value = "0.0"))]
+    pub roll_deg: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// A scene.
@@ -95,6 +106,12 @@ pub struct Scene {
     #[serde(default)]
     #[cfg_attr(test, proptest(strategy = "crate::arbitrary::small_vec()"))]
     pub poses: Vec<CameraPose>,
+    /// The surveyed targets hung in the scene: a `Targets(...)` file,
+    /// relative to this file. The simulator paints them on their plates;
+    /// `campanile register` and `station calibrate-mount` find them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(test, proptest(value = "None"))]
+    pub targets: Option<PathBuf>,
 }
 
 impl Scene {
@@ -140,6 +157,9 @@ impl Validate for Scene {
             v.existing_file("geometry", &self.geometry, "a Wavefront OBJ file");
             None
         };
+        if let Some(t) = &self.targets {
+            v.existing_file("targets", t, "a Targets(...) file of surveyed targets");
+        }
         v.unique_names("materials", self.materials.iter().map(|m| m.name.as_str()));
         v.at("materials", |v| {
             for (i, m) in self.materials.iter().enumerate() {
@@ -204,6 +224,13 @@ impl Validate for Scene {
                     });
                     v.range_open_high("azimuth_deg", p.azimuth_deg, 0.0, 360.0, "an azimuth in degrees");
                     v.range("elevation_deg", p.elevation_deg, -90.0, 90.0, "an elevation in degrees");
+                    v.range(
+                        "roll_deg",
+                        p.roll_deg,
+                        -180.0,
+                        180.0,
+                        "a roll about the optical axis in degrees",
+                    );
                 });
             }
         });

@@ -56,6 +56,7 @@ pub mod error;
 pub mod hdr_files;
 pub mod igi;
 pub mod mount_files;
+pub mod mount_session;
 pub mod outdoor_files;
 pub mod partial_file;
 pub mod photo_import;

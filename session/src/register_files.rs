@@ -127,6 +127,7 @@ pub fn register_photos(request: &RegisterRequest) -> Result<RegisteredPoses> {
                 position_m: (pose.centre.x, pose.centre.y, pose.centre.z),
                 azimuth_deg: pose.azimuth_deg(),
                 elevation_deg: pose.elevation_deg(),
+                roll_deg: pose.roll_deg(),
             });
         }
         out.photos.push(PhotoRegistration {

@@ -7,6 +7,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use campanile_config::Station;
+use campanile_config::scene::CameraPose as ScenePose;
 use campanile_process::camera::image::RadianceImage;
 use campanile_process::exr_io::{read_radiance_exr, read_rgb_exr};
 use campanile_process::hdr::curve::ResponseCurve;
@@ -17,7 +19,7 @@ use campanile_process::outdoor::zoom_albedo::ZoomReport;
 use campanile_process::outdoor::{
     Illumination, Photo, RerenderSettings, ZoomSettings, rerender, rerender_zoom, zoom_albedo,
 };
-use campanile_process::pose::HeadPose;
+use campanile_process::pose::{HeadPose, Mount};
 use campanile_process::render::CameraRig;
 use campanile_process::sky::{Atmosphere, Daylight};
 use campanile_process::sun::{Observer, sun_position};
@@ -138,6 +140,43 @@ fn albedo_image(rho: &[[f64; 3]], rig: &CameraRig) -> RadianceImage {
     }
 }
 
+/// The camera of scene pose `pose` at `width` × `height`: through the
+/// station's head and mount for a level pose, or, for a pose with a roll
+/// (a hand-held photograph's, as `campanile register` writes it), held
+/// exactly at the pose's three angles ([`Mount::holding`]).
+pub fn pose_rig(station: &Station, pose: &ScenePose, width: usize, height: usize) -> Result<CameraRig> {
+    let (x, y, z) = pose.position_m;
+    let (held_by, head) = if pose.roll_deg == 0.0 {
+        let (pan, tilt) = station
+            .head
+            .reach(pose.azimuth_deg, pose.elevation_deg)
+            .with_context(|| format!("the head cannot reach pose {:?}", pose.name))?;
+        let head = HeadPose {
+            pan_rad: pan.to_radians(),
+            tilt_rad: tilt.to_radians(),
+        };
+        (mount(&station.head.mount), head)
+    } else {
+        let held = campanile_process::registration::CameraPose::from_angles(
+            pose.azimuth_deg,
+            pose.elevation_deg,
+            pose.roll_deg,
+            Vector3::zeros(),
+        );
+        let m = held.rotation.matrix();
+        let axis = |i: usize| [m[(i, 0)], m[(i, 1)], m[(i, 2)]];
+        Mount::holding(axis(0), axis(1), axis(2))
+    };
+    Ok(CameraRig {
+        pinhole: pinhole_at(&station.camera, width, height),
+        mount: held_by,
+        head,
+        position: Vector3::new(x, y, z),
+        width,
+        height,
+    })
+}
+
 /// Renders what `opts` ask for into `opts.out`, calling `on` after each
 /// file (the frames of a sequence in time order).
 pub fn render(opts: &SceneRenderOptions, on: &mut dyn FnMut(Rendered<'_>) -> Result<()>) -> Result<()> {
@@ -157,22 +196,7 @@ pub fn render(opts: &SceneRenderOptions, on: &mut dyn FnMut(Rendered<'_>) -> Res
             opts.scene.display()
         )
     })?;
-    let (pan, tilt) = station
-        .head
-        .reach(pose.azimuth_deg, pose.elevation_deg)
-        .with_context(|| format!("the head cannot reach pose {:?}", pose.name))?;
-    let (x, y, z) = pose.position_m;
-    let rig = CameraRig {
-        pinhole: pinhole_at(&station.camera, opts.width, opts.height),
-        mount: mount(&station.head.mount),
-        head: HeadPose {
-            pan_rad: pan.to_radians(),
-            tilt_rad: tilt.to_radians(),
-        },
-        position: Vector3::new(x, y, z),
-        width: opts.width,
-        height: opts.height,
-    };
+    let rig = pose_rig(&station, pose, opts.width, opts.height)?;
     let site = &station.site;
     let observer = Observer::from_degrees(
         site.latitude_deg,
@@ -272,4 +296,46 @@ pub fn render(opts: &SceneRenderOptions, on: &mut dyn FnMut(Rendered<'_>) -> Res
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A hand-held pose with a roll is rendered exactly where registration
+    /// put it: every point projects through the rig to the pixel
+    /// `CameraPose::from_angles` projects it to, within 1e-6 px; a level
+    /// pose still goes through the station's head.
+    #[test]
+    fn a_rolled_pose_renders_from_the_registered_orientation() {
+        let station = campanile_config::load_station(&campanile_sim::world::examples_dir().join("sim-station.ron"))
+            .expect("station")
+            .value;
+        let pose = ScenePose {
+            name: "hand".into(),
+            position_m: (3.0, -20.0, 1.6),
+            azimuth_deg: 12.0,
+            elevation_deg: 18.0,
+            roll_deg: -23.5,
+        };
+        let rig = pose_rig(&station, &pose, 320, 240).expect("a rig");
+        let truth =
+            campanile_process::registration::CameraPose::from_angles(12.0, 18.0, -23.5, Vector3::new(3.0, -20.0, 1.6));
+        let mut compared = 0;
+        for p in [[0.0, 0.0, 5.0], [4.0, 2.0, 9.0], [-3.0, -5.0, 2.0], [6.0, 1.0, 1.0]] {
+            let p = Vector3::from(p);
+            if let (Some(a), Some(b)) = (rig.project(&p), truth.project(&rig.pinhole, &p)) {
+                assert!(
+                    (a.0 - b.0).abs() < 1e-6 && (a.1 - b.1).abs() < 1e-6,
+                    "{a:?} against {b:?}"
+                );
+                compared += 1;
+            }
+        }
+        assert!(compared >= 3, "{compared} points in view");
+        // Level: the head's reading through the station's mount.
+        let level = ScenePose { roll_deg: 0.0, ..pose };
+        let rig = pose_rig(&station, &level, 320, 240).expect("a rig");
+        assert_eq!(rig.mount, mount(&station.head.mount));
+    }
 }

@@ -74,7 +74,7 @@ impl<S: FrameSource> Rig for SimStation<S> {
     }
 
     fn place(&mut self, position_m: Option<[f64; 3]>) {
-        let at = position_m.unwrap_or_else(|| self.home_position());
+        let at = self.position_for(position_m);
         self.camera.set_position(at);
     }
 

@@ -97,6 +97,10 @@ pub struct SimStation<S> {
     clock: SimClock,
     retry: RetryPolicy,
     home_m: [f64; 3],
+    /// Where the head truly stands whatever the plan's poses say (the
+    /// simulation's `true_camera.head_position_m`: a tripod set up away from
+    /// the scene's poses, which the station does not know).
+    true_position_m: Option<[f64; 3]>,
 }
 
 impl<S: FrameSource> SimStation<S> {
@@ -159,6 +163,13 @@ impl<S: FrameSource> SimStation<S> {
                 disconnect(&truth, o.device, o.duration);
             });
         }
+        let true_position_m = station
+            .simulation
+            .as_ref()
+            .and_then(|s| s.true_camera.as_ref())
+            .and_then(|c| c.head_position_m)
+            .map(|(x, y, z)| [x, y, z]);
+        let home_m = true_position_m.unwrap_or(options.position_m);
         let filters = station
             .filter_wheel
             .as_ref()
@@ -170,7 +181,7 @@ impl<S: FrameSource> SimStation<S> {
             filters,
             truth.clone(),
             clock,
-            options.position_m,
+            home_m,
             seed,
             options.camera,
         );
@@ -182,7 +193,8 @@ impl<S: FrameSource> SimStation<S> {
             truth,
             clock,
             retry,
-            home_m: options.position_m,
+            home_m,
+            true_position_m,
         })
     }
 
@@ -192,9 +204,17 @@ impl<S: FrameSource> SimStation<S> {
     }
 
     /// Where the station stands when not at a named pose
-    /// ([`SimOptions::position_m`]).
+    /// ([`SimOptions::position_m`], or the true camera's head position).
     pub fn home_position(&self) -> [f64; 3] {
         self.home_m
+    }
+
+    /// Where the camera stands for a view aimed from `pose_position_m`: the
+    /// pose's place, unless the simulation puts the tripod somewhere the
+    /// station does not know (`true_camera.head_position_m`), which then
+    /// holds for every frame.
+    pub fn position_for(&self, pose_position_m: Option<[f64; 3]>) -> [f64; 3] {
+        self.true_position_m.or(pose_position_m).unwrap_or(self.home_m)
     }
 
     /// The devices' ground truth (shareable).

@@ -48,23 +48,43 @@ pub enum StationCommand {
 /// views do not fix the four angles, e.g. all at one pan) goes to OUT's
 /// stem + .quality.json; a failed calibration exits 3.
 ///
-/// Example:
+/// With --session instead, the photographs come from a captured session
+/// whose plan took them as a calibration step: brackets aimed at head
+/// angles (`Bracket(aim: PanTilt(pan_deg: -55.0, tilt_deg: 8.0), ...)`, at
+/// three or more pans, facing the surveyed targets). Each bracket's
+/// best-exposed frame is registered from --targets, with the head's reading
+/// as the journal recorded it reached; the photographs, head.csv, the
+/// session's station.ron and poses.ron are left in OUT's stem + -photos/.
+///
+/// Examples:
 ///   campanile register head/*.png --targets targets.ron \
 ///       --station examples/sim-station.ron --out poses.ron
 ///   campanile station calibrate-mount poses.ron --readings head.csv \
 ///       --station examples/sim-station.ron --out camera.ron
+///   campanile station calibrate-mount --session mount-session \
+///       --targets examples/campanile-targets.ron --out camera.ron
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct CalibrateMountArgs {
     /// `campanile register`'s poses file.
-    #[arg(value_name = "POSES.ron")]
-    poses: PathBuf,
+    #[arg(value_name = "POSES.ron", required_unless_present = "session", requires_all = ["readings", "station"])]
+    poses: Option<PathBuf>,
     /// The head's reading at each photograph (CSV: photo, pan_deg, tilt_deg).
-    #[arg(long, value_name = "READINGS.csv")]
-    readings: PathBuf,
+    #[arg(long, value_name = "READINGS.csv", requires = "poses")]
+    readings: Option<PathBuf>,
     /// The station file whose camera and head took the photographs.
-    #[arg(long, value_name = "STATION.ron")]
-    station: PathBuf,
+    #[arg(long, value_name = "STATION.ron", requires = "poses")]
+    station: Option<PathBuf>,
+    /// A captured session whose plan took the photographs as brackets aimed
+    /// at head angles (`Bracket(aim: PanTilt(...))`): each bracket's
+    /// best-exposed frame is registered from --targets, with the head's
+    /// reached reading and the session's station. The photographs, their
+    /// readings and poses are left in OUT's stem + `-photos/`.
+    #[arg(long, value_name = "SESSION", conflicts_with_all = ["poses", "readings", "station"], requires = "targets")]
+    session: Option<PathBuf>,
+    /// With --session: the surveyed targets file (`campanile register --targets`).
+    #[arg(long, value_name = "TARGETS.ron", requires = "session")]
+    targets: Option<PathBuf>,
     /// Where to write the calibration.
     #[arg(long, value_name = "CAMERA.ron")]
     out: PathBuf,
@@ -140,8 +160,10 @@ pub struct RunArgs {
     /// Simulation: render samples per pixel.
     #[arg(long, value_name = "N", default_value_t = 2)]
     sim_samples: u32,
-    /// Simulation: render bounces.
-    #[arg(long, value_name = "N", default_value_t = 1)]
+    /// Simulation: render bounces (three keep the light the ground and the
+    /// walls reflect, which processing's models include; see `campanile
+    /// capture --help`).
+    #[arg(long, value_name = "N", default_value_t = 3)]
     sim_bounces: u32,
     /// Simulation: DEVICE (head, wheel or lights) disconnects at START (UTC,
     /// RFC 3339, e.g. 2026-06-22T18:03:00Z) for DURATION seconds, e.g.
@@ -247,12 +269,45 @@ pub fn run(command: StationCommand) -> Result<u8> {
         }
         StationCommand::Status(args) => station_status::status(&args.store, args.max_age, out)?,
         StationCommand::CalibrateMount(args) => {
-            let cal = campanile_session::mount_files::calibrate_mount_files(
-                &args.poses,
-                &args.readings,
-                &args.station,
-                &campanile_process::registration::mount::MountLimits::default(),
-            )?;
+            let limits = campanile_process::registration::mount::MountLimits::default();
+            let cal = match (&args.session, &args.targets, &args.poses, &args.readings, &args.station) {
+                (Some(session), Some(targets), ..) => {
+                    let stem = args.out.file_stem().map(|s| s.to_string_lossy().into_owned());
+                    let dir = args
+                        .out
+                        .with_file_name(format!("{}-photos", stem.as_deref().unwrap_or("camera")));
+                    let bar = campanile_session::progress::bar(0, "reading the session's calibration frames");
+                    let photos = campanile_session::mount_session::session_photos(session, &dir, &bar)?;
+                    bar.finish_and_clear();
+                    let poses = dir.join("poses.ron");
+                    let written = campanile_session::register_files::register_photos(
+                        &campanile_session::register_files::RegisterRequest {
+                            photos: photos.photos,
+                            targets: targets.clone(),
+                            station: photos.station.clone(),
+                            out: poses.clone(),
+                            settings: Default::default(),
+                        },
+                    )?;
+                    for p in &written.photos {
+                        eprintln!("{}: {}", p.file.display(), p.quality.verdict);
+                    }
+                    campanile_session::mount_files::calibrate_mount_files(
+                        &poses,
+                        &photos.readings,
+                        &photos.station,
+                        &limits,
+                    )?
+                }
+                (None, None, Some(poses), Some(readings), Some(station)) => {
+                    campanile_session::mount_files::calibrate_mount_files(poses, readings, station, &limits)?
+                }
+                _ => {
+                    return Err(super::exit::bad_input(
+                        "calibrate-mount takes POSES.ron --readings --station, or --session --targets",
+                    ));
+                }
+            };
             eprint!("{}", cal.report);
             let text = campanile_session::sky_camera_files::calibration_ron(&cal.file)?;
             campanile_session::partial_file::write(&args.out, text.as_bytes())?;

@@ -405,6 +405,7 @@ pub fn plan_import(opts: &ImportOptions, progress: &dyn Fn(usize, usize)) -> Res
                     position_m: pose.position_m.map_or((0.0, 0.0, 0.0), |p| (p[0], p[1], p[2])),
                     azimuth_deg: pose.azimuth_deg.rem_euclid(360.0),
                     elevation_deg: pose.elevation_deg,
+                    roll_deg: 0.0,
                 });
                 name
             }

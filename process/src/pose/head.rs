@@ -108,6 +108,43 @@ impl Mount {
         }
     }
 
+    /// A mount and head reading whose camera has world-frame axes `right`,
+    /// `down` and `forward` (orthonormal, right-handed as a camera's are):
+    /// how a hand-held photograph, turned any way about its optical axis,
+    /// goes through the head's kinematics. The base's roll and pitch carry
+    /// what pan and tilt cannot (an X–Y–X Euler decomposition of the
+    /// orientation, with the pan at zero).
+    pub fn holding(right: [f64; 3], down: [f64; 3], forward: [f64; 3]) -> (Mount, HeadPose) {
+        // Level camera axes at pan 0, tilt 0 (columns of M0): right = x,
+        // down = −z, forward = y; the orientation C = Rx(a) Ry(b) Rx(c) M0.
+        let c_cols = [right, down, forward];
+        let m0 = [[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]];
+        // Q = C M0ᵀ: Q[i][j] = Σ_k C[i][k] M0[j][k], C[i][k] = c_cols[k][i].
+        let q = |i: usize, j: usize| (0..3).map(|k| c_cols[k][i] * m0[j][k]).sum::<f64>();
+        let b = q(0, 0).clamp(-1.0, 1.0).acos();
+        let (a, c) = if b.sin().abs() > 1e-9 {
+            (q(1, 0).atan2(-q(2, 0)), q(0, 1).atan2(q(0, 2)))
+        } else if q(0, 0) > 0.0 {
+            // Ry(0): Q = Rx(a + c).
+            (0.0, q(2, 1).atan2(q(1, 1)))
+        } else {
+            // Ry(π) Rx(c): Q[1][2] = −sin c, Q[1][1] = cos c.
+            (0.0, (-q(1, 2)).atan2(q(1, 1)))
+        };
+        (
+            Mount {
+                pan_zero_azimuth_rad: 0.0,
+                tilt_zero_rad: 0.0,
+                roll_rad: b,
+                pitch_rad: a,
+            },
+            HeadPose {
+                pan_rad: 0.0,
+                tilt_rad: c,
+            },
+        )
+    }
+
     /// The camera-frame direction of a world-frame direction (the inverse
     /// of [`Mount::to_world`]).
     pub fn to_camera(&self, pose: HeadPose, w: [f64; 3]) -> [f64; 3] {
@@ -120,6 +157,57 @@ impl Mount {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A mount holding a camera turned any way (the Euler decomposition's
+    /// regular case, a level camera, one upside down and one looking
+    /// straight up) maps each camera axis onto the world axis it was given,
+    /// within 1e-12.
+    #[test]
+    fn a_held_camera_goes_through_the_mount_exactly() {
+        let unit = |v: [f64; 3]| {
+            let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            v.map(|x| x / n)
+        };
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let mut cases = Vec::new();
+        for (az, el, roll) in [
+            (35.0f64, 12.0f64, 30.0f64),
+            (200.0, -40.0, -75.0),
+            (300.0, 5.0, 0.0),
+            (90.0, 0.0, 180.0),
+            (10.0, 89.999, 20.0),
+        ] {
+            let (sa, ca) = az.to_radians().sin_cos();
+            let (se, ce) = el.to_radians().sin_cos();
+            let (sr, cr) = roll.to_radians().sin_cos();
+            let forward = [ce * sa, ce * ca, se];
+            let level_right = [ca, -sa, 0.0];
+            let level_down = cross(forward, level_right);
+            let right = unit([0, 1, 2].map(|i| level_right[i] * cr + level_down[i] * sr));
+            cases.push((right, cross(forward, right), forward));
+        }
+        // A camera looking straight down with its right axis east.
+        cases.push(([1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]));
+        for (right, down, forward) in cases {
+            let (m, head) = Mount::holding(right, down, forward);
+            for (d, want) in [
+                ([1.0, 0.0, 0.0], right),
+                ([0.0, 1.0, 0.0], down),
+                ([0.0, 0.0, 1.0], forward),
+            ] {
+                let got = m.to_world(head, d);
+                for i in 0..3 {
+                    assert!((got[i] - want[i]).abs() < 1e-12, "{d:?}: {got:?} against {want:?}");
+                }
+            }
+        }
+    }
 
     /// The rotations evaluated once give exactly the per-ray rotation by
     /// angles (so frames rendered through either are identical).

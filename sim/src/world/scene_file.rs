@@ -29,8 +29,21 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, WorldError> {
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
-    let obj = loaded.source.base_dir().join(&loaded.value.geometry);
-    from_description(loaded.value, &obj)
+    let base = loaded.source.base_dir();
+    let obj = base.join(&loaded.value.geometry);
+    let targets = loaded.value.targets.as_ref().map(|t| base.join(t));
+    let scene = from_description(loaded.value, &obj)?;
+    // The surveyed targets, painted on their plates.
+    match targets {
+        Some(t) => {
+            let survey = campanile_config::load_targets(&t).map_err(|e| WorldError::Config {
+                path: t.clone(),
+                message: e.to_string(),
+            })?;
+            super::target_photos::with_targets(&scene, &survey.value.targets)
+        }
+        None => Ok(scene),
+    }
 }
 
 /// Builds the scene of `description` with geometry from `obj`.
