@@ -87,6 +87,12 @@ fn registered_photos_make_a_textured_obj_that_reads_back() {
         stdout.contains("texture: ok") || stdout.contains("texture: poor"),
         "{stdout}"
     );
+    // Each photograph's registration against the other's.
+    assert_eq!(
+        stdout.matches("agrees best with the others moved").count(),
+        2,
+        "{stdout}"
+    );
     let (models, materials) = tobj::load_obj(
         out.join("model.obj"),
         &tobj::LoadOptions {
@@ -297,9 +303,9 @@ fn albedo_products_make_an_albedo_texture_that_meets_the_truth() {
                         (0..3).for_each(|ch| truth[ch] += v[ch] / 64.0);
                     }
                 }
-                for ch in 0..3 {
+                for (ch, want) in truth.iter().enumerate() {
                     let got = f64::from(se.data[px * 3 + ch]);
-                    se2 += (got - truth[ch]).powi(2);
+                    se2 += (got - want).powi(2);
                     n += 1;
                     worst_sun = worst_sun.max((f64::from(sun.data[px * 3 + ch]) - 1.1 * got).abs());
                 }

@@ -69,6 +69,10 @@ pub struct PhotoUse {
     pub occluded: usize,
     /// Texels in its frame seen too obliquely.
     pub grazing: usize,
+    /// The image shift, pixels, at which it agrees best with the other
+    /// photographs (`None`: too few shared texels).
+    #[serde(default)]
+    pub shift_px: Option<[f64; 2]>,
 }
 
 /// One patch as written.
@@ -327,6 +331,7 @@ pub fn texture_files(request: &TextureRequest, bar: &indicatif::ProgressBar) -> 
                 texels: r.used[k],
                 occluded: r.occluded[k],
                 grazing: r.grazing[k],
+                shift_px: r.offsets.get(k).copied().flatten().map(|o| o.shift_px),
             })
             .collect(),
         patches: ps
