@@ -226,8 +226,8 @@ fn a_misregistered_photo_is_found_by_its_shift() {
 /// The independent check's false `poor` (BENCHMARKS.md "Texture maps"):
 /// the whole tower at 0.125 m from the three exact photographs. Without
 /// the mixed-pixel margin (`edge_margin_px: 0`) the border spread is 4.3×
-/// the interior's (measured 0.137 against 0.032 on 256 border texels, all
-/// at the tower's corners); with it no border texel is seen by two
+/// the interior's (measured 0.137 against 0.032 on 256 border texels, the
+/// worst at the tower's corners); with it no border texel is seen by two
 /// photographs through pixels wholly on the face, so the figure has
 /// nothing to flag, and the registration check finds every photograph
 /// within 0.1 px of its place. About 9 s in the dev profile on top of the
