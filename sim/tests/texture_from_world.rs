@@ -230,10 +230,10 @@ fn a_misregistered_photo_is_found_by_its_shift() {
 /// worst at the tower's corners); with it no border texel is seen by two
 /// photographs through pixels wholly on the face, so the figure has
 /// nothing to flag, and the registration check finds every photograph
-/// within 0.1 px of its place. About 9 s in the dev profile on top of the
+/// within 0.1 px of its place. About 4 s in the dev profile on top of the
 /// tests above (CI's budget): run with `--ignored`.
 #[test]
-#[ignore = "9 s; the measurement behind the mixed-pixel margin"]
+#[ignore = "4 s; the measurement behind the mixed-pixel margin"]
 fn whole_tower_exact_poses_show_no_seams() {
     use campanile_process::texture::{judge, seam_figures};
     let world = TextureWorld::campanile().expect("the world");

@@ -445,6 +445,10 @@ pub const OFFSET_STRIDE: usize = 2;
 /// Fewest shared texels for a photograph's offset.
 pub const MIN_OFFSET_TEXELS: usize = 50;
 
+/// Most texels the whole-pixel search compares (an even subset); the
+/// sub-pixel refinement uses every shared texel.
+pub const SEARCH_TEXELS: usize = 2000;
+
 /// One texel's comparison: the others' mean level, the photo's sample
 /// positions, the patch.
 struct Comparison {
@@ -457,9 +461,9 @@ struct Comparison {
 /// shift within ±[`OFFSET_SEARCH_PX`] at which its samples of the texels
 /// it shares with other photographs (every [`OFFSET_STRIDE`]-th texel, off
 /// the faces' borders) best match the others' weighted mean: the shift
-/// minimizing the mean squared relative difference, on whole pixels, then
-/// refined by a parabola through the minimum and its neighbours along each
-/// axis. Exact poses give a shift near 0 whatever the texture; a pose off
+/// minimizing the mean squared relative difference, on whole pixels (over
+/// at most [`SEARCH_TEXELS`] of them), then refined by a parabola through
+/// the minimum and its neighbours along each axis (over all of them). Exact poses give a shift near 0 whatever the texture; a pose off
 /// by an angle moves the whole image, and the check finds the move.
 fn registration_offsets(
     scene: &Scene,
@@ -532,8 +536,12 @@ fn registration_offsets(
             }
             let photo = &photos[k];
             let id_items = &items[k];
-            let cost = |du: f64, dv: f64| -> f64 {
-                let (sum, n) = comps
+            // The whole-pixel search on an even subset, the refinement on all.
+            let step = comps.len().div_ceil(SEARCH_TEXELS).max(1);
+            let subset: Vec<&Comparison> = comps.iter().step_by(step).collect();
+            let all: Vec<&Comparison> = comps.iter().collect();
+            let cost_on = |set: &[&Comparison], du: f64, dv: f64| -> f64 {
+                let (sum, n) = set
                     .par_iter()
                     .filter_map(|c| {
                         let (mut y, mut m) = (0.0, 0usize);
@@ -553,13 +561,15 @@ fn registration_offsets(
             let mut best = (f64::INFINITY, 0i32, 0i32);
             for dv in -r..=r {
                 for du in -r..=r {
-                    let c = cost(f64::from(du), f64::from(dv));
+                    let c = cost_on(&subset, f64::from(du), f64::from(dv));
                     if c < best.0 {
                         best = (c, du, dv);
                     }
                 }
             }
-            let (c0, bu, bv) = best;
+            let (_, bu, bv) = best;
+            let cost = |du: f64, dv: f64| cost_on(&all, du, dv);
+            let c0 = cost(f64::from(bu), f64::from(bv));
             if !c0.is_finite() {
                 return None;
             }
