@@ -69,6 +69,10 @@ pub struct PhotoUse {
     pub occluded: usize,
     /// Texels in its frame seen too obliquely.
     pub grazing: usize,
+    /// The image shift, pixels, at which it agrees best with the other
+    /// photographs (`None`: too few shared texels).
+    #[serde(default)]
+    pub shift_px: Option<[f64; 2]>,
 }
 
 /// One patch as written.
@@ -327,6 +331,7 @@ pub fn texture_files(request: &TextureRequest, bar: &indicatif::ProgressBar) -> 
                 texels: r.used[k],
                 occluded: r.occluded[k],
                 grazing: r.grazing[k],
+                shift_px: r.offsets.get(k).copied().flatten().map(|o| o.shift_px),
             })
             .collect(),
         patches: ps
@@ -353,5 +358,231 @@ pub fn texture_files(request: &TextureRequest, bar: &indicatif::ProgressBar) -> 
         manifest_path,
         exported,
         report: synthesis.report,
+    })
+}
+
+/// What `texture --albedo` was asked.
+#[derive(Debug, Clone)]
+pub struct AlbedoTextureRequest {
+    /// The scene description.
+    pub scene: PathBuf,
+    /// The albedo products: `materials.ron`, or the directory holding it
+    /// (`albedo/`, or the `process` output directory above it).
+    pub albedo: PathBuf,
+    /// The output directory.
+    pub out: PathBuf,
+    /// Texel side, metres (`None`: the products' grid spacing).
+    pub texel_m: Option<f64>,
+    /// The surfaces to texture (`None`: every surface the products cover).
+    pub surfaces: Option<Vec<String>>,
+    /// Verdict thresholds.
+    pub limits: QualityLimits,
+}
+
+/// One surface's cells in the products, by how their pseudo-albedos were
+/// obtained (the materials file's counts; thesis §5.4).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ProductCells {
+    /// The surface.
+    pub surface: String,
+    /// Solved from their own sunlit and shadowed views.
+    pub solved: usize,
+    /// Never seen sunlit (ρ^sun from the face's ratio).
+    pub never_sunlit: usize,
+    /// Never seen shadowed (one unknown through the face's ratio).
+    pub never_shadowed: usize,
+    /// Sunlit and shadowed views too alike to separate.
+    pub ill_conditioned: usize,
+    /// Seen by no photograph (filled in the products; unseen here).
+    pub unseen: usize,
+}
+
+/// `texture.ron` of an albedo texture.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename = "AlbedoTextureMaps")]
+pub struct AlbedoTextureManifest {
+    /// The materials file read.
+    pub materials: PathBuf,
+    /// The products' grid spacing, metres.
+    pub spacing_m: f64,
+    /// Texel side, metres.
+    pub texel_m: f64,
+    /// The OBJ, relative to the manifest.
+    pub obj: String,
+    /// ρ^se pages: (EXR, PNG) file names; the MTL's `map_Kd` is the PNG.
+    pub pages: Vec<(String, String)>,
+    /// ρ^sun pages (EXR), in the same layout.
+    pub sun_pages: Vec<String>,
+    /// The patches.
+    pub patches: Vec<PatchRecord>,
+    /// The products' cells per surface.
+    pub products: Vec<ProductCells>,
+    /// The recovery's findings, from the materials file.
+    pub diagnostics: Vec<String>,
+    /// The verdict and its figures (coverage: texels on cells a photograph saw).
+    pub quality: Quality,
+    /// Wall time of sampling, packing and export, seconds.
+    pub seconds: f64,
+}
+
+/// What `texture --albedo` did.
+#[derive(Debug, Clone)]
+pub struct AlbedoTextureRun {
+    /// The manifest written.
+    pub manifest: AlbedoTextureManifest,
+    /// Where it was written.
+    pub manifest_path: PathBuf,
+    /// The files written (ρ^se).
+    pub exported: Exported,
+    /// The sampling report.
+    pub report: SynthesisReport,
+}
+
+/// The materials file `path` names (module doc of [`AlbedoTextureRequest::albedo`]).
+fn materials_file(path: &Path) -> anyhow::Result<PathBuf> {
+    if path.is_file() {
+        return Ok(path.to_path_buf());
+    }
+    if !path.is_dir() {
+        return Err(bad_input(format!(
+            "--albedo {}: no such file or directory; expected the albedo/ directory `campanile process` or \
+             `campanile outdoor recover` writes (with materials.ron), or that materials.ron",
+            path.display()
+        )));
+    }
+    for candidate in [path.join("materials.ron"), path.join("albedo").join("materials.ron")] {
+        if candidate.is_file() {
+            return Ok(candidate);
+        }
+    }
+    let igi_maps = std::fs::read_dir(path)
+        .map(|d| {
+            d.filter_map(Result::ok)
+                .any(|e| e.path().extension().is_some_and(|x| x == "exr"))
+        })
+        .unwrap_or(false);
+    Err(bad_input(format!(
+        "--albedo {}: no materials.ron here or in albedo/; expected the pseudo-albedo products of `campanile process` \
+         or `campanile outdoor recover`{}",
+        path.display(),
+        if igi_maps {
+            " (the EXR files here look like `campanile igi`'s per-group albedo maps, which record no layout and \
+             are not textured yet)"
+        } else {
+            ""
+        }
+    )))
+}
+
+/// Runs `texture --albedo`: albedo textures from the recovered
+/// pseudo-albedos ([`campanile_process::texture::albedo`]). `bar` gets the
+/// patches' count, then one tick per patch and layer.
+pub fn albedo_texture_files(
+    request: &AlbedoTextureRequest,
+    bar: &indicatif::ProgressBar,
+) -> anyhow::Result<AlbedoTextureRun> {
+    use campanile_process::outdoor::atlas::{MaterialsFile, read_materials};
+    use campanile_process::texture::export::{export_scaled, write_page_exrs};
+    use campanile_process::texture::{PseudoAlbedo, albedo_synthesis, judge_albedo, patches_on_lattice};
+
+    if let Some(t) = request.texel_m
+        && !(t.is_finite() && t > 0.0)
+    {
+        return Err(bad_input(format!("--texel {t}: expected a positive length in metres")));
+    }
+    let materials = materials_file(&request.albedo)?;
+    let (_, scene) = load_geometry(&request.scene)?;
+    let text = std::fs::read_to_string(&materials).map_err(|e| bad_input(format!("{}: {e}", materials.display())))?;
+    let file: MaterialsFile = ron::from_str(&text).map_err(|e| {
+        bad_input(format!(
+            "{}: {e}: expected a materials file (MaterialsFile(spacing_m: …, faces: […])) as `campanile process` \
+             writes it",
+            materials.display()
+        ))
+    })?;
+    let refl = read_materials(&scene, &materials).map_err(|e| bad_input(e.to_string()))?;
+    let texel_m = request.texel_m.unwrap_or(refl.grid.spacing_m);
+    let covered: Vec<String> = refl.grid.targets.iter().map(|&s| scene.surfaces()[s].clone()).collect();
+    let surfaces = request.surfaces.clone().unwrap_or_else(|| covered.clone());
+    let start = Instant::now();
+    let ps = patches_on_lattice(&scene, Some(&surfaces), texel_m, MAX_TEXELS)
+        .map_err(|e| bad_input(format!("{}: {e}", request.scene.display())))?;
+    bar.set_length(2 * ps.len() as u64);
+    let se = albedo_synthesis(&scene, &ps, &refl, PseudoAlbedo::SkyEnvironment, &|| bar.inc(1))
+        .map_err(|e| bad_input(format!("{}: {e}", materials.display())))?;
+    let sun = albedo_synthesis(&scene, &ps, &refl, PseudoAlbedo::Sun, &|| bar.inc(1))
+        .map_err(|e| bad_input(format!("{}: {e}", materials.display())))?;
+    let settings = AtlasSettings::default();
+    let atlas = pack(&scene, &ps, &se.textures, &settings).map_err(|e| bad_input(e.to_string()))?;
+    let sun_atlas = pack(&scene, &ps, &sun.textures, &settings).map_err(|e| bad_input(e.to_string()))?;
+    if sun_atlas.placements != atlas.placements {
+        anyhow::bail!("the ρ^sun patches packed differently from the ρ^se patches (the packer is not deterministic)");
+    }
+    let exported = export_scaled(&scene, &ps, &atlas, &request.out, Some(1.0))?;
+    let sun_pages = write_page_exrs(&sun_atlas, &request.out, "sun_")?;
+    let seconds = start.elapsed().as_secs_f64();
+    let quality = judge_albedo(&se.report, &request.limits);
+    let name_of = |p: &Path| {
+        p.file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    };
+    let mut products: Vec<ProductCells> = Vec::new();
+    for f in &file.faces {
+        let entry = match products.iter_mut().find(|p| p.surface == f.surface) {
+            Some(e) => e,
+            None => {
+                products.push(ProductCells {
+                    surface: f.surface.clone(),
+                    solved: 0,
+                    never_sunlit: 0,
+                    never_shadowed: 0,
+                    ill_conditioned: 0,
+                    unseen: 0,
+                });
+                products.last_mut().expect("just pushed")
+            }
+        };
+        let [a, b, c, d, e] = f.statuses;
+        entry.solved += a;
+        entry.never_sunlit += b;
+        entry.never_shadowed += c;
+        entry.ill_conditioned += d;
+        entry.unseen += e;
+    }
+    let r = &se.report;
+    let manifest = AlbedoTextureManifest {
+        materials: materials.clone(),
+        spacing_m: refl.grid.spacing_m,
+        texel_m,
+        obj: name_of(&exported.obj),
+        pages: exported.pages.iter().map(|(e, p)| (name_of(e), name_of(p))).collect(),
+        sun_pages: sun_pages.iter().map(|p| name_of(p)).collect(),
+        patches: ps
+            .iter()
+            .zip(&atlas.placements)
+            .zip(&r.per_patch)
+            .map(|((p, pl), &(texels, unseen))| PatchRecord {
+                surface: scene.surfaces()[p.surface].clone(),
+                page: pl.page,
+                rect: (pl.x, pl.y, p.cols + 2 * atlas.gutter, p.rows + 2 * atlas.gutter),
+                texels,
+                unseen,
+            })
+            .collect(),
+        products,
+        diagnostics: file.diagnostics,
+        quality,
+        seconds,
+    };
+    let manifest_path = request.out.join("texture.ron");
+    let text =
+        ron::ser::to_string_pretty(&manifest, ron::ser::PrettyConfig::default()).context("serializing texture.ron")?;
+    std::fs::write(&manifest_path, text + "\n").with_context(|| format!("writing {}", manifest_path.display()))?;
+    Ok(AlbedoTextureRun {
+        manifest,
+        manifest_path,
+        exported,
+        report: se.report,
     })
 }

@@ -156,9 +156,125 @@ fn floodlit_tower_texture_meets_the_truth() {
         .map(|t| t.status.iter().filter(|s| **s == TexelStatus::Filled).count())
         .sum();
     assert_eq!(filled, r.unseen);
+    // Exact poses: every photograph agrees best with the others unmoved.
+    for o in &r.offsets {
+        let o = o.expect("each photo shares texels");
+        assert!(o.length_px() < 0.1, "{o:?}");
+    }
+    let seams = campanile_process::texture::seam_figures(&ps, &syn.textures);
+    let q = campanile_process::texture::judge(r, &seams, &Default::default());
+    assert!(
+        q.reasons.iter().all(|r| r.starts_with("coverage")),
+        "only the unseen tops make it poor: {:?}",
+        q.reasons
+    );
 }
 
-/// Hard cases on the south face.
+/// The photographs of [`floodlit_tower_texture_meets_the_truth`] with
+/// view-se registered off: `az_off` degrees in azimuth, `side_m` metres
+/// across its optical axis.
+fn misregistered(world: &TextureWorld, az_off: f64, side_m: f64) -> [TexturePhoto; 3] {
+    let se = named(world, "view-se", 1);
+    let p = scene_pose("view-se");
+    let (x, y, z) = p.position_m;
+    let az = p.azimuth_deg.to_radians();
+    let side = Vector3::new(az.cos(), -az.sin(), 0.0) * side_m;
+    let pose = pose_from_angles(
+        Vector3::new(x, y, z) + side,
+        p.azimuth_deg + az_off,
+        p.elevation_deg,
+        0.0,
+    )
+    .expect("pose");
+    let photo = TexturePhoto::new("view-se", se.image, &pose, station_pinhole()).expect("photo");
+    [photo, named(world, "view-sw", 2), named(world, "view-ne", 3)]
+}
+
+/// The registration check against the truth of the poses. view-se is
+/// about 60 m from the faces it shares; its 640-pixel frame spans 60°
+/// (554 px focal length): 0.5° of azimuth moves its image 4.8 px, 5 cm
+/// sideways 0.46 px. Measured (2026-11-27, deterministic seeds): exact
+/// poses ≤ 0.02 px for each photograph (asserted < 0.1 px above); 0.5° off:
+/// view-se's best shift 4.14 px; 5 cm off: 0.47 px. The verdict's limit is
+/// 0.3 px, so both are `poor` with the reason named; the other two
+/// photographs, compared with a mean that holds view-se, show shifts too
+/// (the check finds the disagreeing pair, not the culprit alone).
+#[test]
+fn a_misregistered_photo_is_found_by_its_shift() {
+    use campanile_process::texture::{judge, seam_figures};
+    let world = TextureWorld::campanile().expect("the world");
+    let ps = faces(&world.scene, &["south-face", "east-face"]);
+    for (az_off, side_m, low, high) in [(0.5, 0.0, 3.5, 5.5), (0.0, 0.05, 0.3, 0.6)] {
+        let photos = misregistered(&world, az_off, side_m);
+        let syn = synthesize(&world.scene, &ps, &photos, &SynthesisSettings::default()).expect("synthesis");
+        let o = syn.report.offsets[0].expect("view-se shares texels");
+        println!("{az_off}° {side_m} m: offsets {:?}", syn.report.offsets);
+        assert!(
+            o.length_px() > low && o.length_px() < high,
+            "{az_off}° / {side_m} m: view-se's shift {o:?}, expected {low}–{high} px"
+        );
+        let q = judge(&syn.report, &seam_figures(&ps, &syn.textures), &Default::default());
+        assert_eq!(q.verdict, "poor");
+        assert!(
+            q.reasons.iter().any(|r| r.contains("photograph 1 agrees best")),
+            "{:?}",
+            q.reasons
+        );
+    }
+}
+
+/// The independent check's false `poor` (BENCHMARKS.md "Texture maps"):
+/// the whole tower at 0.125 m from the three exact photographs. Without
+/// the mixed-pixel margin (`edge_margin_px: 0`) the border spread is 4.3×
+/// the interior's (measured 0.137 against 0.032 on 256 border texels, the
+/// worst at the tower's corners); with it no border texel is seen by two
+/// photographs through pixels wholly on the face, so the figure has
+/// nothing to flag, and the registration check finds every photograph
+/// within 0.1 px of its place. About 4 s in the dev profile on top of the
+/// tests above (CI's budget): run with `--ignored`.
+#[test]
+#[ignore = "4 s; the measurement behind the mixed-pixel margin"]
+fn whole_tower_exact_poses_show_no_seams() {
+    use campanile_process::texture::{judge, seam_figures};
+    let world = TextureWorld::campanile().expect("the world");
+    let names: Vec<String> = ["south-face", "east-face", "north-face", "west-face", "pillars", "roof"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let ps = patches(&world.scene, Some(&names), 0.125, 10_000_000).expect("patches");
+    let photos = [
+        named(&world, "view-se", 1),
+        named(&world, "view-sw", 2),
+        named(&world, "view-ne", 3),
+    ];
+    let mixed = SynthesisSettings {
+        edge_margin_px: 0,
+        ..Default::default()
+    };
+    let before = synthesize(&world.scene, &ps, &photos, &mixed).expect("synthesis");
+    let s0 = seam_figures(&ps, &before.textures);
+    println!("margin 0: {s0:?}, ratio {:.2}", s0.ratio());
+    assert!(s0.ratio() > 3.0, "{s0:?}");
+    let after = synthesize(&world.scene, &ps, &photos, &SynthesisSettings::default()).expect("synthesis");
+    let s1 = seam_figures(&ps, &after.textures);
+    let q = judge(&after.report, &s1, &Default::default());
+    println!(
+        "margin 1: {s1:?}, ratio {:.2}; {:?}; {:?}",
+        s1.ratio(),
+        after.report.offsets,
+        q.reasons
+    );
+    assert!(s1.ratio() <= 2.0, "{s1:?}");
+    assert!(
+        after
+            .report
+            .offsets
+            .iter()
+            .all(|o| o.is_some_and(|o| o.length_px() < 0.1))
+    );
+    assert!(q.reasons.iter().all(|r| r.starts_with("coverage")), "{:?}", q.reasons);
+}
+
 #[test]
 fn hard_cases_unseen_grazing_occluded_and_a_photo_edge() {
     let world = TextureWorld::campanile().expect("the world");

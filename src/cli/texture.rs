@@ -1,16 +1,18 @@
-//! `campanile texture`: texture maps from registered photographs.
+//! `campanile texture`: texture maps from registered photographs, or from
+//! the recovered pseudo-albedos.
 
 use std::path::PathBuf;
 
 use anyhow::Result;
 use campanile_process::texture::QualityLimits;
 use campanile_session::progress::bar;
-use campanile_session::texture_files::{TextureRequest, texture_files};
+use campanile_session::texture_files::{AlbedoTextureRequest, TextureRequest, albedo_texture_files, texture_files};
 use clap::Args;
 
 use super::exit::{EXIT_OK, EXIT_QUALITY};
 
-/// Texture maps from registered HDR photographs (thesis §3.4).
+/// Texture maps from registered HDR photographs (thesis §3.4), or albedo
+/// textures from the recovered pseudo-albedos (--albedo).
 ///
 /// Every face of the scene (coplanar triangles of one named surface) gets a
 /// patch of square texels of --texel metres; each texel is the weighted
@@ -32,16 +34,39 @@ use super::exit::{EXIT_OK, EXIT_QUALITY};
 /// preview) and texture.ron (patches, photographs, coverage, seam figures,
 /// verdict).
 ///
-/// Verdict: failed below 50% of the texels seen, poor below 95% or when the
-/// photographs disagree over twice as much along face borders as inside.
+/// Only pixels whose neighbours show the same face are used (no mixed
+/// pixels along outlines). Each photograph's image is compared with the
+/// others' on the texels they share, shifted over ±6 px: the shift that
+/// agrees best is printed, and over 0.3 px means its pose (or its
+/// neighbours') is off.
+///
+/// Verdict: failed below 50% of the texels seen, poor below 95%, when the
+/// photographs disagree over twice as much along face borders as inside,
+/// or when a photograph agrees best with the others moved over 0.3 px.
 /// Exit status: 0 ok or poor, 3 failed (the files are still written),
 /// 2 bad input, 1 failure while working.
+///
+/// Albedo textures: --albedo DIR takes the pseudo-albedos (ρ^se, ρ^sun per
+/// surface-grid cell, thesis §5.4) that `campanile process` (scene
+/// sessions) and `campanile outdoor recover` write to OUT/albedo/
+/// (materials.ron with its atlases; DIR may be that directory, the output
+/// directory above it, or materials.ron). No photographs, poses or station
+/// are read. Default --texel: the products' grid spacing (each texel is
+/// then one grid cell); default surfaces: those the products cover. Out:
+/// model.obj, model.mtl (map_Kd page_N.png: the ρ^se colour, sRGB, not
+/// tone-mapped), page_N.exr (ρ^se), sun_page_N.exr (ρ^sun, same layout)
+/// and texture.ron. Texels on cells no photograph saw are counted as
+/// unseen and filled from their neighbours; the verdict follows the same
+/// coverage thresholds. (The per-group albedo maps of `campanile igi` are
+/// not taken yet.)
 ///
 /// Example:
 ///   campanile register shots/*.png --targets examples/campanile-targets.ron \
 ///       --station examples/sim-station.ron --out poses.ron
 ///   campanile texture examples/campanile-scene.ron --poses poses.ron \
 ///       --station examples/sim-station.ron --texel 0.1 --out textured/
+///   campanile texture examples/campanile-scene.ron --albedo processed/albedo \
+///       --out albedo-textured/
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct TextureArgs {
@@ -51,39 +76,49 @@ pub struct TextureArgs {
     /// Registered poses from `campanile register` (default: the scene file's poses).
     #[arg(long, value_name = "POSES.ron")]
     poses: Option<PathBuf>,
-    /// The station file whose camera took the photographs.
-    #[arg(long, value_name = "STATION.ron")]
-    station: PathBuf,
+    /// The station file whose camera took the photographs (radiance textures).
+    #[arg(long, value_name = "STATION.ron", required_unless_present = "albedo")]
+    station: Option<PathBuf>,
     /// Directory of the HDR photographs, one per pose, named after it.
     #[arg(long, value_name = "DIR")]
     photos: Option<PathBuf>,
     /// Output directory.
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
-    /// Texel side, metres.
-    #[arg(long, value_name = "M", default_value_t = 0.1)]
-    texel: f64,
+    /// Texel side, metres (default 0.1; with --albedo the products' grid spacing).
+    #[arg(long, value_name = "M")]
+    texel: Option<f64>,
     /// Texture only this surface (repeat for several; default: all).
     #[arg(long = "surface", value_name = "NAME")]
     surfaces: Vec<String>,
-    /// Albedo textures instead of radiance (not implemented yet: refused).
-    #[arg(long)]
-    albedo: bool,
+    /// Albedo textures from the pseudo-albedo products in DIR (`process`'s albedo/) instead of radiance.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["poses", "photos"])]
+    albedo: Option<PathBuf>,
 }
 
 pub fn run(args: TextureArgs) -> Result<u8> {
-    if args.albedo {
-        return Err(super::exit::bad_input(
-            "--albedo: albedo textures are not implemented yet; run without it for radiance textures",
-        ));
+    if let Some(albedo) = args.albedo {
+        return run_albedo(AlbedoTextureRequest {
+            scene: args.scene,
+            albedo,
+            out: args.out,
+            texel_m: args.texel,
+            surfaces: (!args.surfaces.is_empty()).then_some(args.surfaces),
+            limits: QualityLimits::default(),
+        });
     }
+    let Some(station) = args.station else {
+        return Err(super::exit::bad_input(
+            "--station STATION.ron: needed for radiance textures",
+        ));
+    };
     let request = TextureRequest {
         scene: args.scene,
         poses: args.poses,
-        station: args.station,
+        station,
         photos: args.photos,
         out: args.out,
-        texel_m: args.texel,
+        texel_m: args.texel.unwrap_or(0.1),
         surfaces: (!args.surfaces.is_empty()).then_some(args.surfaces),
         limits: QualityLimits::default(),
     };
@@ -94,8 +129,14 @@ pub fn run(args: TextureArgs) -> Result<u8> {
     let m = &run.manifest;
     for p in &m.photos {
         println!(
-            "{}: {} texels ({} hidden, {} too oblique)",
-            p.name, p.texels, p.occluded, p.grazing
+            "{}: {} texels ({} hidden, {} too oblique){}",
+            p.name,
+            p.texels,
+            p.occluded,
+            p.grazing,
+            p.shift_px.map_or(String::new(), |[u, v]| format!(
+                "; agrees best with the others moved ({u:.2}, {v:.2}) px"
+            ))
         );
     }
     let q = &m.quality;
@@ -107,6 +148,39 @@ pub fn run(args: TextureArgs) -> Result<u8> {
         q.unseen,
         q.seams.border_spread,
         q.seams.interior_spread,
+        m.pages.len(),
+        m.seconds,
+        if q.reasons.is_empty() {
+            String::new()
+        } else {
+            format!(": {}", q.reasons.join("; "))
+        }
+    );
+    println!("written to {}", run.manifest_path.display());
+    Ok(if q.verdict == "failed" { EXIT_QUALITY } else { EXIT_OK })
+}
+
+fn run_albedo(request: AlbedoTextureRequest) -> Result<u8> {
+    let progress = bar(0, "albedo texture");
+    let run = albedo_texture_files(&request, &progress);
+    progress.finish_and_clear();
+    let run = run?;
+    let m = &run.manifest;
+    for p in &m.products {
+        println!(
+            "{}: cells {} solved, {} never sunlit, {} never shadowed, {} ill-conditioned, {} unseen",
+            p.surface, p.solved, p.never_sunlit, p.never_shadowed, p.ill_conditioned, p.unseen
+        );
+    }
+    let q = &m.quality;
+    println!(
+        "albedo texture: {} (coverage {:.1}% of {} texels, {} on unseen cells filled from neighbours; {} m texels on {} m cells; {} page(s), {:.1} s){}",
+        q.verdict,
+        100.0 * q.coverage,
+        q.texels_on_faces,
+        q.unseen,
+        m.texel_m,
+        m.spacing_m,
         m.pages.len(),
         m.seconds,
         if q.reasons.is_empty() {

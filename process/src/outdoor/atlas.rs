@@ -7,6 +7,7 @@
 //! lattice square `(i, j)` (so `t`, up the face, is up in the image); where
 //! a square spans two triangles, the texel holds their area-weighted mean.
 
+use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -37,6 +38,11 @@ pub struct AtlasFace {
     pub rect: (usize, usize, usize, usize),
     /// Cells by status: solved, never sunlit, never shadowed, ill-conditioned, unseen.
     pub statuses: [usize; 5],
+    /// Lattice squares `(i, j)` whose every cell no photograph saw: their
+    /// texels hold the median of the nearest seen cells, not a measurement
+    /// (absent in files written before this field: read as none).
+    #[serde(default)]
+    pub unseen: Vec<(i64, i64)>,
 }
 
 /// The materials file: the grid's spacing and each face's place in the atlases.
@@ -97,6 +103,13 @@ pub fn write_materials(scene: &Scene, refl: &Reflectance, dir: &Path) -> Result<
         for &c in &f.cells {
             statuses[status_index(refl.cells[c].status)] += 1;
         }
+        // Squares where every cell is unseen (a square may span two triangles).
+        let mut squares: BTreeMap<(i64, i64), bool> = BTreeMap::new();
+        for &c in &f.cells {
+            let unseen = refl.cells[c].status == CellStatus::Unseen;
+            *squares.entry(g.cells[c].lattice).or_insert(true) &= unseen;
+        }
+        let unseen: Vec<(i64, i64)> = squares.into_iter().filter(|s| s.1).map(|s| s.0).collect();
         faces.push(AtlasFace {
             surface: scene.surfaces()[f.surface].clone(),
             normal: [f.normal.x, f.normal.y, f.normal.z],
@@ -104,6 +117,7 @@ pub fn write_materials(scene: &Scene, refl: &Reflectance, dir: &Path) -> Result<
             lattice_origin: (i0, j1),
             rect: (x, y, w, h),
             statuses,
+            unseen,
         });
         x += w;
         width = width.max(x);
@@ -160,8 +174,9 @@ pub fn write_materials(scene: &Scene, refl: &Reflectance, dir: &Path) -> Result<
 
 /// Reads a materials file written by [`write_materials`] for `scene`: the
 /// grid is rebuilt on the surfaces it names, with the sides it records, and
-/// each cell takes its texel (status [`CellStatus::FromFile`]; its stated
-/// uncertainty and conditioning are not stored, so read as infinite).
+/// each cell takes its texel (status [`CellStatus::FromFile`], or
+/// [`CellStatus::Unseen`] where the file lists its square as unseen; its
+/// stated uncertainty and conditioning are not stored, so read as infinite).
 pub fn read_materials(scene: &Scene, path: &Path) -> Result<Reflectance, OutdoorError> {
     let text = std::fs::read_to_string(path).map_err(|e| file_error(path, e))?;
     let file: MaterialsFile =
@@ -208,23 +223,26 @@ pub fn read_materials(scene: &Scene, path: &Path) -> Result<Reflectance, Outdoor
         })
     };
     let grid = Grid::with_sides(scene, &targets, file.spacing_m, &side)?;
+    let unseen: Vec<HashSet<(i64, i64)>> = file.faces.iter().map(|f| f.unseen.iter().copied().collect()).collect();
     let mut cells = Vec::with_capacity(grid.cells.len());
     for c in &grid.cells {
         let tri = &scene.triangles()[c.triangle];
-        let texel = find(c.surface, &c.normal, &tri.vertices[0]).and_then(|k| {
+        let face = find(c.surface, &c.normal, &tri.vertices[0]);
+        let texel = face.and_then(|k| {
             let f = &file.faces[k];
             let dx = c.lattice.0 - f.lattice_origin.0;
             let dy = f.lattice_origin.1 - c.lattice.1;
             (dx >= 0 && dy >= 0 && (dx as usize) < f.rect.2 && (dy as usize) < f.rect.3)
                 .then(|| (f.rect.1 + dy as usize) * file.size.0 + f.rect.0 + dx as usize)
         });
+        let listed_unseen = face.is_some_and(|k| unseen[k].contains(&c.lattice));
         let get = |img: &RadianceImage| texel.map_or([0.0; 3], |k| [0, 1, 2].map(|ch| f64::from(img.data[k * 3 + ch])));
         cells.push(CellEstimate {
             rho_sun: get(&sun),
             rho_se: get(&se),
             sigma_sun: [f64::INFINITY; 3],
             sigma_se: [f64::INFINITY; 3],
-            status: if texel.is_some() {
+            status: if texel.is_some() && !listed_unseen {
                 CellStatus::FromFile
             } else {
                 CellStatus::Unseen
@@ -255,7 +273,9 @@ mod tests {
     use crate::render::{Material, Triangle};
 
     /// Pseudo-albedos written as atlases and read back with the scene land
-    /// on the same cells, to f32 precision.
+    /// on the same cells, to f32 precision; the cells no photograph saw
+    /// (the lattice column i = 5, both triangles' cells there) come back
+    /// unseen, the rest from the file.
     #[test]
     fn atlases_round_trip() {
         let v = |x: f64, z: f64| Vector3::new(x, 0.0, z);
@@ -280,7 +300,11 @@ mod tests {
                 rho_se: value(c, 0.5),
                 sigma_sun: [0.01; 3],
                 sigma_se: [0.01; 3],
-                status: CellStatus::Solved,
+                status: if c.lattice.0 == 5 {
+                    CellStatus::Unseen
+                } else {
+                    CellStatus::Solved
+                },
                 condition: 2.0,
                 amplification: 2.0,
                 observations: 4,
@@ -300,8 +324,16 @@ mod tests {
         let back = read_materials(&scene, &path).unwrap();
         assert_eq!(back.grid.cells.len(), refl.grid.cells.len());
         assert_eq!(back.diagnostics, refl.diagnostics);
+        let unseen = refl.cells.iter().filter(|c| c.status == CellStatus::Unseen).count();
+        // Column 5 of a 6 m × 4 m wall at 1 m: 4 squares, the diagonal's lower triangle in each.
+        assert!(unseen >= 4, "{unseen}");
         for (a, b) in back.cells.iter().zip(&refl.cells) {
-            assert_eq!(a.status, CellStatus::FromFile);
+            let want = if b.status == CellStatus::Unseen {
+                CellStatus::Unseen
+            } else {
+                CellStatus::FromFile
+            };
+            assert_eq!(a.status, want);
             for ch in 0..3 {
                 assert!((a.rho_sun[ch] - b.rho_sun[ch]).abs() < 1e-6, "{a:?} {b:?}");
                 assert!((a.rho_se[ch] - b.rho_se[ch]).abs() < 1e-6);

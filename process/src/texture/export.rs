@@ -73,13 +73,14 @@ pub fn preview_scale(atlas: &Atlas) -> f64 {
     1.0 / f64::from(*p99)
 }
 
-/// Writes `model.obj`, `model.mtl` and the pages into `dir` (made if missing).
-pub fn export(scene: &Scene, patches: &[Patch], atlas: &Atlas, dir: &Path) -> Result<Exported, TextureError> {
+/// Writes each page of `atlas` as `dir/{prefix}page_N.exr` (32-bit float
+/// RGB): a second layer in the first's layout (ρ^sun beside ρ^se), which
+/// the same texture coordinates address.
+pub fn write_page_exrs(atlas: &Atlas, dir: &Path, prefix: &str) -> Result<Vec<PathBuf>, TextureError> {
     std::fs::create_dir_all(dir).map_err(|e| file_error(dir, e))?;
-    let scale = preview_scale(atlas);
-    let mut pages = Vec::new();
+    let mut out = Vec::new();
     for (n, page) in atlas.pages.iter().enumerate() {
-        let exr = dir.join(format!("page_{n}.exr"));
+        let exr = dir.join(format!("{prefix}page_{n}.exr"));
         let map = RadianceMap {
             width: page.width,
             height: page.height,
@@ -88,6 +89,31 @@ pub fn export(scene: &Scene, patches: &[Patch], atlas: &Atlas, dir: &Path) -> Re
             mask: Vec::new(),
         };
         write_rgb_exr(&map, &exr, ExrPrecision::Float).map_err(|e| file_error(&exr, e))?;
+        out.push(exr);
+    }
+    Ok(out)
+}
+
+/// Writes `model.obj`, `model.mtl` and the pages into `dir` (made if
+/// missing), the previews tone-mapped by [`preview_scale`].
+pub fn export(scene: &Scene, patches: &[Patch], atlas: &Atlas, dir: &Path) -> Result<Exported, TextureError> {
+    export_scaled(scene, patches, atlas, dir, None)
+}
+
+/// [`export`] with the previews' scale given (`Some(1.0)` for albedo: the
+/// PNG is then the diffuse colour itself, sRGB-encoded, clipped at 1), or
+/// from [`preview_scale`] when `None`.
+pub fn export_scaled(
+    scene: &Scene,
+    patches: &[Patch],
+    atlas: &Atlas,
+    dir: &Path,
+    scale: Option<f64>,
+) -> Result<Exported, TextureError> {
+    let scale = scale.unwrap_or_else(|| preview_scale(atlas));
+    let exrs = write_page_exrs(atlas, dir, "")?;
+    let mut pages = Vec::new();
+    for ((n, page), exr) in atlas.pages.iter().enumerate().zip(exrs) {
         let png = dir.join(format!("page_{n}.png"));
         let bytes: Vec<u8> = page.rgb.iter().map(|&v| srgb(f64::from(v) * scale)).collect();
         image::RgbImage::from_raw(page.width as u32, page.height as u32, bytes)

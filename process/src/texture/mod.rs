@@ -25,6 +25,8 @@
 //!   each vertex's texture coordinates.
 //! - [`export`]: OBJ + MTL + atlas images (OpenEXR radiance, PNG preview
 //!   through a tone map).
+//! - [`albedo`]: the same patches from the recovered pseudo-albedos
+//!   (thesis ch. 5) instead of photographs: albedo textures.
 //! - [`seam`]: how visible the patch borders are (the difference across
 //!   shared edges against the difference between neighbouring texels
 //!   inside a patch), and the verdict.
@@ -34,6 +36,7 @@
 //! standard HDR image formats, BENCHMARKS.md "Texture maps"); triangles
 //! that are not planar with their face's neighbours get a patch each.
 
+pub mod albedo;
 pub mod atlas;
 pub mod export;
 pub mod fill;
@@ -43,8 +46,9 @@ pub mod seam;
 pub mod synthesis;
 pub mod weight;
 
+pub use albedo::{PseudoAlbedo, albedo_synthesis, judge_albedo};
 pub use atlas::{Atlas, AtlasSettings, pack};
-pub use patch::{Patch, patches};
+pub use patch::{Patch, patches, patches_on_lattice};
 pub use photo::{TexturePhoto, pose_from_angles};
 pub use seam::{Quality, QualityLimits, SeamFigures, judge, seam_figures};
 pub use synthesis::{
@@ -71,6 +75,14 @@ pub enum TextureError {
         name: String,
         /// The scene's surfaces, comma-separated.
         known: String,
+    },
+    /// A surface was asked for that the albedo products do not cover.
+    #[error("surface {name:?} has no recovered albedo (the albedo products cover: {covered})")]
+    NotInProducts {
+        /// The surface.
+        name: String,
+        /// The surfaces the products cover, comma-separated.
+        covered: String,
     },
     /// A photograph's buffer does not match its size, or its size its camera's.
     #[error("photo {photo:?}: {what}")]

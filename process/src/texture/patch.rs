@@ -85,6 +85,30 @@ pub fn patches(
     texel_m: f64,
     max_texels: usize,
 ) -> Result<Vec<Patch>, TextureError> {
+    patches_with(scene, surfaces, texel_m, max_texels, false)
+}
+
+/// [`patches`] with each lattice's corner on a multiple of `texel_m` in
+/// the face's texture coordinates, so that texel `(i, j)` is the square
+/// `⌊s/Δ⌋ = i + i0`, `⌊t/Δ⌋ = j + j0` of the surface grid of the same
+/// spacing ([`crate::outdoor::grid`]): an albedo texture at the grid's
+/// spacing then copies each grid square into one texel, without resampling.
+pub fn patches_on_lattice(
+    scene: &Scene,
+    surfaces: Option<&[String]>,
+    texel_m: f64,
+    max_texels: usize,
+) -> Result<Vec<Patch>, TextureError> {
+    patches_with(scene, surfaces, texel_m, max_texels, true)
+}
+
+fn patches_with(
+    scene: &Scene,
+    surfaces: Option<&[String]>,
+    texel_m: f64,
+    max_texels: usize,
+    on_lattice: bool,
+) -> Result<Vec<Patch>, TextureError> {
     if !(texel_m.is_finite() && texel_m > 0.0) {
         return Err(TextureError::BadSetting {
             field: "texel_m",
@@ -133,7 +157,11 @@ pub fn patches(
             .collect();
         let lo = |k: usize| st.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
         let hi = |k: usize| st.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
-        let origin = [lo(0), lo(1)];
+        let origin = if on_lattice {
+            [0, 1].map(|k| (lo(k) / texel_m + 1e-9).floor() * texel_m)
+        } else {
+            [lo(0), lo(1)]
+        };
         let cols = (((hi(0) - origin[0]) / texel_m).ceil() as usize).max(1);
         let rows = (((hi(1) - origin[1]) / texel_m).ceil() as usize).max(1);
         total = total.saturating_add(cols.saturating_mul(rows));

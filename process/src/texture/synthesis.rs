@@ -16,10 +16,29 @@
 //!    the four pixels it interpolates all show the texel's face (an item
 //!    buffer per photograph, §3.5 step 4: the triangle each pixel centre's
 //!    ray meets first), so an occluder's or the sky's pixels beside a
-//!    silhouette do not bleed onto the face.
+//!    silhouette do not bleed onto the face. A pixel *shows* the face only
+//!    when its neighbours within [`SynthesisSettings::edge_margin_px`] do
+//!    too: a pixel whose centre is on the face but next to its outline
+//!    integrates the sky or the surface beyond over part of its area (and
+//!    the lens's blur more), so it is a mixed pixel. Measured on the
+//!    simulator's tower (all faces, 0.125 m texels, three exact photos):
+//!    without the margin the photographs' spread along face borders was
+//!    4.3× the interior's, at the tower's corners where one photograph
+//!    sees the sky beside the face and another the next face (seam
+//!    figure, [`super::seam`]).
 //!
 //! Texels on the face that no photograph sees are counted per patch and
 //! then filled from their neighbours ([`super::fill`]); their status says so.
+//!
+//! Registration check: a misregistered photograph shows each texel's
+//! neighbourhood instead of the texel, everywhere it is used, not only at
+//! face borders (a pose 0.5° off moves a 640-pixel, 60° frame about 5
+//! pixels). So each photograph's samples are compared with the other
+//! photographs' weighted mean on the texels they share, with the image
+//! shifted by whole pixels over ±[`OFFSET_SEARCH_PX`], and the shift that
+//! agrees best is refined to a fraction of a pixel
+//! ([`registration_offsets`], [`PhotoOffset`]); the verdict
+//! ([`super::seam::judge`]) reads it.
 
 use rayon::prelude::*;
 
@@ -38,10 +57,22 @@ pub const SAME_POINT_REL: f64 = 1e-4;
 pub const MAX_SUBSAMPLES: usize = 4;
 
 /// The knobs of synthesis.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SynthesisSettings {
     /// The photographs' weights.
     pub weight: WeightSettings,
+    /// A pixel shows a face only when every pixel within this many pixels
+    /// of it (a square) shows the same face (module doc: mixed pixels).
+    pub edge_margin_px: usize,
+}
+
+impl Default for SynthesisSettings {
+    fn default() -> Self {
+        SynthesisSettings {
+            weight: WeightSettings::default(),
+            edge_margin_px: 1,
+        }
+    }
 }
 
 /// Where a texel's value came from.
@@ -87,6 +118,26 @@ pub struct SynthesisReport {
     pub occluded: Vec<usize>,
     /// Per photograph: texels in its frame seen too obliquely to count.
     pub grazing: Vec<usize>,
+    /// Per photograph: its registration against the others
+    /// ([`registration_offsets`]; `None` where it shares too few texels).
+    pub offsets: Vec<Option<PhotoOffset>>,
+}
+
+/// How far a photograph's image must move to agree best with the other
+/// photographs on the texels they share (module doc: registration check).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhotoOffset {
+    /// The shift, pixels along the image's columns and rows.
+    pub shift_px: [f64; 2],
+    /// Texels compared.
+    pub texels: usize,
+}
+
+impl PhotoOffset {
+    /// The shift's length, pixels.
+    pub fn length_px(&self) -> f64 {
+        self.shift_px[0].hypot(self.shift_px[1])
+    }
 }
 
 impl SynthesisReport {
@@ -122,16 +173,33 @@ enum Look {
 }
 
 /// The patch each pixel centre's ray of `photo` meets first (`u32::MAX`:
-/// none, or a surface without a patch).
-fn item_buffer(scene: &Scene, photo: &TexturePhoto, patch_of: &[u32]) -> Vec<u32> {
+/// none, or a surface without a patch), kept only where every pixel within
+/// `margin` pixels meets the same patch (`u32::MAX` elsewhere, and within
+/// `margin` of the frame's edge).
+fn item_buffer(scene: &Scene, photo: &TexturePhoto, patch_of: &[u32], margin: usize) -> Vec<u32> {
     let (w, h) = (photo.image.width, photo.image.height);
     let rays = photo.rig.rays();
-    (0..w * h)
+    let items: Vec<u32> = (0..w * h)
         .into_par_iter()
         .map(|k| {
             rays.ray((k % w) as f64 + 0.5, (k / w) as f64 + 0.5)
                 .and_then(|r| scene.intersect(&r, f64::INFINITY))
                 .map_or(u32::MAX, |hit| patch_of[hit.triangle])
+        })
+        .collect();
+    if margin == 0 {
+        return items;
+    }
+    (0..w * h)
+        .into_par_iter()
+        .map(|k| {
+            let (x, y) = (k % w, k / w);
+            let id = items[k];
+            if x < margin || y < margin || x + margin >= w || y + margin >= h {
+                return u32::MAX;
+            }
+            let pure = (y - margin..=y + margin).all(|yy| (x - margin..=x + margin).all(|xx| items[yy * w + xx] == id));
+            if pure { id } else { u32::MAX }
         })
         .collect()
 }
@@ -143,7 +211,14 @@ struct Texel<'a> {
     j: usize,
 }
 
-fn look(scene: &Scene, texel: &Texel, photo: &TexturePhoto, items: &[u32], settings: &SynthesisSettings) -> Look {
+fn look(
+    scene: &Scene,
+    texel: &Texel,
+    photo: &TexturePhoto,
+    items: &[u32],
+    settings: &SynthesisSettings,
+    mut positions: Option<&mut Vec<(f64, f64)>>,
+) -> Look {
     let Texel { patch, id, i, j } = *texel;
     let p = patch.texel_centre(i, j);
     let rig = &photo.rig;
@@ -204,6 +279,9 @@ fn look(scene: &Scene, texel: &Texel, photo: &TexturePhoto, items: &[u32], setti
             {
                 (0..3).for_each(|c| sum[c] += rgb[c]);
                 k += 1;
+                if let Some(out) = positions.as_deref_mut() {
+                    out.push((su, sv));
+                }
             }
         }
     }
@@ -255,6 +333,7 @@ pub fn synthesize_with_progress(
         used: vec![0; np],
         occluded: vec![0; np],
         grazing: vec![0; np],
+        offsets: vec![None; np],
         ..Default::default()
     };
     let mut patch_of = vec![u32::MAX; scene.triangles().len()];
@@ -266,7 +345,7 @@ pub fn synthesize_with_progress(
     let items: Vec<Vec<u32>> = photos
         .iter()
         .map(|p| {
-            let buffer = item_buffer(scene, p, &patch_of);
+            let buffer = item_buffer(scene, p, &patch_of, settings.edge_margin_px);
             step();
             buffer
         })
@@ -294,7 +373,7 @@ pub fn synthesize_with_progress(
                         i,
                         j,
                     };
-                    match look(scene, &texel, photo, &items[k], settings) {
+                    match look(scene, &texel, photo, &items[k], settings, None) {
                         Look::Out => {}
                         Look::Grazing => codes[k] = 2,
                         Look::Occluded => codes[k] = 3,
@@ -352,7 +431,166 @@ pub fn synthesize_with_progress(
         textures.push(tex);
         step();
     }
+    report.offsets = registration_offsets(scene, patches, photos, &items, settings);
     Ok(Synthesis { textures, report })
+}
+
+/// Half-width of the shift search, pixels (a pose 0.5° off moves a
+/// 640-pixel, 60° frame by about 5 pixels).
+pub const OFFSET_SEARCH_PX: i32 = 6;
+
+/// Every this many texels along each axis are compared (a quarter of them).
+pub const OFFSET_STRIDE: usize = 2;
+
+/// Fewest shared texels for a photograph's offset.
+pub const MIN_OFFSET_TEXELS: usize = 50;
+
+/// Most texels the whole-pixel search compares (an even subset); the
+/// sub-pixel refinement uses every shared texel.
+pub const SEARCH_TEXELS: usize = 2000;
+
+/// One texel's comparison: the others' mean level, the photo's sample
+/// positions, the patch.
+struct Comparison {
+    reference: f64,
+    positions: Vec<(f64, f64)>,
+    id: u32,
+}
+
+/// The registration check (module doc): for each photograph, the image
+/// shift within ±[`OFFSET_SEARCH_PX`] at which its samples of the texels
+/// it shares with other photographs (every [`OFFSET_STRIDE`]-th texel, off
+/// the faces' borders) best match the others' weighted mean: the shift
+/// minimizing the mean squared relative difference, on whole pixels (over
+/// at most [`SEARCH_TEXELS`] of them), then refined by a parabola through
+/// the minimum and its neighbours along each axis (over all of them). Exact poses give a shift near 0 whatever the texture; a pose off
+/// by an angle moves the whole image, and the check finds the move.
+fn registration_offsets(
+    scene: &Scene,
+    patches: &[Patch],
+    photos: &[TexturePhoto],
+    items: &[Vec<u32>],
+    settings: &SynthesisSettings,
+) -> Vec<Option<PhotoOffset>> {
+    let np = photos.len();
+    if np < 2 {
+        return vec![None; np];
+    }
+    let mut texels = Vec::new();
+    for (pi, patch) in patches.iter().enumerate() {
+        for j in (1..patch.rows.saturating_sub(1)).step_by(OFFSET_STRIDE) {
+            for i in (1..patch.cols.saturating_sub(1)).step_by(OFFSET_STRIDE) {
+                if patch.texel_triangle[j * patch.cols + i].is_some() && !super::seam::on_border(patch, i, j) {
+                    texels.push((pi, i, j));
+                }
+            }
+        }
+    }
+    // Per texel, each photo's look; then per photo its comparisons.
+    let per_texel: Vec<Vec<(usize, Comparison)>> = texels
+        .par_iter()
+        .map(|&(pi, i, j)| {
+            let texel = Texel {
+                patch: &patches[pi],
+                id: pi as u32,
+                i,
+                j,
+            };
+            let mut seen = Vec::new();
+            for (k, photo) in photos.iter().enumerate() {
+                let mut positions = Vec::new();
+                if let Look::Seen(w, rgb) = look(scene, &texel, photo, &items[k], settings, Some(&mut positions)) {
+                    seen.push((k, w, (rgb[0] + rgb[1] + rgb[2]) / 3.0, positions));
+                }
+            }
+            let (wsum, ysum) = seen.iter().fold((0.0, 0.0), |(a, b), s| (a + s.1, b + s.1 * s.2));
+            seen.into_iter()
+                .filter_map(|(k, w, y, positions)| {
+                    let (wo, yo) = (wsum - w, ysum - w * y);
+                    (wo > 0.0 && yo > 0.0).then(|| {
+                        (
+                            k,
+                            Comparison {
+                                reference: yo / wo,
+                                positions,
+                                id: pi as u32,
+                            },
+                        )
+                    })
+                })
+                .collect()
+        })
+        .collect();
+    let mut by_photo: Vec<Vec<Comparison>> = (0..np).map(|_| Vec::new()).collect();
+    for list in per_texel {
+        for (k, c) in list {
+            by_photo[k].push(c);
+        }
+    }
+    by_photo
+        .iter()
+        .enumerate()
+        .map(|(k, comps)| {
+            if comps.len() < MIN_OFFSET_TEXELS {
+                return None;
+            }
+            let photo = &photos[k];
+            let id_items = &items[k];
+            // The whole-pixel search on an even subset, the refinement on all.
+            let step = comps.len().div_ceil(SEARCH_TEXELS).max(1);
+            let subset: Vec<&Comparison> = comps.iter().step_by(step).collect();
+            let all: Vec<&Comparison> = comps.iter().collect();
+            let cost_on = |set: &[&Comparison], du: f64, dv: f64| -> f64 {
+                let (sum, n) = set
+                    .par_iter()
+                    .filter_map(|c| {
+                        let (mut y, mut m) = (0.0, 0usize);
+                        for &(u, v) in &c.positions {
+                            if let Some(rgb) = photo.sample_where(u + du, v + dv, &|px| id_items[px] == c.id) {
+                                y += (rgb[0] + rgb[1] + rgb[2]) / 3.0;
+                                m += 1;
+                            }
+                        }
+                        (m > 0).then(|| (y / m as f64 / c.reference - 1.0).powi(2))
+                    })
+                    .fold(|| (0.0, 0usize), |(a, b), e| (a + e, b + 1))
+                    .reduce(|| (0.0, 0usize), |(a, b), (c, d)| (a + c, b + d));
+                if n == 0 { f64::INFINITY } else { sum / n as f64 }
+            };
+            let r = OFFSET_SEARCH_PX;
+            let mut best = (f64::INFINITY, 0i32, 0i32);
+            for dv in -r..=r {
+                for du in -r..=r {
+                    let c = cost_on(&subset, f64::from(du), f64::from(dv));
+                    if c < best.0 {
+                        best = (c, du, dv);
+                    }
+                }
+            }
+            let (_, bu, bv) = best;
+            let cost = |du: f64, dv: f64| cost_on(&all, du, dv);
+            let c0 = cost(f64::from(bu), f64::from(bv));
+            if !c0.is_finite() {
+                return None;
+            }
+            // Parabola through the minimum and its neighbours along one axis.
+            let refine = |minus: f64, plus: f64| {
+                let curvature = minus + plus - 2.0 * c0;
+                if curvature > 0.0 && minus.is_finite() && plus.is_finite() {
+                    (0.5 * (minus - plus) / curvature).clamp(-0.5, 0.5)
+                } else {
+                    0.0
+                }
+            };
+            let (fu, fv) = (f64::from(bu), f64::from(bv));
+            let su = fu + refine(cost(fu - 1.0, fv), cost(fu + 1.0, fv));
+            let sv = fv + refine(cost(fu, fv - 1.0), cost(fu, fv + 1.0));
+            Some(PhotoOffset {
+                shift_px: [su, sv],
+                texels: comps.len(),
+            })
+        })
+        .collect()
 }
 
 #[cfg(test)]
