@@ -50,6 +50,14 @@ pub struct CircleDetectorSettings {
     pub max_template_residual: f64,
     /// Least ratio of the minor to the major axis.
     pub min_axis_ratio: f64,
+    /// Least ratio of the white level to the plate's.
+    pub min_contrast_ratio: f64,
+    /// Largest standard deviation inside the ellipse, relative to the contrast.
+    pub max_inside_spread: f64,
+    /// Largest standard deviation over the ring around it, relative to the contrast.
+    pub max_ring_spread: f64,
+    /// Least fraction of the perimeter with an edge across it.
+    pub min_perimeter_edges: f64,
 }
 
 impl Default for CircleDetectorSettings {
@@ -64,6 +72,10 @@ impl Default for CircleDetectorSettings {
             max_fit_rms_px: 0.6,
             max_template_residual: 0.3,
             min_axis_ratio: 0.2,
+            min_contrast_ratio: 2.0,
+            max_inside_spread: 0.2,
+            max_ring_spread: 0.15,
+            min_perimeter_edges: 0.8,
         }
     }
 }
@@ -81,6 +93,14 @@ pub struct CircleDetection {
     pub template_residual: f64,
     /// White level minus plate level, codes.
     pub contrast: f64,
+    /// White level over plate level.
+    pub contrast_ratio: f64,
+    /// Standard deviation of the levels inside the ellipse, relative to the contrast.
+    pub inside_spread: f64,
+    /// Standard deviation of the levels in the ring around it, relative to the contrast.
+    pub ring_spread: f64,
+    /// Fraction of the ellipse's perimeter with a white-to-dark edge across it.
+    pub perimeter_edges: f64,
     /// The candidate's normalized cross-correlation with the template.
     pub ncc: f64,
 }
@@ -306,53 +326,97 @@ fn edge_points(
     (pts, med(his), med(los))
 }
 
-/// The residual of the best two-level elliptical template (module doc):
-/// `Σ (I − T)² / (n · contrast²)` over the ellipse and its ring to 1.5
-/// times its size, with each level the mean of its region, leaving out a
-/// band of a pixel either side of the edge (the lens's blur). Also the contrast.
-fn template_residual(gray: &[f32], w: usize, h: usize, e: &Ellipse) -> Option<(f64, f64)> {
+/// What the fitted ellipse's neighbourhood looks like (module doc, step 3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Look {
+    /// The two-level template's residual, relative to the contrast.
+    residual: f64,
+    /// Mean inside minus mean of the ring, codes.
+    contrast: f64,
+    /// Mean inside over mean of the ring.
+    ratio: f64,
+    /// Standard deviation inside, relative to the contrast.
+    inside_spread: f64,
+    /// Standard deviation over the ring, relative to the contrast.
+    ring_spread: f64,
+    /// Fraction of the perimeter with an edge across it.
+    perimeter_edges: f64,
+}
+
+/// The fitted ellipse's neighbourhood (module doc, step 3): the levels,
+/// spreads and residual of the best two-level elliptical template over
+/// the ellipse and its ring to 1.5 times its size, leaving out a band of
+/// a pixel either side of the edge (the lens's blur); then the fraction
+/// of 64 points on the perimeter where the level 1.5 px inside exceeds
+/// the level 1.5 px outside by half the contrast.
+fn look(gray: &[f32], w: usize, h: usize, e: &Ellipse) -> Option<Look> {
     let reach = 1.5 * e.a + 2.0;
     let (x0, x1) = (
         (e.centre.0 - reach).floor().max(0.0) as usize,
-        ((e.centre.0 + reach).ceil() as usize).min(w),
+        ((e.centre.0 + reach).ceil().max(0.0) as usize).min(w),
     );
     let (y0, y1) = (
         (e.centre.1 - reach).floor().max(0.0) as usize,
-        ((e.centre.1 + reach).ceil() as usize).min(h),
+        ((e.centre.1 + reach).ceil().max(0.0) as usize).min(h),
     );
     let (s, c) = e.angle.sin_cos();
-    let mut inside = Vec::new();
-    let mut ring = Vec::new();
+    // (count, sum, sum of squares) inside and over the ring.
+    let (mut inside, mut ring) = ([0.0f64; 3], [0.0f64; 3]);
+    let scale = e.b.max(1.0);
     for y in y0..y1 {
         for x in x0..x1 {
             let (px, py) = (x as f64 + 0.5 - e.centre.0, y as f64 + 0.5 - e.centre.1);
             let (u, v) = (c * px + s * py, -s * px + c * py);
             // The ellipse's "radius" at the pixel, and the pixel's distance from the edge.
             let rho = ((u / e.a).powi(2) + (v / e.b).powi(2)).sqrt();
-            let scale = e.b.max(1.0);
             let value = f64::from(gray[y * w + x]);
-            if (rho - 1.0) * scale < -1.0 {
-                inside.push(value);
+            let acc = if (rho - 1.0) * scale < -1.0 {
+                &mut inside
             } else if (rho - 1.0) * scale > 1.0 && rho <= 1.5 {
-                ring.push(value);
-            }
+                &mut ring
+            } else {
+                continue;
+            };
+            acc[0] += 1.0;
+            acc[1] += value;
+            acc[2] += value * value;
         }
     }
-    if inside.len() < 3 || ring.len() < 3 {
+    if inside[0] < 3.0 || ring[0] < 3.0 {
         return None;
     }
-    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
-    let (mi, mr) = (mean(&inside), mean(&ring));
+    let stats = |a: [f64; 3]| {
+        let mean = a[1] / a[0];
+        (mean, (a[2] / a[0] - mean * mean).max(0.0).sqrt(), a[2] - a[1] * mean)
+    };
+    let ((mi, si, ssd_i), (mr, sr, ssd_r)) = (stats(inside), stats(ring));
     let contrast = mi - mr;
     if contrast <= 0.0 {
         return None;
     }
-    let ssd: f64 =
-        inside.iter().map(|v| (v - mi).powi(2)).sum::<f64>() + ring.iter().map(|v| (v - mr).powi(2)).sum::<f64>();
-    Some((
-        ssd / ((inside.len() + ring.len()) as f64 * contrast * contrast),
+    const ROUND: usize = 64;
+    let edges = (0..ROUND)
+        .filter(|k| {
+            let t = std::f64::consts::TAU * *k as f64 / ROUND as f64;
+            let (px, py) = e.point(t);
+            // The outward normal: the conic's gradient direction.
+            let (ct, st) = (t.cos(), t.sin());
+            let (nu, nv) = (ct / e.a, st / e.b);
+            let (nx, ny) = (c * nu - s * nv, s * nu + c * nv);
+            let norm = nx.hypot(ny);
+            let (nx, ny) = (nx / norm, ny / norm);
+            let at = |d: f64| sample(gray, w, h, px + nx * d, py + ny * d);
+            matches!((at(-1.5), at(1.5)), (Some(a), Some(b)) if a - b >= 0.5 * contrast)
+        })
+        .count();
+    Some(Look {
+        residual: (ssd_i + ssd_r) / ((inside[0] + ring[0]) * contrast * contrast),
         contrast,
-    ))
+        ratio: mi / mr.max(1.0),
+        inside_spread: si / contrast,
+        ring_spread: sr / contrast,
+        perimeter_edges: edges as f64 / ROUND as f64,
+    })
 }
 
 /// Verifies one candidate (module doc, step 2).
@@ -387,16 +451,26 @@ fn verify(gray: &[f32], w: usize, h: usize, c: &Candidate, s: &CircleDetectorSet
     {
         return None;
     }
-    let (residual, contrast) = template_residual(gray, w, h, &e)?;
-    if residual > s.max_template_residual || contrast < s.min_contrast {
+    let l = look(gray, w, h, &e)?;
+    if l.residual > s.max_template_residual
+        || l.contrast < s.min_contrast
+        || l.ratio < s.min_contrast_ratio
+        || l.inside_spread > s.max_inside_spread
+        || l.ring_spread > s.max_ring_spread
+        || l.perimeter_edges < s.min_perimeter_edges
+    {
         return None;
     }
     Some(CircleDetection {
         ellipse: e,
         edge_points: kept,
         fit_rms_px: fit.rms,
-        template_residual: residual,
-        contrast,
+        template_residual: l.residual,
+        contrast: l.contrast,
+        contrast_ratio: l.ratio,
+        inside_spread: l.inside_spread,
+        ring_spread: l.ring_spread,
+        perimeter_edges: l.perimeter_edges,
         ncc: c.ncc,
     })
 }

@@ -686,6 +686,10 @@ mod tests {
             fit_rms_px: fit.rms,
             template_residual: 0.0,
             contrast: 100.0,
+            contrast_ratio: 8.0,
+            inside_spread: 0.0,
+            ring_spread: 0.0,
+            perimeter_edges: 1.0,
             ncc: 1.0,
         }
     }
