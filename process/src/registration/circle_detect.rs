@@ -156,7 +156,9 @@ fn sweep(gray: &[f32], w: usize, h: usize, s: &CircleDetectorSettings) -> Vec<Ca
         // The inscribed square of the circle, and the plate to 1.5 r.
         let hi = ((0.7 * r).round() as usize).max(1);
         let ho = ((1.5 * r).round() as usize).max(hi + 1);
-        let step = ((r / 4.0).floor() as usize).max(1);
+        // A grid a quarter of the radius apart (rounded up): the peak of the
+        // correlation is r wide, and the verification recasts from the fitted centre.
+        let step = ((r / 4.0).ceil() as usize).max(1);
         let (n_a, n_w) = (
             ((2 * hi + 1) * (2 * hi + 1)) as f64,
             ((2 * ho + 1) * (2 * ho + 1)) as f64,

@@ -114,8 +114,10 @@ pub struct CircleSearchSettings {
     /// factor (either way).
     pub size_factor: f64,
     /// The search stops once a hypothesis explains this fraction of the
-    /// detections (and at least 4).
+    /// detections, or `enough_targets` of them (and at least 4).
     pub enough_fraction: f64,
+    /// See `enough_fraction`.
+    pub enough_targets: usize,
 }
 
 impl Default for CircleSearchSettings {
@@ -128,6 +130,7 @@ impl Default for CircleSearchSettings {
             max_shape_error: 0.15,
             size_factor: 1.5,
             enough_fraction: 0.8,
+            enough_targets: 12,
         }
     }
 }
@@ -144,6 +147,10 @@ pub struct ImageCircle {
     /// The circle's two possible centres and normals in the camera frame
     /// (normals toward the camera), for the survey's radius.
     pub poses: Vec<(Vector3<f64>, Vector3<f64>)>,
+    /// The ellipse's quality, the search's order: its semi-major axis
+    /// (pixels) times the fraction of its perimeter with an edge, over
+    /// 1 + its fit's RMS in pixels.
+    pub quality: f64,
 }
 
 /// The virtual camera looking along unit `z` (camera frame), its up the
@@ -258,6 +265,7 @@ pub fn image_circle(pinhole: &Pinhole, index: usize, d: &CircleDetection, radius
         centre_px,
         shape: (e.a, e.b, line_angle(c, s)),
         poses,
+        quality: e.a * d.perimeter_edges / (1.0 + d.fit_rms_px),
     })
 }
 
@@ -402,11 +410,24 @@ pub fn register_circles(
         .enumerate()
         .filter_map(|(i, d)| image_circle(pinhole, i, d, radius))
         .collect();
-    // Largest first: their shapes and distances are the most precise.
-    circles.sort_by(|a, b| b.shape.0.total_cmp(&a.shape.0));
+    // Best first: the largest, cleanest ellipses' shapes and distances are the most precise.
+    circles.sort_by(|a, b| b.quality.total_cmp(&a.quality));
     let n = circles.len();
     let threshold = settings.inlier_threshold_px;
-    let enough = ((search.enough_fraction * n as f64).ceil() as usize).max(4);
+    let enough = ((search.enough_fraction * n as f64).ceil() as usize)
+        .min(search.enough_targets)
+        .max(4);
+    // The surveyed pairs by baseline, for a range search per detection pair.
+    let mut by_baseline: Vec<(f64, usize, usize)> = Vec::with_capacity(targets.len() * targets.len());
+    for (g, tg) in targets.iter().enumerate() {
+        for (h, th) in targets.iter().enumerate() {
+            let baseline = (th.centre - tg.centre).norm();
+            if g != h && baseline > 1e-9 {
+                by_baseline.push((baseline, g, h));
+            }
+        }
+    }
+    by_baseline.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut hypotheses = 0usize;
     let mut pairs_considered = 0usize;
     // (count, error sum, pose, assignment)
@@ -424,15 +445,34 @@ pub fn register_circles(
         let (pi0, pj0) = (ci.poses[0].0, cj.poses[0].0);
         let seen_baseline = (pj0 - pi0).norm();
         let mean_distance = 0.5 * (pi0.norm() + pj0.norm());
-        for (g, tg) in targets.iter().enumerate() {
-            for (h, th) in targets.iter().enumerate() {
-                if g == h {
+        // |seen − b| ≤ k·d + ρ·b bounds b to [(seen − k·d)/(1 + ρ), (seen + k·d)/(1 − ρ)].
+        let slack = search.baseline_of_distance * mean_distance;
+        let low = (seen_baseline - slack) / (1.0 + search.baseline_relative);
+        let high = (seen_baseline + slack) / (1.0 - search.baseline_relative).max(1e-9);
+        let first = by_baseline.partition_point(|(b, _, _)| *b < low);
+        let last = by_baseline.partition_point(|(b, _, _)| *b <= high);
+        // The angle between the two normals, seen (either pose of each) and surveyed.
+        let seen_normal_angles: Vec<f64> = ci
+            .poses
+            .iter()
+            .flat_map(|(_, ni)| cj.poses.iter().map(move |(_, nj)| ni.angle(nj)))
+            .collect();
+        // Most consistent baselines first.
+        let mut candidates: Vec<(f64, usize, usize)> = by_baseline[first..last].to_vec();
+        candidates.sort_by(|a, b| (a.0 - seen_baseline).abs().total_cmp(&(b.0 - seen_baseline).abs()));
+        for (baseline, g, h) in candidates {
+            let (tg, th) = (&targets[g], &targets[h]);
+            {
+                pairs_considered += 1;
+                let tol = slack + search.baseline_relative * baseline;
+                if (seen_baseline - baseline).abs() > tol {
                     continue;
                 }
-                pairs_considered += 1;
-                let baseline = (th.centre - tg.centre).norm();
-                let tol = search.baseline_of_distance * mean_distance + search.baseline_relative * baseline;
-                if (seen_baseline - baseline).abs() > tol || baseline < 1e-9 {
+                let surveyed_angle = tg.normal.angle(&th.normal);
+                if seen_normal_angles
+                    .iter()
+                    .all(|a| (a - surveyed_angle).abs() > 2.0 * search.max_normal_deg.to_radians())
+                {
                     continue;
                 }
                 for (pi, ni) in &ci.poses {
@@ -489,7 +529,15 @@ pub fn register_circles(
                                     let e = (u - cm.centre_px.0).hypot(v - cm.centre_px.1);
                                     let a = t.radius_m / (t.centre - pose.centre).norm() * pinhole.focal_px;
                                     let ratio = a / cm.shape.0;
-                                    (e <= radius_px && ratio <= search.size_factor && ratio >= 1.0 / search.size_factor)
+                                    // Size, axis ratio and orientation agree with the target's
+                                    // radius and normal at the pair's pose (the thesis's function,
+                                    // with twice the pair's tolerance: that pose is rough).
+                                    let shape_ok = predicted_shape(pinhole, &pose, t)
+                                        .is_some_and(|p| shape_error(cm.shape, p) <= 2.0 * search.max_shape_error);
+                                    (e <= radius_px
+                                        && ratio <= search.size_factor
+                                        && ratio >= 1.0 / search.size_factor
+                                        && shape_ok)
                                         .then_some((e, k))
                                 })
                                 .collect();
