@@ -36,8 +36,8 @@ fn config_check_passes_on_every_example_and_summarizes_them() {
         "stdout:\n{stdout}\nstderr:\n{}",
         text(&out.stderr)
     );
-    // 16: four stations, six plans, four scenes, two targets files.
-    assert_eq!(stdout.matches(": valid ").count(), 16, "{stdout}");
+    // 18: four stations, six plans, four scenes, four targets files.
+    assert_eq!(stdout.matches(": valid ").count(), 18, "{stdout}");
     // The six plans were checked against the four stations.
     assert_eq!(stdout.matches("  runs on station").count(), 24, "{stdout}");
     assert!(stdout.contains("equidistant fisheye, 512×512 px"), "{stdout}");

@@ -1,12 +1,12 @@
 //! `campanile register` as a user runs it: simulated photographs of the
-//! tower's surveyed AprilTags in, poses out, against the simulator's
-//! truth; and its errors and exit statuses.
+//! tower's surveyed AprilTags (and of its circle targets) in, poses out,
+//! against the simulator's truth; and its errors and exit statuses.
 
 mod common;
 
 use campanile_process::pose::Pinhole;
 use campanile_process::registration::CameraPose;
-use campanile_sim::world::target_photos::{PhotoSettings, photograph, pose_looking, with_targets};
+use campanile_sim::world::target_photos::{PhotoSettings, photograph, pose_looking, with_circle_targets, with_targets};
 use campanile_sim::world::{World, examples_dir, load_scene};
 use common::campanile;
 
@@ -19,13 +19,22 @@ fn station() -> campanile_config::Station {
 /// A 1600 × 1200 photo of the tower's south-east corner from `centre`,
 /// written as a PNG; returns its true pose.
 fn photo(dir: &std::path::Path, name: &str, centre: [f64; 3]) -> CameraPose {
-    let targets = campanile_config::load_targets(&examples_dir().join("campanile-targets.ron"))
+    photo_of(dir, name, centre, "campanile-targets.ron", 2)
+}
+
+/// The same, of the targets of `survey` (coded or circles) hung on the
+/// tower, rendered with `samples` paths a pixel.
+fn photo_of(dir: &std::path::Path, name: &str, centre: [f64; 3], survey: &str, samples: u32) -> CameraPose {
+    let survey = campanile_config::load_targets(&examples_dir().join(survey))
         .expect("survey")
-        .value
-        .targets;
+        .value;
     let scene = load_scene(&examples_dir().join("campanile-scene.ron")).expect("scene");
-    let mut w = World::new(&station(), with_targets(&scene, &targets).expect("targets"));
-    w.quality.samples_per_pixel = 2;
+    let hung = match survey.kind.circle_radius_m() {
+        Some(r) => with_circle_targets(&scene, &survey.targets, r),
+        None => with_targets(&scene, &survey.targets),
+    };
+    let mut w = World::new(&station(), hung.expect("targets"));
+    w.quality.samples_per_pixel = samples;
     w.quality.max_bounces = 1;
     let c = &station().camera;
     let settings = PhotoSettings {
@@ -113,6 +122,49 @@ fn a_tripod_photo_is_registered_within_five_millimetres_and_a_blank_one_fails_wi
     // The poses are in the scene file's form: they parse as scene poses.
     let poses_only = ron::ser::to_string(&written.poses).expect("ser");
     let _: Vec<campanile_config::scene::CameraPose> = ron::from_str(&poses_only).expect("scene poses");
+}
+
+/// The thesis's own targets (white circles, no identity): found, paired
+/// with the survey by search and registered by the command, rendered with
+/// 1 path a pixel (as `sim/tests/circle_registration.rs`) to save time.
+#[test]
+fn a_photo_of_circle_targets_is_registered_by_search_within_five_millimetres() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let truth = photo_of(
+        dir.path(),
+        "circles.png",
+        [12.0, -13.0, 1.5],
+        "campanile-circles.ron",
+        1,
+    );
+    let out_file = dir.path().join("poses.ron");
+    let out = campanile(&[
+        "register",
+        dir.path().join("circles.png").to_str().expect("utf-8"),
+        "--targets",
+        examples_dir().join("campanile-circles.ron").to_str().expect("utf-8"),
+        "--station",
+        examples_dir().join("sim-station.ron").to_str().expect("utf-8"),
+        "--out",
+        out_file.to_str().expect("utf-8"),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
+    let text = std::fs::read_to_string(&out_file).expect("poses written");
+    let written: campanile_session::register_files::RegisteredPoses = ron::from_str(&text).expect("poses parse");
+    let p = &written.poses[0];
+    let position = nalgebra::Vector3::new(p.position_m.0, p.position_m.1, p.position_m.2);
+    assert!(
+        (position - truth.centre).norm() < 0.005,
+        "{:?} vs {:?}",
+        position,
+        truth.centre
+    );
+    assert!((p.azimuth_deg - truth.azimuth_deg()).abs() < 0.05);
+    let circles = written.photos[0].circles.as_ref().expect("the circle search's figures");
+    assert!(circles.matched.len() >= 6, "{circles:?}");
+    assert!(circles.hypotheses > 0, "{circles:?}");
 }
 
 #[test]

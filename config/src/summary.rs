@@ -295,7 +295,14 @@ fn plan_summary(p: &LoadedPlan) -> String {
 
 fn targets_summary(t: &crate::targets::Targets) -> String {
     let mut o = String::new();
-    let _ = writeln!(o, "targets: {} {:?} tags", t.targets.len(), t.family);
+    match t.kind.circle_radius_m() {
+        Some(r) => {
+            let _ = writeln!(o, "targets: {} circles of radius {r} m", t.targets.len());
+        }
+        None => {
+            let _ = writeln!(o, "targets: {} {:?} tags", t.targets.len(), t.family);
+        }
+    }
     let ids: Vec<String> = t.targets.iter().map(|t| t.id.to_string()).collect();
     let _ = writeln!(o, "  ids        {}", ids.join(", "));
     o

@@ -1,7 +1,10 @@
-//! Surveyed targets (`targets.ron`): the world positions of the coded
-//! targets that `campanile register` finds photographs' poses from
-//! (thesis §3.3). A target is a flat square AprilTag; its position comes
-//! from a survey or a range scan.
+//! Surveyed targets (`targets.ron`): the world positions of the targets
+//! that `campanile register` finds photographs' poses from (thesis §3.3).
+//! Two kinds: coded targets (the default, `kind: Coded`), flat square
+//! AprilTags whose id the image shows; and the thesis's own targets
+//! (`kind: Circle(radius_m)`), flat dark square plates with a white circle
+//! of that radius and no identity in the image, whose correspondences are
+//! found by search (§3.3.2). Positions come from a survey or a range scan.
 //!
 //! ```ron
 //! Targets(
@@ -12,6 +15,19 @@
 //!         (id: 0, centre_m: (-3.0, -5.5, 2.0), normal: (0.0, -1.0, 0.0), size_m: 0.5),
 //!         // On a horizontal face, `up` says where the tag's top points.
 //!         (id: 7, centre_m: (0.0, -9.0, 0.0), normal: (0.0, 0.0, 1.0), up: Some((0.0, 1.0, 0.0)), size_m: 0.5),
+//!     ],
+//! )
+//! ```
+//!
+//! Circle targets (the `id` is the survey's label, not seen in the image;
+//! `centre_m` is the circle's centre; `size_m` is the plate's side, which
+//! must exceed the circle's diameter; `up` is not used):
+//!
+//! ```ron
+//! Targets(
+//!     kind: Circle(0.1),
+//!     targets: [
+//!         (id: 1, centre_m: (-3.0, -5.502, 2.0), normal: (0.0, -1.0, 0.0), size_m: 0.4),
 //!     ],
 //! )
 //! ```
@@ -32,20 +48,41 @@ pub enum TagFamily {
     Tag36h11,
 }
 
+/// The kind of every target of a file.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub enum TargetKind {
+    /// AprilTags of the file's `family`: identity from the image.
+    #[default]
+    Coded,
+    /// The thesis's targets: a white circle of this radius, metres, on a
+    /// dark square plate; no identity in the image.
+    Circle(f64),
+}
+
+impl TargetKind {
+    /// The circle's radius for `Circle`, `None` for coded targets.
+    pub fn circle_radius_m(&self) -> Option<f64> {
+        match self {
+            TargetKind::Coded => None,
+            TargetKind::Circle(r) => Some(*r),
+        }
+    }
+}
+
 /// One surveyed target.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Target {
-    /// The tag's id in its family.
+    /// The tag's id in its family; for circle targets, the survey's label.
     pub id: u32,
-    /// Centre of the tag, world frame, metres.
+    /// Centre of the tag (of the circle), world frame, metres.
     pub centre_m: (f64, f64, f64),
     /// Normal out of the tag's printed face (need not be unit length).
     pub normal: (f64, f64, f64),
     /// Where the tag's top edge faces, if not the default (module doc).
     #[serde(default)]
     pub up: Option<(f64, f64, f64)>,
-    /// Side of the tag's black square, metres.
+    /// Side of the tag's black square; for circle targets, of the plate. Metres.
     pub size_m: f64,
 }
 
@@ -53,7 +90,10 @@ pub struct Target {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, rename = "Targets")]
 pub struct Targets {
-    /// The tags' family.
+    /// The targets' kind (coded by default).
+    #[serde(default)]
+    pub kind: TargetKind,
+    /// The tags' family (coded targets).
     #[serde(default)]
     pub family: TagFamily,
     /// The targets.
@@ -73,10 +113,20 @@ impl Validate for Targets {
         if self.targets.is_empty() {
             v.invalid("targets", "[]".into(), "at least one target");
         }
+        let radius = self.kind.circle_radius_m();
+        if let Some(r) = radius
+            && !(r.is_finite() && r > 0.0)
+        {
+            v.invalid(
+                "kind",
+                format!("Circle({})", fmt_f64(r)),
+                "a circle of positive radius, metres",
+            );
+        }
         v.at("targets", |v| {
             for (i, t) in self.targets.iter().enumerate() {
                 v.at(i, |v| {
-                    if t.id >= 587 {
+                    if radius.is_none() && t.id >= 587 {
                         v.invalid("id", t.id.to_string(), "a tag36h11 id, 0 to 586");
                     }
                     if self.targets[..i].iter().any(|o| o.id == t.id) {
@@ -103,6 +153,15 @@ impl Validate for Targets {
                     }
                     if !(t.size_m.is_finite() && t.size_m > 0.0) {
                         v.invalid("size_m", fmt_f64(t.size_m), "a positive side, metres");
+                    } else if let Some(r) = radius
+                        && r.is_finite()
+                        && t.size_m <= 2.0 * r
+                    {
+                        v.invalid(
+                            "size_m",
+                            fmt_f64(t.size_m),
+                            "a plate side larger than the circle's diameter, metres",
+                        );
                     }
                 });
             }
@@ -187,6 +246,7 @@ mod tests {
     #[test]
     fn bad_fields_are_named() {
         let t = Targets {
+            kind: TargetKind::Coded,
             family: TagFamily::Tag36h11,
             targets: vec![
                 wall_tag(),
@@ -201,5 +261,25 @@ mod tests {
         t.validate(&mut v);
         let issues: Vec<String> = v.into_issues().iter().map(|i| i.path.to_string()).collect();
         assert_eq!(issues, ["targets[1].id", "targets[1].normal", "targets[1].size_m"]);
+    }
+
+    #[test]
+    fn circle_targets_take_any_label_and_need_a_plate_wider_than_the_circle() {
+        let text = "Targets(kind: Circle(0.1), targets: [
+            (id: 1000, centre_m: (0.0, 0.0, 1.0), normal: (0.0, -1.0, 0.0), size_m: 0.4),
+            (id: 1001, centre_m: (1.0, 0.0, 1.0), normal: (0.0, -1.0, 0.0), size_m: 0.15),
+        ])";
+        let t: Targets = ron::from_str(text).expect("parses");
+        assert_eq!(t.kind.circle_radius_m(), Some(0.1));
+        let mut v = Validator::new(".");
+        t.validate(&mut v);
+        let issues: Vec<String> = v.into_issues().iter().map(|i| i.path.to_string()).collect();
+        assert_eq!(issues, ["targets[1].size_m"]);
+        // Without a kind: coded.
+        let coded: Targets = ron::from_str(
+            "Targets(targets: [(id: 1, centre_m: (0.0, 0.0, 1.0), normal: (0.0, -1.0, 0.0), size_m: 0.4)])",
+        )
+        .expect("parses");
+        assert_eq!(coded.kind, TargetKind::Coded);
     }
 }

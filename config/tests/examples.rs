@@ -19,8 +19,8 @@ fn every_example_file_is_valid() {
         }
     }
     assert_eq!(
-        n, 16,
-        "sim station, sky sim station, all-sky fisheye sim station, real station, six plans, four scenes, two targets files"
+        n, 18,
+        "sim station, sky sim station, all-sky fisheye sim station, real station, six plans, four scenes, four targets files (tags and circles)"
     );
 }
 

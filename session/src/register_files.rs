@@ -1,8 +1,11 @@
-//! `campanile register` on files: photographs and a survey of coded
-//! targets in, camera poses out (thesis §3.3). Each photograph's tags are
-//! found ([`TagDetector`]), paired with the surveyed corners by id, and
-//! registered ([`register`]); the poses are written in the form a scene
-//! file's `poses` take, with each photograph's verdict and figures beside.
+//! `campanile register` on files: photographs and a survey of targets in,
+//! camera poses out (thesis §3.3). The targets file's kind says how:
+//! coded targets are found ([`TagDetector`]), paired with the surveyed
+//! corners by id, and registered ([`register`]); the thesis's circle
+//! targets are found ([`detect_circles`]), paired with the survey by
+//! search and registered ([`register_circles`]). The poses are written in
+//! the form a scene file's `poses` take, with each photograph's verdict and
+//! figures beside.
 
 use std::path::{Path, PathBuf};
 
@@ -10,6 +13,8 @@ use anyhow::{Context, Result};
 use campanile_config::targets::Targets;
 use campanile_process::pose::Pinhole;
 use campanile_process::registration::apriltag::{TagDetector, correspondences};
+use campanile_process::registration::circle_detect::{CircleDetectorSettings, detect_circles};
+use campanile_process::registration::circle_search::{CircleSearchSettings, SurveyedCircle, register_circles};
 use campanile_process::registration::{Quality, RegistrationSettings, Verdict, register};
 use serde::{Deserialize, Serialize};
 
@@ -28,8 +33,25 @@ pub struct PhotoRegistration {
     pub roll_deg: Option<f64>,
     /// Tags decoded that the survey does not list.
     pub unknown_tags: Vec<u32>,
+    /// Circle targets: what the detection and the correspondence search found.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub circles: Option<CircleSearchFigures>,
     /// Verdict and figures.
     pub quality: Quality,
+}
+
+/// The circle search's figures for one photograph.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CircleSearchFigures {
+    /// Circles (ellipses) found in the photograph.
+    pub found: usize,
+    /// Those paired with a surveyed target: (detection index, target id).
+    pub matched: Vec<(usize, u32)>,
+    /// Detections paired with none (false or unsurveyed targets).
+    pub unmatched: Vec<usize>,
+    /// Pose hypotheses tried by the search.
+    pub hypotheses: usize,
 }
 
 /// The file `register` writes.
@@ -81,6 +103,7 @@ pub fn register_photos(request: &RegisterRequest) -> Result<RegisteredPoses> {
         return Err(bad_input("no photographs given: expected one or more image files"));
     }
     let targets: Targets = campanile_config::load_targets(&request.targets)?.value;
+    let circles = SurveyedCircle::from_targets(&targets);
     let station = campanile_config::load_station(&request.station)?.value;
     let configured = Pinhole::of_camera(&station.camera);
     let configured_size = (
@@ -105,6 +128,38 @@ pub fn register_photos(request: &RegisterRequest) -> Result<RegisteredPoses> {
             )));
         }
         let pinhole = configured.rescaled(configured_size, w, h);
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| path.display().to_string());
+        if let Some(surveyed) = &circles {
+            let found = detect_circles(&gray, w, h, &CircleDetectorSettings::default());
+            let r = register_circles(
+                &pinhole,
+                &found,
+                surveyed,
+                &request.settings,
+                &CircleSearchSettings::default(),
+            );
+            let reg = r.registration;
+            tracing::info!(photo = %path.display(), verdict = %reg.quality.verdict, circles = found.len(),
+                hypotheses = r.hypotheses, "registered");
+            push_photo(
+                &mut out,
+                name,
+                path,
+                reg.pose,
+                reg.quality,
+                Vec::new(),
+                Some(CircleSearchFigures {
+                    found: found.len(),
+                    matched: r.matches,
+                    unmatched: r.unmatched,
+                    hypotheses: r.hypotheses,
+                }),
+            );
+            continue;
+        }
         if detector.as_ref().is_none_or(|d| d.size() != (w, h)) {
             detector = Some(TagDetector::new(w, h).context("starting the tag detector")?);
         }
@@ -116,31 +171,41 @@ pub fn register_photos(request: &RegisterRequest) -> Result<RegisteredPoses> {
             .unwrap_or_default();
         let (points, unknown_tags) = correspondences(&found, &targets.targets);
         let reg = register(&pinhole, &points, &request.settings);
-        let name = path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| path.display().to_string());
         tracing::info!(photo = %path.display(), verdict = %reg.quality.verdict, tags = found.len(), "registered");
-        if let Some(pose) = reg.pose {
-            out.poses.push(campanile_config::scene::CameraPose {
-                name: name.clone(),
-                position_m: (pose.centre.x, pose.centre.y, pose.centre.z),
-                azimuth_deg: pose.azimuth_deg(),
-                elevation_deg: pose.elevation_deg(),
-                roll_deg: pose.roll_deg(),
-            });
-        }
-        out.photos.push(PhotoRegistration {
-            name,
-            file: path.clone(),
-            roll_deg: reg.pose.map(|p| p.roll_deg()),
-            unknown_tags,
-            quality: reg.quality,
-        });
+        push_photo(&mut out, name, path, reg.pose, reg.quality, unknown_tags, None);
     }
     let text = ron::ser::to_string_pretty(&out, ron::ser::PrettyConfig::default()).context("serializing the poses")?;
     std::fs::write(&request.out, text + "\n").with_context(|| format!("writing {}", request.out.display()))?;
     Ok(out)
+}
+
+/// Adds one photograph's registration (and its pose, unless failed) to `out`.
+fn push_photo(
+    out: &mut RegisteredPoses,
+    name: String,
+    path: &Path,
+    pose: Option<campanile_process::registration::CameraPose>,
+    quality: Quality,
+    unknown_tags: Vec<u32>,
+    circles: Option<CircleSearchFigures>,
+) {
+    if let Some(pose) = pose {
+        out.poses.push(campanile_config::scene::CameraPose {
+            name: name.clone(),
+            position_m: (pose.centre.x, pose.centre.y, pose.centre.z),
+            azimuth_deg: pose.azimuth_deg(),
+            elevation_deg: pose.elevation_deg(),
+            roll_deg: pose.roll_deg(),
+        });
+    }
+    out.photos.push(PhotoRegistration {
+        name,
+        file: path.to_path_buf(),
+        roll_deg: pose.map(|p| p.roll_deg()),
+        unknown_tags,
+        circles,
+        quality,
+    });
 }
 
 /// The photographs whose verdict is `failed`, each with its reasons.

@@ -1,4 +1,5 @@
-//! `campanile register`: camera poses from photographs of surveyed coded targets.
+//! `campanile register`: camera poses from photographs of surveyed targets
+//! (coded AprilTags, or the thesis's white circles).
 
 use std::path::PathBuf;
 
@@ -9,10 +10,16 @@ use clap::Args;
 
 use super::exit::{EXIT_OK, EXIT_QUALITY};
 
-/// Camera poses from photographs of surveyed AprilTags (thesis §3.3).
+/// Camera poses from photographs of surveyed targets (thesis §3.3).
 ///
-/// Finds the tag36h11 tags in each photograph, pairs their corners with
-/// the surveyed ones by id, solves the pose (three-point solver inside
+/// The targets file's kind decides. Coded targets (the default): finds the
+/// tag36h11 tags in each photograph and pairs their corners with the
+/// surveyed ones by id. Circle targets (`kind: Circle(radius_m)`, the
+/// thesis's own): finds white circles on dark plates (template sweep at
+/// several scales, ellipse fit) and pairs them with the survey by search
+/// (pairs of ellipses give a pose, the other targets confirm it, §3.3.2);
+/// `photos[].circles` reports what was found, matched and tried. Then
+/// solves the pose (three-point solver inside
 /// RANSAC, then Levenberg–Marquardt through the station camera's lens
 /// distortion), and judges it: ok, poor (nearly collinear targets, a
 /// reprojection error or an uncertainty over its limit) or failed (fewer

@@ -20,14 +20,22 @@
 //! - [`solve`]: the whole chain, correspondences to a judged pose.
 //! - [`mount`]: the head's mount calibration from photographs registered
 //!   at known head readings.
+//! - the thesis's own targets, white circles without identity (§3.3.1–
+//!   §3.3.3): [`circle_detect`] finds them (template sweep at several
+//!   scales, then an [`ellipse`] fit), [`circle_search`] finds their
+//!   correspondences by search over pairs of ellipse constraints and
+//!   registers the photograph through [`solve`].
 //!
 //! Camera frame as in [`crate::pose`]: x right, y down, z forward; world
 //! frame x east, y north, z up, metres.
 
 pub mod apriltag;
 pub mod camera_pose;
+pub mod circle_detect;
+pub mod circle_search;
 pub mod consensus;
 pub mod correspondence;
+pub mod ellipse;
 pub mod mount;
 pub mod p3p;
 pub mod refine;

@@ -70,6 +70,21 @@ pub enum Texture {
         /// Albedo of white cells and of the plate around the pattern.
         white: [f64; 3],
     },
+    /// A disc on a square plate, such as the thesis's targets (§3.3: "flat
+    /// square green patches with a white circular area in the middle"):
+    /// `inside` within `radius_m` of `centre_st`, `outside` elsewhere.
+    Disc {
+        /// The disc's centre, texture coordinates (metres).
+        centre_st: [f64; 2],
+        /// The disc's radius, metres.
+        radius_m: f64,
+        /// Side of the square plate around it, metres (for the mean albedo).
+        plate_m: f64,
+        /// Albedo inside the disc.
+        inside: [f64; 3],
+        /// Albedo of the plate around it.
+        outside: [f64; 3],
+    },
 }
 
 /// A uniform number in [−1, 1] for integer cell `(i, j)` and `seed`
@@ -157,6 +172,19 @@ impl Texture {
                     _ => *white,
                 }
             }
+            Texture::Disc {
+                centre_st,
+                radius_m,
+                inside,
+                outside,
+                ..
+            } => {
+                if (st[0] - centre_st[0]).hypot(st[1] - centre_st[1]) <= *radius_m {
+                    *inside
+                } else {
+                    *outside
+                }
+            }
         }
     }
 
@@ -184,6 +212,17 @@ impl Texture {
             } => {
                 let f = cells.iter().filter(|c| **c).count() as f64 / cells.len().max(1) as f64;
                 [0, 1, 2].map(|c| f * white[c] + (1.0 - f) * black[c])
+            }
+            // Over the plate.
+            Texture::Disc {
+                radius_m,
+                plate_m,
+                inside,
+                outside,
+                ..
+            } => {
+                let f = (std::f64::consts::PI * radius_m * radius_m / (plate_m * plate_m).max(1e-300)).min(1.0);
+                [0, 1, 2].map(|c| f * inside[c] + (1.0 - f) * outside[c])
             }
         }
     }
@@ -253,6 +292,21 @@ mod tests {
         // Beyond the pattern: the white plate.
         assert_eq!(t.albedo([12.0, 5.0]), [0.9; 3]);
         assert_eq!(t.mean_albedo(), [0.25 * 0.9 + 0.75 * 0.05; 3]);
+    }
+
+    #[test]
+    fn a_disc_is_inside_within_its_radius_and_its_mean_is_over_the_plate() {
+        let t = Texture::Disc {
+            centre_st: [2.0, 1.0],
+            radius_m: 0.1,
+            plate_m: 0.4,
+            inside: [0.9; 3],
+            outside: [0.05; 3],
+        };
+        assert_eq!(t.albedo([2.09, 1.0]), [0.9; 3]);
+        assert_eq!(t.albedo([2.08, 1.08]), [0.05; 3]);
+        let f = std::f64::consts::PI * 0.01 / 0.16;
+        assert!((t.mean_albedo()[0] - (f * 0.9 + (1.0 - f) * 0.05)).abs() < 1e-12);
     }
 
     #[test]

@@ -8,6 +8,11 @@
 //! on a wall puts them a little proud of it (the example surveys: 2 mm,
 //! a plate's thickness), so that plate and wall do not coincide.
 //!
+//! [`with_circle_targets`] hangs the thesis's own targets (§3.3): a dark
+//! square plate ([`CIRCLE_PLATE`], the thesis's "flat square green
+//! patches") with a white circle in the middle ([`Texture::Disc`]), the
+//! circle's centre where the survey puts it.
+//!
 //! [`photograph`] renders a view through the world's path tracer (the
 //! sun and sky outdoors, the lamps indoors), blurs it by the lens's
 //! Gaussian spot, exposes it on the 8-bit [`CameraModel::typical`] sensor
@@ -32,6 +37,9 @@ use super::{LoadedScene, World, WorldError};
 pub const TAG_WHITE: [f64; 3] = [0.85, 0.85, 0.85];
 /// See [`TAG_WHITE`].
 pub const TAG_BLACK: [f64; 3] = [0.04, 0.04, 0.04];
+
+/// Albedo of a circle target's plate: a dark green.
+pub const CIRCLE_PLATE: [f64; 3] = [0.03, 0.07, 0.04];
 
 fn vec3(v: (f64, f64, f64)) -> Vector3<f64> {
     Vector3::new(v.0, v.1, v.2)
@@ -94,6 +102,66 @@ pub fn with_targets(scene: &LoadedScene, targets: &[Target]) -> Result<LoadedSce
         triangles.extend([a, b]);
         materials.push(Material {
             name: format!("target-{}", t.id),
+            albedo: texture.clone(),
+            specular: None,
+            emission: [0.0; 3],
+        });
+        appearances.push(Appearance::diffuse(texture));
+    }
+    let scene_out = Scene::new(triangles, materials, surfaces).map_err(|e| geometry_error(e.to_string()))?;
+    Ok(LoadedScene {
+        description: scene.description.clone(),
+        scene: scene_out,
+        appearances,
+    })
+}
+
+/// `scene` with circle targets of radius `radius_m` hung on it (module
+/// doc): each target's plate of side `size_m`, centred on `centre_m`,
+/// facing `normal`. Like [`with_targets`], plates stand free.
+pub fn with_circle_targets(scene: &LoadedScene, targets: &[Target], radius_m: f64) -> Result<LoadedScene, WorldError> {
+    let mut triangles: Vec<Triangle> = scene.scene.triangles().to_vec();
+    let mut materials: Vec<Material> = scene.scene.materials().to_vec();
+    let mut surfaces: Vec<String> = scene.scene.surfaces().to_vec();
+    let mut appearances = scene.appearances.clone();
+    let surface = surfaces.len() as u32;
+    surfaces.push("circle-targets".into());
+    for t in targets {
+        if !(t.size_m > 2.0 * radius_m && radius_m > 0.0) {
+            return Err(geometry_error(format!(
+                "circle target {}: a plate of {} m cannot hold a circle of radius {radius_m} m",
+                t.id, t.size_m
+            )));
+        }
+        let [right, up, _normal] = t.axes().map(Vector3::from);
+        let half = 0.5 * t.size_m;
+        let centre = vec3(t.centre_m);
+        let corner = |a: f64, b: f64| centre + right * (a * half) + up * (b * half);
+        let (tl, tr, br, bl) = (
+            corner(-1.0, 1.0),
+            corner(1.0, 1.0),
+            corner(1.0, -1.0),
+            corner(-1.0, -1.0),
+        );
+        let material = materials.len() as u32;
+        let pair = [
+            Triangle::new([bl, br, tr], material, surface),
+            Triangle::new([bl, tr, tl], material, surface),
+        ];
+        let [Some(a), Some(b)] = pair else {
+            return Err(geometry_error(format!("circle target {}: a degenerate plate", t.id)));
+        };
+        let [s_axis, t_axis] = a.texture_axes;
+        let texture = Texture::Disc {
+            centre_st: [centre.dot(&s_axis), centre.dot(&t_axis)],
+            radius_m,
+            plate_m: t.size_m,
+            inside: TAG_WHITE,
+            outside: CIRCLE_PLATE,
+        };
+        triangles.extend([a, b]);
+        materials.push(Material {
+            name: format!("circle-target-{}", t.id),
             albedo: texture.clone(),
             specular: None,
             emission: [0.0; 3],
