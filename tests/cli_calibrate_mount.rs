@@ -376,7 +376,7 @@ fn a_moved_tripod_is_processed_from_registered_poses_as_well_as_from_known_ones(
     // the registration's error (about 0.01° and 3 mm, 0.04 px of this
     // 256 × 192 camera) moves ρ_se by under 1% at the median and 5% at the
     // 95th percentile (cells along face borders and shadow edges, a few
-    // pixels each; measured 0.28% and 1.8%).
+    // pixels each; measured 0.16% and 0.85%).
     assert!(known.0 < 0.05 && known.2 < 0.095, "known {known:?}");
     assert!(
         registered.0 <= known.0 + 0.005,

@@ -164,7 +164,10 @@ fn a_session_without_sky_frames_gets_pseudo_albedos_under_estimated_light() {
         100.0 * sun50,
         100.0 * sun95
     );
-    assert!(se.len() > 1000, "{} cells", se.len());
+    // Compared over the cells the training photographs saw (756 measured;
+    // before the atlas recorded its unseen cells, the filled ones were
+    // read back as estimates and counted too, over 1000).
+    assert!(se.len() > 700, "{} cells", se.len());
     // Measured light (tests/demo.rs): medians 2.5 % / 2.1 %.
     assert!(
         se50 < BOUND_SE && sun50 < BOUND_SUN,

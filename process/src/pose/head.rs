@@ -119,8 +119,9 @@ impl Mount {
         // down = −z, forward = y; the orientation C = Rx(a) Ry(b) Rx(c) M0.
         let c_cols = [right, down, forward];
         let m0 = [[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]];
-        // Q = C M0ᵀ: Q[i][j] = Σ_k C[i][k] M0[j][k], C[i][k] = c_cols[k][i].
-        let q = |i: usize, j: usize| (0..3).map(|k| c_cols[k][i] * m0[j][k]).sum::<f64>();
+        // Q = C M0ᵀ: Q[i][j] = Σ_k C[i][k] M0[j][k], with C[i][k] = c_cols[k][i]
+        // and M0[j][k] = m0[k][j] (both listed by columns).
+        let q = |i: usize, j: usize| (0..3).map(|k| c_cols[k][i] * m0[k][j]).sum::<f64>();
         let b = q(0, 0).clamp(-1.0, 1.0).acos();
         let (a, c) = if b.sin().abs() > 1e-9 {
             (q(1, 0).atan2(-q(2, 0)), q(0, 1).atan2(q(0, 2)))
