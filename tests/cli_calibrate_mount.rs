@@ -164,6 +164,29 @@ fn held_out_block_rmse(out: &Path) -> f64 {
         .expect("a held-out figure")
 }
 
+/// The calibration file at `path`, its mount and head place asserted
+/// against the truth within the registration's goals (0.05°, and 5 mm at
+/// 10 m: the head is 20 m from the tower).
+fn calibration_within_the_goals(path: &Path) -> campanile_config::camera_calibration::CameraCalibration {
+    let cal = campanile_config::document::load_camera_calibration(path)
+        .expect("a CameraCalibration file")
+        .value;
+    let m = true_mount();
+    let errors = [
+        (cal.mount.pan_zero_azimuth_deg - m.pan_zero_azimuth_rad.to_degrees()).abs(),
+        (cal.mount.tilt_zero_deg - m.tilt_zero_rad.to_degrees()).abs(),
+        (cal.mount.level_roll_deg - m.roll_rad.to_degrees()).abs(),
+        (cal.mount.level_pitch_deg - m.pitch_rad.to_degrees()).abs(),
+    ];
+    println!("mount errors (pan zero, tilt zero, roll, pitch): {errors:?} degrees");
+    assert!(errors.iter().all(|&e| e < 0.05), "{errors:?}");
+    let (x, y, z) = cal.head_position_m.expect("the head's place");
+    let offset = (Vector3::new(x, y, z) - Vector3::from(TRUE_HEAD)).norm();
+    println!("head position error {:.2} mm", 1e3 * offset);
+    assert!(offset < 0.005, "{offset} m");
+    cal
+}
+
 /// Median and 95th percentile of ρ_se's relative error over the estimated cells.
 fn albedo_error(out: &Path, world: &World, scene: &campanile_process::render::Scene) -> (f64, f64, usize) {
     let refl = campanile_process::outdoor::atlas::read_materials(scene, &out.join("albedo").join("materials.ron"))
@@ -302,23 +325,7 @@ fn a_moved_tripod_is_processed_from_registered_poses_as_well_as_from_known_ones(
     );
     println!("{said}");
     stage("registered, mount calibrated");
-    let cal = campanile_config::document::load_camera_calibration(&file("registered.ron"))
-        .expect("a CameraCalibration file")
-        .value;
-    // The registration's goals, 0.05° and 5 mm at 10 m: the mount's angles
-    // within 0.05°, the head within 5 mm (it is 20 m from the tower).
-    let errors = [
-        (cal.mount.pan_zero_azimuth_deg - m.pan_zero_azimuth_rad.to_degrees()).abs(),
-        (cal.mount.tilt_zero_deg - m.tilt_zero_rad.to_degrees()).abs(),
-        (cal.mount.level_roll_deg - m.roll_rad.to_degrees()).abs(),
-        (cal.mount.level_pitch_deg - m.pitch_rad.to_degrees()).abs(),
-    ];
-    println!("mount errors (pan zero, tilt zero, roll, pitch): {errors:?} degrees");
-    assert!(errors.iter().all(|&e| e < 0.05), "{errors:?}");
-    let (x, y, z) = cal.head_position_m.expect("the head's place");
-    let offset = (Vector3::new(x, y, z) - Vector3::from(TRUE_HEAD)).norm();
-    println!("head position error {:.2} mm", 1e3 * offset);
-    assert!(offset < 0.005, "{offset} m");
+    let cal = calibration_within_the_goals(&file("registered.ron"));
     // The station's lens is kept; the verdict sits beside the file.
     assert_eq!(cal.intrinsics, station.camera.intrinsics);
     let quality = std::fs::read_to_string(file("registered.quality.json")).expect("quality.json");
@@ -546,22 +553,7 @@ fn a_plan_step_takes_the_calibration_photographs_and_the_session_gives_the_mount
         0,
     );
     println!("{said}");
-    let cal = campanile_config::document::load_camera_calibration(&file("camera.ron"))
-        .expect("a CameraCalibration file")
-        .value;
-    let m = true_mount();
-    let errors = [
-        (cal.mount.pan_zero_azimuth_deg - m.pan_zero_azimuth_rad.to_degrees()).abs(),
-        (cal.mount.tilt_zero_deg - m.tilt_zero_rad.to_degrees()).abs(),
-        (cal.mount.level_roll_deg - m.roll_rad.to_degrees()).abs(),
-        (cal.mount.level_pitch_deg - m.pitch_rad.to_degrees()).abs(),
-    ];
-    println!("mount errors (pan zero, tilt zero, roll, pitch): {errors:?} degrees");
-    assert!(errors.iter().all(|&e| e < 0.05), "{errors:?}");
-    let (x, y, z) = cal.head_position_m.expect("the head's place");
-    let offset = (Vector3::new(x, y, z) - Vector3::from(TRUE_HEAD)).norm();
-    println!("head position error {:.2} mm", 1e3 * offset);
-    assert!(offset < 0.005, "{offset} m");
+    calibration_within_the_goals(&file("camera.ron"));
     // The photographs, their readings and poses are left for inspection.
     let photos = file("camera-photos");
     for name in ["head.csv", "poses.ron", "station.ron"] {

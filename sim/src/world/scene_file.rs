@@ -40,7 +40,7 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, WorldError> {
                 path: t.clone(),
                 message: e.to_string(),
             })?;
-            super::target_photos::with_targets(&scene, &survey.value.targets)
+            super::target_photos::with_survey(&scene, &survey.value)
         }
         None => Ok(scene),
     }

@@ -52,6 +52,56 @@ fn geometry_error(message: String) -> WorldError {
     }
 }
 
+/// A target's plate: a square of half-side `half` about its centre, as two
+/// triangles counter-clockwise seen from the front (the normal faces out),
+/// with the plate's right and up axes and its centre.
+struct Plate {
+    triangles: [Triangle; 2],
+    right: Vector3<f64>,
+    up: Vector3<f64>,
+    centre: Vector3<f64>,
+}
+
+fn plate(t: &Target, half: f64, material: u32, surface: u32, what: &str) -> Result<Plate, WorldError> {
+    let [right, up, _normal] = t.axes().map(Vector3::from);
+    let centre = vec3(t.centre_m);
+    let corner = |a: f64, b: f64| centre + right * (a * half) + up * (b * half);
+    let (tl, tr, br, bl) = (
+        corner(-1.0, 1.0),
+        corner(1.0, 1.0),
+        corner(1.0, -1.0),
+        corner(-1.0, -1.0),
+    );
+    let pair = [
+        Triangle::new([bl, br, tr], material, surface),
+        Triangle::new([bl, tr, tl], material, surface),
+    ];
+    let [Some(a), Some(b)] = pair else {
+        return Err(geometry_error(format!("{what} {}: a degenerate plate", t.id)));
+    };
+    Ok(Plate {
+        triangles: [a, b],
+        right,
+        up,
+        centre,
+    })
+}
+
+/// `scene` with a survey's targets hung on it, of the survey's kind:
+/// AprilTags ([`with_targets`]) or the thesis's circles
+/// ([`with_circle_targets`]).
+pub fn with_survey(
+    scene: &LoadedScene,
+    survey: &campanile_config::targets::Targets,
+) -> Result<LoadedScene, WorldError> {
+    match survey.kind {
+        campanile_config::targets::TargetKind::Coded => with_targets(scene, &survey.targets),
+        campanile_config::targets::TargetKind::Circle(radius_m) => {
+            with_circle_targets(scene, &survey.targets, radius_m)
+        }
+    }
+}
+
 /// `scene` with `targets` hung on it (module doc). Targets are flat plates
 /// standing free: they need not lie on a surface (a false target can
 /// hang in the air in front of the wall it pretends to be on).
@@ -65,26 +115,14 @@ pub fn with_targets(scene: &LoadedScene, targets: &[Target]) -> Result<LoadedSce
     for t in targets {
         let (width, cells) =
             tag36h11_cells(t.id).ok_or_else(|| geometry_error(format!("target {}: not a tag36h11 id", t.id)))?;
-        let [right, up, _normal] = t.axes().map(Vector3::from);
         let cell = t.size_m / TAG36H11_BORDER_CELLS as f64;
         let half = 0.5 * (width as f64 + 2.0) * cell;
-        let centre = vec3(t.centre_m);
-        let corner = |a: f64, b: f64| centre + right * (a * half) + up * (b * half);
-        let (tl, tr, br, bl) = (
-            corner(-1.0, 1.0),
-            corner(1.0, 1.0),
-            corner(1.0, -1.0),
-            corner(-1.0, -1.0),
-        );
-        let material = materials.len() as u32;
-        // Counter-clockwise seen from the front: the normal faces out.
-        let pair = [
-            Triangle::new([bl, br, tr], material, surface),
-            Triangle::new([bl, tr, tl], material, surface),
-        ];
-        let [Some(a), Some(b)] = pair else {
-            return Err(geometry_error(format!("target {}: a degenerate plate", t.id)));
-        };
+        let Plate {
+            triangles: [a, b],
+            right,
+            up,
+            centre,
+        } = plate(t, half, materials.len() as u32, surface, "target")?;
         // The pattern's axes in the face's texture axes (s, t).
         let [s_axis, t_axis] = a.texture_axes;
         let texture = Texture::Pattern {
@@ -133,24 +171,11 @@ pub fn with_circle_targets(scene: &LoadedScene, targets: &[Target], radius_m: f6
                 t.id, t.size_m
             )));
         }
-        let [right, up, _normal] = t.axes().map(Vector3::from);
-        let half = 0.5 * t.size_m;
-        let centre = vec3(t.centre_m);
-        let corner = |a: f64, b: f64| centre + right * (a * half) + up * (b * half);
-        let (tl, tr, br, bl) = (
-            corner(-1.0, 1.0),
-            corner(1.0, 1.0),
-            corner(1.0, -1.0),
-            corner(-1.0, -1.0),
-        );
-        let material = materials.len() as u32;
-        let pair = [
-            Triangle::new([bl, br, tr], material, surface),
-            Triangle::new([bl, tr, tl], material, surface),
-        ];
-        let [Some(a), Some(b)] = pair else {
-            return Err(geometry_error(format!("circle target {}: a degenerate plate", t.id)));
-        };
+        let Plate {
+            triangles: [a, b],
+            centre,
+            ..
+        } = plate(t, 0.5 * t.size_m, materials.len() as u32, surface, "circle target")?;
         let [s_axis, t_axis] = a.texture_axes;
         let texture = Texture::Disc {
             centre_st: [centre.dot(&s_axis), centre.dot(&t_axis)],
