@@ -60,8 +60,12 @@ fn device_label(device: Option<&DeviceRef>) -> String {
     }
 }
 
-/// The camera `device` names among those detected.
-fn pick<'a>(found: &'a [CameraDescriptor], device: Option<&DeviceRef>) -> Result<&'a CameraDescriptor, DeviceError> {
+/// The camera `device` names among those detected (the first when it
+/// names none); a clear error listing what was found when none matches.
+pub fn pick<'a>(
+    found: &'a [CameraDescriptor],
+    device: Option<&DeviceRef>,
+) -> Result<&'a CameraDescriptor, DeviceError> {
     let listed = || {
         let l: Vec<String> = found.iter().map(|d| format!("{} at {}", d.model, d.port)).collect();
         if l.is_empty() { "none".to_owned() } else { l.join(", ") }
@@ -228,80 +232,5 @@ impl Tether for Gphoto2Tether {
             tracing::info!(camera = %self.name, file = %path, "left on the camera: {e}");
         }
         Ok(data.into_vec())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn descriptors() -> Vec<CameraDescriptor> {
-        vec![
-            CameraDescriptor {
-                model: "Canon EOS 5D Mark II".into(),
-                port: "usb:001,004".into(),
-            },
-            CameraDescriptor {
-                model: "Nikon DSC D7000".into(),
-                port: "usb:001,007".into(),
-            },
-        ]
-    }
-
-    #[test]
-    fn the_device_picks_by_port_model_or_index() {
-        let found = descriptors();
-        assert_eq!(pick(&found, None).unwrap().model, "Canon EOS 5D Mark II");
-        let by_port = pick(&found, Some(&DeviceRef::Path("usb:001,007".into()))).unwrap();
-        assert_eq!(by_port.model, "Nikon DSC D7000");
-        let by_model = pick(&found, Some(&DeviceRef::Path("Nikon DSC D7000".into()))).unwrap();
-        assert_eq!(by_model.port, "usb:001,007");
-        assert_eq!(pick(&found, Some(&DeviceRef::Index(1))).unwrap().port, "usb:001,007");
-        let err = pick(&found, Some(&DeviceRef::Index(2))).unwrap_err().to_string();
-        assert!(
-            err.contains("camera number 2") && err.contains("Nikon DSC D7000 at usb:001,007"),
-            "{err}"
-        );
-        let err = pick(&[], None).unwrap_err().to_string();
-        assert!(
-            err.starts_with("camera failure: gphoto2 finds no camera (cameras found: none); check")
-                && err.contains("PTP"),
-            "{err}"
-        );
-    }
-
-    /// No camera is attached where the tests run: opening is a clear error,
-    /// not a panic, whether the camera is asked for by default, port or
-    /// model.
-    #[test]
-    fn opening_with_no_camera_attached_is_a_clear_error() {
-        let station = campanile_config::load_station(
-            &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/real-station.ron"),
-        )
-        .unwrap()
-        .value;
-        let mut cfg = station.camera.clone();
-        cfg.driver = campanile_config::camera::CameraDriver::Gphoto2;
-        for device in [
-            None,
-            Some(DeviceRef::Path("usb:999,999".into())),
-            Some(DeviceRef::Path("Canon EOS 5D Mark II".into())),
-        ] {
-            cfg.device = device.clone();
-            let err = Gphoto2Tether::open(cfg.device.as_ref()).unwrap_err();
-            assert!(matches!(err, DeviceError::Camera(_)), "{device:?}: {err:?}");
-            let msg = err.to_string();
-            assert!(
-                msg.starts_with("camera failure: gphoto2 finds no camera"),
-                "{device:?}: {msg}"
-            );
-            assert!(msg.contains("(cameras found: none)"), "{device:?}: {msg}");
-            if let Some(DeviceRef::Path(p)) = &device {
-                assert!(msg.contains(&format!("matching {p} ")), "{device:?}: {msg}");
-            }
-            // Through the camera thread too.
-            let err = open(&cfg).unwrap_err().to_string();
-            assert_eq!(err, msg, "{device:?}");
-        }
     }
 }
