@@ -103,7 +103,7 @@ fn nominal_scene_text() -> String {
     assert!(text.contains(anchor), "the example scene's poses changed");
     text.replacen(
         anchor,
-        &format!("(name: \"lawn\", position_m: ({x}, {y}, {z}), azimuth_deg: {azimuth:.2}, elevation_deg: 35.0),\n        {anchor}"),
+        &format!("(name: \"lawn\", position_m: ({x}, {y}, {z}), azimuth_deg: {azimuth:.2}, elevation_deg: 18.0),\n        {anchor}"),
         1,
     )
 }
@@ -394,6 +394,183 @@ fn a_moved_tripod_is_processed_from_registered_poses_as_well_as_from_known_ones(
         "held-out {registered:?} against {known:?}"
     );
     assert!(agreement.0 < 0.01 && agreement.1 < 0.05, "per cell {agreement:?}");
+
+    // The same views as photographs taken off the head (by hand, or on a
+    // plain tripod): their journal lines lose the head reading, as
+    // `session import` writes them, and the scene's "lawn" pose becomes
+    // the pose `campanile register` measures from a photograph of the
+    // tags taken from there. Processing then turns each view by that pose,
+    // roll included (the true mount's level roll and pitch give the view
+    // one), and places it there, whatever the calibration says of the
+    // head; the sun, sky and environment frames keep the head and the
+    // registered calibration.
+    let held_session = file("session-held");
+    let lawn_head = strip_view_head_readings(&session, &held_session);
+    let lawn_photo = file("lawn.png");
+    let shot = photograph(&w, &pose_at(&m, lawn_head), &settings).expect("rendered");
+    image::save_buffer(
+        &lawn_photo,
+        &shot.rgb,
+        shot.width as u32,
+        shot.height as u32,
+        image::ExtendedColorType::Rgb8,
+    )
+    .expect("png written");
+    let lawn_poses = file("lawn-poses.ron");
+    run(
+        &[
+            "register",
+            path(&lawn_photo),
+            "--targets",
+            path(&targets_file),
+            "--station",
+            path(&station_file),
+            "--out",
+            path(&lawn_poses),
+        ],
+        0,
+    );
+    let registered_lawn: campanile_session::register_files::RegisteredPoses =
+        ron::from_str(&std::fs::read_to_string(&lawn_poses).expect("poses")).expect("a RegisteredPoses file");
+    let lawn = &registered_lawn.poses[0];
+    let truth = pose_at(&m, lawn_head);
+    println!(
+        "the lawn view registered: position {:.2} mm off, azimuth {:.4}°, elevation {:.4}°, roll {:.4}° (true roll {:.4}°)",
+        1e3 * (Vector3::new(lawn.position_m.0, lawn.position_m.1, lawn.position_m.2) - truth.centre).norm(),
+        lawn.azimuth_deg - truth.azimuth_deg(),
+        lawn.elevation_deg - truth.elevation_deg(),
+        lawn.roll_deg - truth.roll_deg(),
+        truth.roll_deg()
+    );
+    let held_scene = |roll_deg: f64| {
+        let (x, y, z) = lawn.position_m;
+        let text = nominal_scene_text();
+        let start = text.find("(name: \"lawn\"").expect("the lawn pose");
+        let end = start + text[start..].find('\n').expect("its line's end");
+        format!(
+            "{}(name: \"lawn\", position_m: ({x}, {y}, {z}), azimuth_deg: {}, elevation_deg: {}, roll_deg: {roll_deg}),{}",
+            &text[..start],
+            lawn.azimuth_deg,
+            lawn.elevation_deg,
+            &text[end..]
+        )
+    };
+    std::fs::write(file("held-scene.ron"), held_scene(lawn.roll_deg)).expect("scene");
+    std::fs::write(file("level-scene.ron"), held_scene(0.0)).expect("scene");
+    stage("views taken off the head, their pose registered");
+    let mut held_figures = Vec::new();
+    for (name, scene_file) in [
+        ("held", file("held-scene.ron")),
+        ("held, roll dropped", file("level-scene.ron")),
+    ] {
+        let out = file(&format!("processed-{}", name.replace([' ', ','], "-")));
+        let calibration = file("registered.ron");
+        let args = [
+            "-q",
+            "process",
+            path(&held_session),
+            "--scene",
+            path(&scene_file),
+            "--out",
+            path(&out),
+            "--camera-calibration",
+            path(&calibration),
+        ];
+        run(&args, 0);
+        let (median, p95, cells) = albedo_error(&out, &truth_world, &nominal_scene.scene);
+        let held = held_out_block_rmse(&out);
+        println!(
+            "{name:>10}: ρ_se error median {:.1}% p95 {:.1}% over {cells} cells; held-out RMSE per 4×4 block {:.1}%",
+            100.0 * median,
+            100.0 * p95,
+            100.0 * held
+        );
+        held_figures.push((median, p95, held));
+        stage(name);
+    }
+    let [held, level] = [held_figures[0], held_figures[1]];
+    let held_agreement = cell_agreement(&file("processed-held"), &file("processed-known"), &nominal_scene.scene);
+    println!(
+        "held against known, per cell: median {:.2}%, p95 {:.2}%",
+        100.0 * held_agreement.0,
+        100.0 * held_agreement.1
+    );
+    // The bounds of the registered run above: the views' own registered
+    // pose serves as well as the head through a registered mount.
+    assert!(held.0 <= known.0 + 0.005, "median {held:?} against {known:?}");
+    assert!(held.2 <= known.2 + 0.005, "held-out {held:?} against {known:?}");
+    assert!(
+        held_agreement.0 < 0.01 && held_agreement.1 < 0.05,
+        "per cell {held_agreement:?}"
+    );
+    // The view's roll (0.6° from the true mount's level roll and pitch) is
+    // used: dropped, the held-out blocks are worse by more than 0.3 points
+    // (measured 7.3% → 7.9%, p95 of ρ_se 8.1% → 10.0%).
+    assert!(level.2 > held.2 + 0.003, "roll dropped {level:?} against {held:?}");
+}
+
+/// Copies the session at `from` to `to` with the head readings of the
+/// "lawn" views' frames removed from the journal (as `session import`
+/// writes a photograph taken off the head); returns their head reading
+/// (one for every such frame: the head was sent to one pose).
+fn strip_view_head_readings(from: &Path, to: &Path) -> HeadPose {
+    copy_dir(from, to);
+    let journal = to.join("journal.jsonl");
+    let text = std::fs::read_to_string(&journal).expect("journal");
+    // The plan's view steps: morning s3 (Views) and s4 (the dense
+    // bracket), afternoon and held-out s2.
+    let views = ["morning@", "afternoon@", "held-out@"];
+    let is_view = |key: &str| {
+        let step = key.split('/').nth(1).unwrap_or_default();
+        views.iter().any(|v| key.starts_with(v))
+            && if key.starts_with("morning@") {
+                step == "s3" || step == "s4"
+            } else {
+                step == "s2"
+            }
+    };
+    let mut reading: Option<(f64, f64)> = None;
+    let mut stripped = 0;
+    let mut lines = Vec::new();
+    for line in text.lines() {
+        let mut v: serde_json::Value = serde_json::from_str(line).expect("a journal line");
+        let taken = matches!(v["status"].as_str(), Some("done" | "late"));
+        if taken && v["key"].as_str().is_some_and(is_view) {
+            let meta = &mut v["meta"];
+            let pan = meta["pose_reached"]["pan_deg"].as_f64().expect("a head reading");
+            let tilt = meta["pose_reached"]["tilt_deg"].as_f64().expect("a head reading");
+            let first = *reading.get_or_insert((pan, tilt));
+            assert!(
+                (first.0 - pan).abs() < 1e-9 && (first.1 - tilt).abs() < 1e-9,
+                "the lawn views were taken at one head reading: {first:?} and {:?}",
+                (pan, tilt)
+            );
+            meta["pose_reached"] = serde_json::Value::Null;
+            meta["pose_requested"] = serde_json::Value::Null;
+            stripped += 1;
+        }
+        lines.push(serde_json::to_string(&v).expect("json"));
+    }
+    assert!(stripped > 20, "{stripped} view frames");
+    std::fs::write(&journal, lines.join("\n") + "\n").expect("journal written");
+    let (pan, tilt) = reading.expect("view frames");
+    HeadPose {
+        pan_rad: pan.to_radians(),
+        tilt_rad: tilt.to_radians(),
+    }
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("directory");
+    for entry in std::fs::read_dir(from).expect("a directory") {
+        let entry = entry.expect("an entry");
+        let target = to.join(entry.file_name());
+        if entry.file_type().expect("a type").is_dir() {
+            copy_dir(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).expect("copied");
+        }
+    }
 }
 
 /// A poses file written straight from the truth (no photographs), with

@@ -138,7 +138,13 @@ fn real_jpeg_brackets_become_a_session_that_process_takes() {
     // SKY_6960: IMG_6960 (0.4 s, 15:45:17.57) ten minutes later.
     assert_eq!(meta(18, "time"), "2017-07-13T22:55:15.070Z");
     assert_eq!(meta(18, "exposure_actual_s"), 0.4);
+    // Without a scene, the views and the sky bracket go through the head
+    // and the estimated mount (level, its pan zero north): the views at
+    // azimuth 180°, the sky at azimuth 90°, elevation 45°.
     assert_eq!(meta(0, "pose_reached")["pan_deg"], 180.0);
+    let reached = |f: &str| meta(18, "pose_reached")[f].as_f64().expect("a head reading");
+    assert!((reached("pan_deg") - 90.0).abs() < 1e-9, "{}", lines[18]);
+    assert!((reached("tilt_deg") - 45.0).abs() < 1e-9, "{}", lines[18]);
     // Byte for byte.
     let file = lines[0]["file"].as_str().unwrap();
     assert_eq!(std::fs::read(session.join(file)).unwrap(), fixture("IMG_6955.JPG"));
@@ -171,6 +177,51 @@ fn real_jpeg_brackets_become_a_session_that_process_takes() {
     ] {
         assert!(quality.contains(said), "{said:?} not in {quality}");
     }
+}
+
+/// With a scene, a view is taken off the head: its frames journal no head
+/// reading, and its pose (roll included) is kept among the scene's poses,
+/// which `process` turns it by; without a scene a roll is refused.
+#[test]
+fn a_view_imported_with_a_scene_keeps_its_rolled_pose() {
+    let dir = tempfile::tempdir().expect("temp");
+    let photos = folder(dir.path(), false);
+    let poses = dir.path().join("rolled.ron");
+    std::fs::write(
+        &poses,
+        r#"ImportPoses(brackets: [
+    (files: "IMG_*.JPG", position_m: (3.0, -20.0, 1.5), azimuth_deg: 170.0, elevation_deg: 10.0, roll_deg: -4.5),
+])"#,
+    )
+    .unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/campanile-scene.ron");
+    let session = dir.path().join("session");
+    let clock = ["--clock-offset-s", "0", "--utc-offset", "-07:00"];
+    let mut extra = clock.to_vec();
+    extra.extend(["--scene", s(&scene)]);
+    let o = import(&photos, &session, &poses, &extra);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let journal = std::fs::read_to_string(session.join("journal.jsonl")).unwrap();
+    for line in journal.lines() {
+        let v: serde_json::Value = serde_json::from_str(line).unwrap();
+        assert!(v["meta"]["pose_reached"].is_null(), "{line}");
+        assert!(v["meta"]["pose_requested"].is_null(), "{line}");
+    }
+    let snapshot = std::fs::read_to_string(session.join("scene.ron")).unwrap();
+    let scene: campanile_config::Scene = ron::from_str(&snapshot).unwrap();
+    let pose = scene.pose("import-IMG_6955").expect("the made pose");
+    assert_eq!(
+        (pose.position_m, pose.azimuth_deg, pose.elevation_deg, pose.roll_deg),
+        ((3.0, -20.0, 1.5), 170.0, 10.0, -4.5)
+    );
+
+    let o = import(&photos, &dir.path().join("no-scene"), &poses, &clock);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        text(&o).contains("is given roll_deg -4.5: a rolled view needs --scene"),
+        "{}",
+        text(&o)
+    );
 }
 
 /// Runs an import expected to fail with exit 2 and a message holding every `want`.

@@ -19,7 +19,7 @@ use campanile_process::outdoor::zoom_albedo::ZoomReport;
 use campanile_process::outdoor::{
     Illumination, Photo, RerenderSettings, ZoomSettings, rerender, rerender_zoom, zoom_albedo,
 };
-use campanile_process::pose::{HeadPose, Mount};
+use campanile_process::pose::HeadPose;
 use campanile_process::render::CameraRig;
 use campanile_process::sky::{Atmosphere, Daylight};
 use campanile_process::sun::{Observer, sun_position};
@@ -143,7 +143,7 @@ fn albedo_image(rho: &[[f64; 3]], rig: &CameraRig) -> RadianceImage {
 /// The camera of scene pose `pose` at `width` × `height`: through the
 /// station's head and mount for a level pose, or, for a pose with a roll
 /// (a hand-held photograph's, as `campanile register` writes it), held
-/// exactly at the pose's three angles ([`Mount::holding`]).
+/// exactly at the pose's three angles ([`campanile_process::pose::Mount::holding`]).
 pub fn pose_rig(station: &Station, pose: &ScenePose, width: usize, height: usize) -> Result<CameraRig> {
     let (x, y, z) = pose.position_m;
     let (held_by, head) = if pose.roll_deg == 0.0 {
@@ -157,15 +157,13 @@ pub fn pose_rig(station: &Station, pose: &ScenePose, width: usize, height: usize
         };
         (mount(&station.head.mount), head)
     } else {
-        let held = campanile_process::registration::CameraPose::from_angles(
+        campanile_process::registration::CameraPose::from_angles(
             pose.azimuth_deg,
             pose.elevation_deg,
             pose.roll_deg,
             Vector3::zeros(),
-        );
-        let m = held.rotation.matrix();
-        let axis = |i: usize| [m[(i, 0)], m[(i, 1)], m[(i, 2)]];
-        Mount::holding(axis(0), axis(1), axis(2))
+        )
+        .holding()
     };
     Ok(CameraRig {
         pinhole: pinhole_at(&station.camera, width, height),

@@ -34,7 +34,11 @@ pub enum SessionCommand {
 ///   exposure   ExposureTime (or --times), and the effective time
 ///              t·(ISO/ISO₀)·(N₀/N)² that the journal's exposure_actual_s holds
 ///   poses      --poses POSES.ron, per bracket (first file name or pattern):
-///              a pose of --scene, or azimuth/elevation (and position)
+///              a pose of --scene (`campanile register` writes them from
+///              targets in the photographs), or azimuth/elevation (and
+///              position, roll). A view is taken off the head: it journals
+///              no head reading, and `process` turns it by its pose as it
+///              is, roll included
 ///   sky        brackets marked sky: true in the poses, or by --sky PATTERN:
 ///              processed as a sky scan
 ///   camera     --station STATION.ron (calibrated), or estimated from EXIF
@@ -48,6 +52,8 @@ pub enum SessionCommand {
 ///   ImportPoses(brackets: [
 ///       (files: "IMG_6955.JPG", pose: "view-se"),
 ///       (files: "IMG_70*.JPG", position_m: (12.0, -30.0, 1.6), azimuth_deg: 20.0, elevation_deg: 8.0),
+///       (files: "IMG_71*.JPG", position_m: (9.0, -25.0, 1.5), azimuth_deg: 35.0, elevation_deg: 12.0,
+///        roll_deg: -4.5),
 ///       (files: "SKY_*.JPG", sky: true, azimuth_deg: 0.0, elevation_deg: 90.0),
 ///   ])
 ///

@@ -106,8 +106,13 @@ pub struct ImportedBracket {
     pub pose: BracketPose,
     /// The pose name in the plan.
     pub pose_name: String,
-    /// The head's (pan, tilt), degrees.
-    pub head_deg: (f64, f64),
+    /// The head's (pan, tilt), degrees, journaled for a sky bracket (fitted
+    /// as a sky scan's tiles are, through the station's mount) and for a
+    /// view imported without a scene. `None` for a view with a scene: a
+    /// photograph taken off the head has no head reading, and processing
+    /// takes its scene pose as it is (its roll too, as `campanile register`
+    /// measures it).
+    pub head_deg: Option<(f64, f64)>,
     /// Its key prefix, `{occurrence}/s{step}/t{target}`.
     pub group: String,
 }
@@ -405,18 +410,36 @@ pub fn plan_import(opts: &ImportOptions, progress: &dyn Fn(usize, usize)) -> Res
                     position_m: pose.position_m.map_or((0.0, 0.0, 0.0), |p| (p[0], p[1], p[2])),
                     azimuth_deg: pose.azimuth_deg.rem_euclid(360.0),
                     elevation_deg: pose.elevation_deg,
-                    roll_deg: 0.0,
+                    roll_deg: pose.roll_deg,
                 });
                 name
             }
         };
-        let head_deg =
-            crate::controller::aim::head_angles(&station, pose.azimuth_deg, pose.elevation_deg).ok_or_else(|| {
-                ImportError::Description(format!(
-                    "the bracket {first} … {last}: azimuth {}° elevation {}° is outside the station's head limits",
-                    pose.azimuth_deg, pose.elevation_deg
-                ))
-            })?;
+        // A view's pose is kept in the scene (the given scene's pose, or one
+        // made for it), and processing takes it from there; without a scene
+        // the view is journaled as a head reading, which cannot roll.
+        if scene.is_none() && pose.roll_deg != 0.0 {
+            return Err(ImportError::Description(format!(
+                "the bracket {first} … {last} is given roll_deg {}: a rolled view needs --scene (its pose is \
+                 kept among the scene's poses)",
+                pose.roll_deg
+            )));
+        }
+        let head_deg = if pose.sky || scene.is_none() {
+            Some(
+                crate::controller::aim::head_angles(&station, pose.azimuth_deg, pose.elevation_deg).ok_or_else(
+                    || {
+                        ImportError::Description(format!(
+                            "the bracket {first} … {last}: azimuth {}° elevation {}° is outside the station's head \
+                             limits",
+                            pose.azimuth_deg, pose.elevation_deg
+                        ))
+                    },
+                )?,
+            )
+        } else {
+            None
+        };
         firsts.push(&frames[g.frames[0]].file.name);
         placed_brackets.push(ImportedBracket {
             frames: members,
@@ -676,13 +699,10 @@ pub fn write_session(
                     bytes,
                 }),
             };
-            let head = PoseDeg {
-                pan_deg: b.head_deg.0,
-                tilt_deg: b.head_deg.1,
-            };
+            let head = b.head_deg.map(|(pan_deg, tilt_deg)| PoseDeg { pan_deg, tilt_deg });
             let mut meta = FrameMeta::from_frame(&frame, ShotKind::Data);
-            meta.pose_requested = Some(head);
-            meta.pose_reached = Some(head);
+            meta.pose_requested = head;
+            meta.pose_reached = head;
             meta.notes.push(format!(
                 "imported from {}: DateTimeOriginal {}, {}{}{}",
                 f.file.name,
@@ -718,7 +738,7 @@ pub fn write_session(
             azimuth_deg: b.pose.azimuth_deg,
             elevation_deg: b.pose.elevation_deg,
             position_m: b.pose.position_m,
-            head_deg: [b.head_deg.0, b.head_deg.1],
+            head_deg: b.head_deg.map(|(pan, tilt)| [pan, tilt]),
             from: b.pose.from_entry.clone(),
             began: b.began.clone(),
             frames,

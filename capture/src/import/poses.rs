@@ -1,8 +1,8 @@
 //! Where each bracket was taken from: a poses file (`--poses`) mapping
 //! brackets, by their first file's name or a pattern of it, to a named
 //! pose of the scene or to a position and direction, and marking sky
-//! brackets. Registration from targets (thesis chapter 3) is another
-//! issue; until then poses are given.
+//! brackets. Poses are given: measured, or registered from targets in the
+//! photographs (`campanile register`, thesis §3.3) into the scene's poses.
 //!
 //! ```ron
 //! ImportPoses(
@@ -10,6 +10,8 @@
 //!         (files: "IMG_6955.JPG", pose: "view-se"),          // a pose of --scene
 //!         (files: "IMG_70*.JPG", position_m: (12.0, -30.0, 1.6),
 //!          azimuth_deg: 20.0, elevation_deg: 8.0),          // or where and which way
+//!         (files: "IMG_71*.JPG", position_m: (9.0, -25.0, 1.5),
+//!          azimuth_deg: 35.0, elevation_deg: 12.0, roll_deg: -4.5), // and turned
 //!         (files: "SKY_*.JPG", sky: true, azimuth_deg: 0.0, elevation_deg: 90.0),
 //!     ],
 //! )
@@ -17,6 +19,13 @@
 //!
 //! Patterns take `*` and `?` ([`super::name_pattern`]); the first entry
 //! whose pattern matches a bracket's first file name is its pose.
+//!
+//! A view's pose is taken as it is: the bracket was taken off the head (by
+//! hand, or on a plain tripod), so it journals no head reading, and
+//! processing turns the camera by the pose's azimuth, elevation and roll
+//! (the scene's `poses`, which `campanile register` writes from targets,
+//! carry all three). A sky bracket goes through the station's head and
+//! mount, as a sky scan's tiles do.
 
 use std::path::Path;
 
@@ -53,6 +62,11 @@ pub struct PoseEntry {
     /// Elevation of the optical axis, degrees.
     #[serde(default)]
     pub elevation_deg: Option<f64>,
+    /// Roll about the optical axis, degrees (as `campanile register`
+    /// measures it: positive when the image turns clockwise as seen by the
+    /// photographer); 0 when not given.
+    #[serde(default)]
+    pub roll_deg: Option<f64>,
     /// The bracket is of the sky (a sky frame, fitted as a sky scan is).
     #[serde(default)]
     pub sky: bool,
@@ -69,6 +83,8 @@ pub struct BracketPose {
     pub azimuth_deg: f64,
     /// Elevation of the optical axis, degrees.
     pub elevation_deg: f64,
+    /// Roll about the optical axis, degrees.
+    pub roll_deg: f64,
     /// Which entry (its `files` pattern) gave it.
     pub from_entry: String,
     /// A sky bracket.
@@ -88,10 +104,10 @@ pub fn read_poses(path: &Path) -> Result<ImportPoses, ImportError> {
             ))
         };
         match (&e.pose, e.azimuth_deg, e.elevation_deg) {
-            (Some(_), None, None) if e.position_m.is_none() => {}
+            (Some(_), None, None) if e.position_m.is_none() && e.roll_deg.is_none() => {}
             (Some(_), _, _) => {
                 return Err(bad(
-                    "give either pose or position_m/azimuth_deg/elevation_deg, not both",
+                    "give either pose or position_m/azimuth_deg/elevation_deg/roll_deg, not both",
                 ));
             }
             (None, Some(az), Some(el)) => {
@@ -107,6 +123,16 @@ pub fn read_poses(path: &Path) -> Result<ImportPoses, ImportError> {
                     "no pose: expected pose: \"NAME\" (a pose of the scene) or azimuth_deg and elevation_deg",
                 ));
             }
+        }
+        if let Some(r) = e.roll_deg
+            && !(r.is_finite() && (-180.0..=180.0).contains(&r))
+        {
+            return Err(bad(&format!("roll_deg is {r}: expected degrees in [-180, 180]")));
+        }
+        if e.sky && e.roll_deg.is_some_and(|r| r != 0.0) {
+            return Err(bad(
+                "a sky bracket takes no roll_deg: it is fitted through the station's head and mount",
+            ));
         }
         if let Some(p) = e.position_m
             && ![p.0, p.1, p.2].iter().all(|v| v.is_finite())
@@ -144,6 +170,7 @@ impl ImportPoses {
                     position_m: Some([pose.position_m.0, pose.position_m.1, pose.position_m.2]),
                     azimuth_deg: pose.azimuth_deg,
                     elevation_deg: pose.elevation_deg,
+                    roll_deg: pose.roll_deg,
                     from_entry: e.files.clone(),
                     sky: e.sky,
                 }
@@ -153,6 +180,7 @@ impl ImportPoses {
                 position_m: e.position_m.map(|p| [p.0, p.1, p.2]),
                 azimuth_deg: e.azimuth_deg.unwrap_or_default(),
                 elevation_deg: e.elevation_deg.unwrap_or_default(),
+                roll_deg: e.roll_deg.unwrap_or_default(),
                 from_entry: e.files.clone(),
                 sky: e.sky,
             },

@@ -64,8 +64,12 @@ pub struct ImportedBracketRecord {
     pub elevation_deg: f64,
     /// Where the camera stood, metres, if given.
     pub position_m: Option<[f64; 3]>,
-    /// The head's pan and tilt journaled, degrees.
-    pub head_deg: [f64; 2],
+    /// The head's pan and tilt journaled, degrees: a sky bracket's, or a
+    /// view's imported without a scene. `None` for a view with a scene
+    /// (taken off the head: processing takes its scene pose as it is);
+    /// earlier imports journaled one for every bracket.
+    #[serde(default)]
+    pub head_deg: Option<[f64; 2]>,
     /// The poses-file entry (or `--sky` pattern) that gave it.
     pub from: String,
     /// Why the bracket began where it did.

@@ -4,7 +4,7 @@
 use chrono::{DateTime, Utc};
 
 use crate::camera::image::CodeImage;
-use crate::pose::HeadPose;
+use crate::pose::{HeadPose, Mount};
 
 /// What a frame was taken for (from the plan step that took it).
 #[derive(Debug, Clone, PartialEq)]
@@ -44,9 +44,15 @@ pub struct CapturedFrame {
     pub time: DateTime<Utc>,
     /// What for.
     pub purpose: Purpose,
-    /// The head's reading.
+    /// The head's reading; for a photograph taken off the head, the head
+    /// pose that goes with [`CapturedFrame::held_by`].
     pub head: HeadPose,
-    /// Where the head stood, scene frame, metres.
+    /// For a photograph taken off the head (by hand, or on a plain
+    /// tripod; an imported one): its own orientation as a mount
+    /// ([`Mount::holding`]), which replaces the station's. `None` for the
+    /// station's head, through the station's mount.
+    pub held_by: Option<Mount>,
+    /// Where the head (or the hand-held camera) stood, scene frame, metres.
     pub position_m: [f64; 3],
     /// The exposure the camera reports it applied, seconds.
     pub exposure_s: f64,

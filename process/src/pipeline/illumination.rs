@@ -67,7 +67,7 @@ fn sky_frame<'a>(g: &'a MergedGroup, valid: &'a [bool], optics: &StationOptics) 
         rgb: &g.map.rgb,
         valid: Some(valid),
         camera: g.pinhole,
-        mount: optics.mount,
+        mount: g.mount(&optics.mount),
         pose: g.head,
     }
 }
@@ -290,7 +290,7 @@ pub fn sky_fisheye(
                 let Some(d) = g.pinhole.unproject(x as f64 + 0.5, y as f64 + 0.5) else {
                     continue;
                 };
-                let d = optics.mount.to_world(g.head, d);
+                let d = g.mount(&optics.mount).to_world(g.head, d);
                 if d[2] > 0.0 {
                     points.push((d, value(d, f64::from(g.map.rgb[3 * p + channel]))));
                 }

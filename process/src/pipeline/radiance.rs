@@ -6,7 +6,7 @@ use super::{FrameGroup, PipelineError, Purpose, StationOptics};
 use crate::hdr::bracket::Bracket;
 use crate::hdr::curve::ResponseCurve;
 use crate::hdr::merge::{MergeOptions, RadianceMap, merge};
-use crate::pose::{HeadPose, Pinhole};
+use crate::pose::{HeadPose, Mount, Pinhole};
 
 /// One merged group: a radiance map and where it looked.
 #[derive(Debug, Clone)]
@@ -23,12 +23,23 @@ pub struct MergedGroup {
     pub time: chrono::DateTime<chrono::Utc>,
     /// Mean head reading.
     pub head: HeadPose,
+    /// A photograph's own orientation when taken off the head
+    /// ([`super::CapturedFrame::held_by`]); `None` for the station's head.
+    pub held_by: Option<Mount>,
     /// Where the head stood, metres.
     pub position_m: [f64; 3],
     /// The intrinsics at the map's size.
     pub pinhole: Pinhole,
     /// Radiance (W·m⁻²·sr⁻¹ under the full-well gauge), variance and mask.
     pub map: RadianceMap,
+}
+
+impl MergedGroup {
+    /// How the camera was held: the photograph's own orientation when it
+    /// was taken off the head, else the station's mount (`station`).
+    pub fn mount(&self, station: &Mount) -> Mount {
+        self.held_by.unwrap_or(*station)
+    }
 }
 
 /// Merges every group through `curve`. Sun groups are merged frame by frame
@@ -78,6 +89,7 @@ pub fn merge_groups(
                 purpose: first.purpose.clone(),
                 time: super::mean_time(&frames.iter().map(|f| f.time).collect::<Vec<_>>()),
                 head,
+                held_by: first.held_by,
                 position_m: first.position_m,
                 pinhole: optics.pinhole_at(map.width, map.height),
                 map,

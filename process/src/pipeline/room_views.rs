@@ -251,6 +251,7 @@ mod tests {
             purpose: Purpose::View { pose: "p".into() },
             time: chrono::DateTime::UNIX_EPOCH,
             head,
+            held_by: None,
             position_m: [1.0, 2.0, 1.5],
             pinhole,
             map: RadianceMap {

@@ -2,7 +2,7 @@
 
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
-use crate::pose::Pinhole;
+use crate::pose::{HeadPose, Mount, Pinhole};
 
 /// Where a camera was and how it was turned: a world point `X` is seen in
 /// the camera frame at `R (X − C)`.
@@ -56,6 +56,16 @@ impl CameraPose {
         let right = level_right * cr + level_down * sr;
         let down = forward.cross(&right);
         CameraPose::from_axes(right, down, forward, centre)
+    }
+
+    /// The mount and head reading that turn a camera as this pose is
+    /// turned ([`Mount::holding`]): how a photograph taken off the head,
+    /// hand-held or rolled, goes through the head's kinematics (its
+    /// position is [`CameraPose::centre`]).
+    pub fn holding(&self) -> (Mount, HeadPose) {
+        let m = self.rotation.matrix();
+        let axis = |i: usize| [m[(i, 0)], m[(i, 1)], m[(i, 2)]];
+        Mount::holding(axis(0), axis(1), axis(2))
     }
 
     /// Azimuth of the optical axis, degrees from north through east, in [0, 360).

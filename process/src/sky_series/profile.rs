@@ -71,7 +71,7 @@ pub fn meridian_profile(
                 let Some(d) = g.pinhole.unproject(x as f64 + 0.5, y as f64 + 0.5) else {
                     continue;
                 };
-                let d = optics.mount.to_world(g.head, d);
+                let d = g.mount(&optics.mount).to_world(g.head, d);
                 let off = d[0] * n[0] + d[1] * n[1];
                 if d[2] <= 0.0 || off.abs() > max_off || angle_between(d, sun_dir) < SUN_MARGIN_RAD {
                     continue;

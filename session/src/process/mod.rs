@@ -406,7 +406,7 @@ pub fn outdoor_sections(
         .ok_or_else(|| anyhow::anyhow!("no training view"))?;
     let rig = campanile_process::render::CameraRig {
         pinhole: view.pinhole,
-        mount: p.optics.mount,
+        mount: view.mount(&p.optics.mount),
         head: view.head,
         position: nalgebra::Vector3::from(view.position_m),
         width: view.map.width,

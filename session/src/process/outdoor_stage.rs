@@ -95,11 +95,12 @@ pub fn targets(p: &Processed, scene: &Scene) -> Result<Vec<usize>> {
         .collect()
 }
 
-/// The camera of merged group `g` (its head pose and the station's mount).
+/// The camera of merged group `g` (its head pose and the station's mount,
+/// or a photograph's own orientation when it was taken off the head).
 pub fn rig_of(p: &Processed, g: &MergedGroup) -> CameraRig {
     CameraRig {
         pinhole: g.pinhole,
-        mount: p.optics.mount,
+        mount: g.mount(&p.optics.mount),
         head: g.head,
         position: Vector3::from(g.position_m),
         width: g.map.width,

@@ -207,7 +207,7 @@ pub fn room_stage(p: &Processed, out: &Path, opts: &RoomOptions) -> Result<RoomP
         use rayon::prelude::*;
         chosen
             .par_iter()
-            .map(|(pose, g)| (pose.to_string(), *g, rectify(g, &p.optics.mount, opts.scale)))
+            .map(|(pose, g)| (pose.to_string(), *g, rectify(g, &g.mount(&p.optics.mount), opts.scale)))
             .collect()
     };
     let mut cameras = Vec::new();
@@ -273,7 +273,7 @@ pub fn room_stage(p: &Processed, out: &Path, opts: &RoomOptions) -> Result<RoomP
                 let cam = rectified_camera(
                     &g.pinhole,
                     (g.map.width, g.map.height),
-                    &p.optics.mount,
+                    &g.mount(&p.optics.mount),
                     g.head,
                     g.position_m,
                     1.0,
@@ -290,7 +290,10 @@ pub fn room_stage(p: &Processed, out: &Path, opts: &RoomOptions) -> Result<RoomP
                 } else {
                     None
                 };
-                (pose.to_string(), v.unwrap_or_else(|| rectify(g, &p.optics.mount, 1.0)))
+                (
+                    pose.to_string(),
+                    v.unwrap_or_else(|| rectify(g, &g.mount(&p.optics.mount), 1.0)),
+                )
             })
             .collect()
     };

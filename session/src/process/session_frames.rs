@@ -12,8 +12,10 @@ use campanile_config::source::SourceFile;
 use campanile_config::{Plan, Scene, Station};
 use campanile_process::hdr::linear_codes;
 use campanile_process::pipeline::{CapturedFrame, Purpose, clip_lossy_top};
-use campanile_process::pose::HeadPose;
+use campanile_process::pose::{HeadPose, Mount};
+use campanile_process::registration::CameraPose;
 use indicatif::ProgressBar;
+use nalgebra::Vector3;
 use rayon::prelude::*;
 
 /// A session's descriptions, parsed from its snapshot.
@@ -133,12 +135,28 @@ impl SessionInputs {
             if let Some(p) = pos {
                 position = p;
             }
-            described.push((purpose, self.head_position.unwrap_or(position)));
+            let (head, held_by, position_m) = match e.meta.pose_reached.or(e.meta.pose_requested) {
+                Some(pose) => (
+                    HeadPose {
+                        pan_rad: pose.pan_deg.to_radians(),
+                        tilt_rad: pose.tilt_deg.to_radians(),
+                    },
+                    None,
+                    self.head_position.unwrap_or(position),
+                ),
+                // A photograph taken off the head stood where its pose
+                // says, wherever a calibration put the head.
+                None => {
+                    let (mount, head, at) = self.held(e, &purpose)?;
+                    (head, Some(mount), at)
+                }
+            };
+            described.push((purpose, head, held_by, position_m));
         }
         let frames: Result<Vec<CapturedFrame>> = entries
             .par_iter()
             .zip(described)
-            .map(|(e, (purpose, position_m))| {
+            .map(|(e, (purpose, head, held_by, position_m))| {
                 // A frame file that is missing, damaged or undecodable is
                 // bad input (exit 2), named by the store's error.
                 let mut codes = self
@@ -156,13 +174,6 @@ impl SessionInputs {
                     codes = linear_codes::log_codes_of_linear(&codes, 0.0);
                 }
                 bar.inc(1);
-                let pose = e.meta.pose_reached.or(e.meta.pose_requested).ok_or_else(|| {
-                    anyhow!(
-                        "{}: journal line of {:?} has no head pose",
-                        self.reader.dir().display(),
-                        e.key
-                    )
-                })?;
                 let filter_transmittance = match &e.meta.filter {
                     None => [1.0; 3],
                     Some(name) => self
@@ -186,10 +197,8 @@ impl SessionInputs {
                     held_out,
                     time: e.meta.time,
                     purpose,
-                    head: HeadPose {
-                        pan_rad: pose.pan_deg.to_radians(),
-                        tilt_rad: pose.tilt_deg.to_radians(),
-                    },
+                    head,
+                    held_by,
                     position_m,
                     exposure_s: e.meta.exposure_actual_s,
                     filter_transmittance,
@@ -236,6 +245,36 @@ impl SessionInputs {
     pub fn session_of(&self, occurrence: &str) -> Option<&campanile_config::plan::Session> {
         let name = occurrence.split('@').next()?;
         self.plan.sessions.iter().find(|s| s.name == name)
+    }
+
+    /// A view taken off the head (by hand, or on a plain tripod; an
+    /// imported one), whose journal line has no head reading: the scene
+    /// pose its step names, as it is (azimuth, elevation, roll and
+    /// position, as `campanile register` measures them), through
+    /// [`CameraPose::holding`]. A frame with no head reading and no scene
+    /// pose is bad input.
+    fn held(&self, e: &FrameEntry, purpose: &Purpose) -> Result<(Mount, HeadPose, [f64; 3])> {
+        let no_pose = |why: &str| {
+            crate::error::bad_input(format!(
+                "{}: journal line of {:?} has no head reading, and {why}: a frame taken off the head needs \
+                 the scene pose it was taken from",
+                self.reader.dir().display(),
+                e.key
+            ))
+        };
+        let name = match purpose {
+            Purpose::View { pose } | Purpose::Lights { pose, .. } => pose,
+            _ => return Err(no_pose("it is not a view of a scene pose").into()),
+        };
+        let pose = self
+            .scene
+            .as_ref()
+            .and_then(|(s, _)| s.pose(name))
+            .ok_or_else(|| no_pose(&format!("the scene has no pose {name:?}")))?;
+        let (x, y, z) = pose.position_m;
+        let (mount, head) =
+            CameraPose::from_angles(pose.azimuth_deg, pose.elevation_deg, pose.roll_deg, Vector3::zeros()).holding();
+        Ok((mount, head, [x, y, z]))
     }
 
     /// What a frame was for, from its key `"{session}@{date}/s{step}/t{target}/f{frame}"`,
