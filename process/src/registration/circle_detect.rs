@@ -26,6 +26,17 @@
 //! A detection gives the five parameters of the ellipse (centre, axes,
 //! angle), its edge points (for [`super::circle_search`] to refit in the
 //! lens's undistorted frame) and its figures.
+//!
+//! **Speed, with the same results.** The integral images hold exact
+//! integer sums (`u32`, wrapping), so every score is the one `f64` sums
+//! would give; a window is first tested for contrast without divisions
+//! and its sum of squares read only if it passes; only scores above
+//! `min_ncc` are kept (no lower score can stop a local maximum), row by
+//! row in parallel. Candidates are verified in parallel a few at a time
+//! and taken in order, as if one by one. On a 2048 × 1536 photograph of
+//! 100 targets that is about 3 times faster than `f64` integral images
+//! and a full score grid per scale (BENCHMARKS.md, "Camera pose from
+//! targets").
 
 use super::ellipse::{Ellipse, fit_ellipse_robust};
 use rayon::prelude::*;
@@ -225,8 +236,8 @@ fn sweep(ii: &Integral, w: usize, h: usize, s: &CircleDetectorSettings) -> Vec<C
         let rows: Vec<Vec<(usize, f64)>> = (0..gh)
             .into_par_iter()
             .map_init(
-                || (vec![0u32; w + 1], vec![0u32; w + 1]),
-                |(inner, outer), gy| {
+                || (vec![0u32; w + 1], vec![0u32; w + 1], vec![0.0f64; gw]),
+                |(inner, outer, contrast), gy| {
                     let mut row = Vec::new();
                     let cy = ho + gy * step;
                     if cy + ho + 1 > h {
@@ -236,16 +247,34 @@ fn sweep(ii: &Integral, w: usize, h: usize, s: &CircleDetectorSettings) -> Vec<C
                     // a window's sum is then the difference of two of them.
                     ii.column_sums(cy - hi, cy + hi + 1, inner);
                     ii.column_sums(cy - ho, cy + ho + 1, outer);
-                    for gx in 0..gw {
+                    // Every window's sa n_w - sw n_a in one loop without branches
+                    // (one the compiler vectorizes at step 1); sums of windows
+                    // are below 2³¹, so as `i32` they convert exactly.
+                    let sums = |x: usize| {
+                        let sa = inner[x + ho + hi + 1].wrapping_sub(inner[x + ho - hi]) as i32;
+                        let sw = outer[x + 2 * ho + 1].wrapping_sub(outer[x]) as i32;
+                        (f64::from(sa), f64::from(sw))
+                    };
+                    if step == 1 {
+                        let (ia, ib) = (&inner[ho + hi + 1..][..gw], &inner[ho - hi..][..gw]);
+                        let (oa, ob) = (&outer[2 * ho + 1..][..gw], &outer[..gw]);
+                        for ((((c, ia), ib), oa), ob) in contrast.iter_mut().zip(ia).zip(ib).zip(oa).zip(ob) {
+                            let sa = f64::from(ia.wrapping_sub(*ib) as i32);
+                            let sw = f64::from(oa.wrapping_sub(*ob) as i32);
+                            *c = sa * n_w - sw * n_a;
+                        }
+                    } else {
+                        for (gx, c) in contrast.iter_mut().enumerate() {
+                            let (sa, sw) = sums(gx * step);
+                            *c = sa * n_w - sw * n_a;
+                        }
+                    }
+                    for (gx, c) in contrast.iter().enumerate() {
                         let cx = ho + gx * step;
-                        if cx + ho + 1 > w {
+                        if *c < reject_below || cx + ho + 1 > w {
                             continue;
                         }
-                        let sa = f64::from(inner[cx + hi + 1].wrapping_sub(inner[cx - hi]));
-                        let sw = f64::from(outer[cx + ho + 1].wrapping_sub(outer[cx - ho]));
-                        if sa * n_w - sw * n_a < reject_below {
-                            continue;
-                        }
+                        let (sa, sw) = sums(gx * step);
                         let outer_mean = (sw - sa) / (n_w - n_a);
                         // Too little contrast: the sum of squares is not needed.
                         if sa / n_a - outer_mean < s.min_contrast {
