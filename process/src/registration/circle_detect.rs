@@ -41,12 +41,17 @@
 use super::ellipse::{Ellipse, fit_ellipse_robust};
 use rayon::prelude::*;
 
+/// The largest radius swept, pixels: its window (2 × 1440 + 1 pixels a
+/// side) sums to under 2³¹ codes, as the sweep's integer sums need.
+pub const MAX_RADIUS_PX: f64 = 960.0;
+
 /// How circle targets are looked for.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CircleDetectorSettings {
     /// Smallest radius of a circle's image, pixels.
     pub min_radius_px: f64,
-    /// Largest radius, pixels (also capped at an eighth of the image's smaller side).
+    /// Largest radius, pixels (also capped at an eighth of the image's
+    /// smaller side, and at [`MAX_RADIUS_PX`]).
     pub max_radius_px: f64,
     /// Least normalized cross-correlation of a candidate (liberal).
     pub min_ncc: f64,
@@ -204,7 +209,7 @@ struct Candidate {
 /// lower neighbour cannot stop a local maximum), so a row is a short
 /// list of (column, score), in column order.
 fn sweep(ii: &Integral, w: usize, h: usize, s: &CircleDetectorSettings) -> Vec<Candidate> {
-    let r_max = s.max_radius_px.min(w.min(h) as f64 / 8.0);
+    let r_max = s.max_radius_px.min(w.min(h) as f64 / 8.0).min(MAX_RADIUS_PX);
     let mut out: Vec<Candidate> = Vec::new();
     let mut r = s.min_radius_px.max(2.0);
     while r <= r_max {
