@@ -20,7 +20,7 @@ use campanile_process::registration::circle_search::{
 };
 use campanile_process::registration::{CameraPose, RegistrationSettings, Verdict};
 use campanile_sim::world::target_photos::{
-    PhotoSettings, TargetPhoto, photograph, pose_looking, with_circle_targets, with_targets,
+    PhotoSettings, TargetPhoto, photograph, pose_looking, with_circle_targets, with_round_window, with_targets,
 };
 use campanile_sim::world::{World, examples_dir, load_scene};
 use chrono::{DateTime, Utc};
@@ -77,8 +77,17 @@ fn noon() -> DateTime<Utc> {
 }
 
 fn world(scene: &str, hung: &[Target], radius_m: f64, tags: &[Target]) -> World {
+    world_with_windows(scene, hung, radius_m, tags, &[])
+}
+
+/// [`world`] with round white windows (radius [`WINDOW_RADIUS_M`], in a
+/// square of brick) at `windows`.
+fn world_with_windows(scene: &str, hung: &[Target], radius_m: f64, tags: &[Target], windows: &[Target]) -> World {
     let loaded = load_scene(&examples_dir().join(scene)).expect("the example scene");
-    let with = with_circle_targets(&loaded, hung, radius_m).expect("targets hung");
+    let mut with = with_circle_targets(&loaded, hung, radius_m).expect("targets hung");
+    for window in windows {
+        with = with_round_window(&with, window, WINDOW_RADIUS_M, BRICK).expect("window");
+    }
     let with = with_targets(&with, tags).expect("boards hung");
     let mut w = World::new(&station(), with);
     w.quality.samples_per_pixel = 1;
@@ -275,6 +284,24 @@ fn assert_right_or_clear(name: &str, o: &Outcome) {
     }
 }
 
+/// A round window's radius: larger than a target's circle (0.1 m).
+const WINDOW_RADIUS_M: f64 = 0.15;
+/// The wall around a round window: a brick red.
+const BRICK: [f64; 3] = [0.45, 0.30, 0.24];
+
+/// A round white window in the tower's south face, 1.4 m from the nearest
+/// surveyed target (the false target: a white disc no survey lists
+/// and no dark plate surrounds).
+fn tower_round_window() -> Target {
+    Target {
+        id: 98,
+        centre_m: (1.0, -5.502, 2.7),
+        normal: (0.0, -1.0, 0.0),
+        up: None,
+        size_m: 0.5,
+    }
+}
+
 /// A false target on the south face of the tower: a plate with a white
 /// circle, the survey's size, 1.3 m from the nearest surveyed one.
 fn tower_false_target() -> Target {
@@ -397,7 +424,8 @@ fn hard_cases_give_a_right_pose_or_a_clear_verdict() {
     let (_, tripod_south) = tower_views()[4];
 
     // A moved target (3 hangs 1.2 m above where the survey says), the
-    // false target, and a board 0.3 m in front of target 2 hiding half of it.
+    // false target, a round white window, and a board 0.3 m in front of
+    // target 2 hiding half of it.
     let mut hung = targets.clone();
     hung.iter_mut().filter(|t| t.id == 3).for_each(|t| t.centre_m.2 += 1.2);
     hung.push(tower_false_target());
@@ -408,10 +436,43 @@ fn hard_cases_give_a_right_pose_or_a_clear_verdict() {
         up: None,
         size_m: 0.6,
     };
-    let w = world("campanile-scene.ron", &hung, radius, &[board]);
+    let window = tower_round_window();
+    let w = world_with_windows(
+        "campanile-scene.ron",
+        &hung,
+        radius,
+        &[board],
+        std::slice::from_ref(&window),
+    );
     let photo = photograph(&w, &tripod_south, &settings(501)).expect("rendered");
     let o = register_photo(&w, &photo, &targets, radius, &hung);
-    assert_right_or_clear("moved, false and half-hidden targets", &o);
+    assert_right_or_clear("moved, false and half-hidden targets and a round window", &o);
+    // The window is in view; whether it is detected (a white disc, but in
+    // brick rather than on a dark plate) is said, and it is matched to
+    // nothing either way (a detection matched to a target lies on that
+    // target's image, checked by `false_matches` below).
+    let (u, v) = tripod_south
+        .project(
+            &lens(),
+            &Vector3::new(window.centre_m.0, window.centre_m.1, window.centre_m.2),
+        )
+        .expect("the window is in front of the camera");
+    assert!(
+        (0.0..WIDTH as f64).contains(&u) && (0.0..HEIGHT as f64).contains(&v),
+        "the window is out of frame at ({u:.0}, {v:.0})"
+    );
+    let on_window: Vec<usize> = (0..o.detections.len())
+        .filter(|&i| {
+            let c = o.detections[i].ellipse.centre;
+            (c.0 - u).hypot(c.1 - v) < 3.0
+        })
+        .collect();
+    eprintln!("round window at ({u:.1}, {v:.1}) px: detections on it {on_window:?}");
+    assert!(
+        o.registration.matches.iter().all(|(i, _)| !on_window.contains(i)),
+        "the round window was matched to a target: {}",
+        describe("window", &o)
+    );
     let ids: Vec<u32> = o.registration.matches.iter().map(|(_, id)| *id).collect();
     assert!(
         !ids.contains(&3) || o.registration.registration.quality.rejected_targets.contains(&3),

@@ -11,7 +11,9 @@
 //! [`with_circle_targets`] hangs the thesis's own targets (§3.3): a dark
 //! square plate ([`CIRCLE_PLATE`], the thesis's "flat square green
 //! patches") with a white circle in the middle ([`Texture::Disc`]), the
-//! circle's centre where the survey puts it.
+//! circle's centre where the survey puts it. [`with_round_window`] hangs
+//! a white disc in a square of wall colour: a round window, the false
+//! target no survey lists.
 //!
 //! [`photograph`] renders a view through the world's path tracer (the
 //! sun and sky outdoors, the lamps indoors), blurs it by the lens's
@@ -158,12 +160,45 @@ pub fn with_targets(scene: &LoadedScene, targets: &[Target]) -> Result<LoadedSce
 /// doc): each target's plate of side `size_m`, centred on `centre_m`,
 /// facing `normal`. Like [`with_targets`], plates stand free.
 pub fn with_circle_targets(scene: &LoadedScene, targets: &[Target], radius_m: f64) -> Result<LoadedScene, WorldError> {
+    hang_discs(scene, targets, radius_m, TAG_WHITE, CIRCLE_PLATE, "circle-targets")
+}
+
+/// `scene` with a round window of radius `radius_m` in a square of wall
+/// (`wall` albedo, side `window.size_m`) where `window` says: a white
+/// disc no survey lists and no dark plate surrounds, the thesis's hard
+/// case of a false target (issue 27).
+pub fn with_round_window(
+    scene: &LoadedScene,
+    window: &Target,
+    radius_m: f64,
+    wall: [f64; 3],
+) -> Result<LoadedScene, WorldError> {
+    hang_discs(
+        scene,
+        std::slice::from_ref(window),
+        radius_m,
+        TAG_WHITE,
+        wall,
+        "round-windows",
+    )
+}
+
+/// `scene` with a disc of albedo `inside` on a square plate of albedo
+/// `outside` at each of `targets`, in a new surface `surface_name`.
+fn hang_discs(
+    scene: &LoadedScene,
+    targets: &[Target],
+    radius_m: f64,
+    inside: [f64; 3],
+    outside: [f64; 3],
+    surface_name: &str,
+) -> Result<LoadedScene, WorldError> {
     let mut triangles: Vec<Triangle> = scene.scene.triangles().to_vec();
     let mut materials: Vec<Material> = scene.scene.materials().to_vec();
     let mut surfaces: Vec<String> = scene.scene.surfaces().to_vec();
     let mut appearances = scene.appearances.clone();
     let surface = surfaces.len() as u32;
-    surfaces.push("circle-targets".into());
+    surfaces.push(surface_name.into());
     for t in targets {
         if !(t.size_m > 2.0 * radius_m && radius_m > 0.0) {
             return Err(geometry_error(format!(
@@ -181,12 +216,12 @@ pub fn with_circle_targets(scene: &LoadedScene, targets: &[Target], radius_m: f6
             centre_st: [centre.dot(&s_axis), centre.dot(&t_axis)],
             radius_m,
             plate_m: t.size_m,
-            inside: TAG_WHITE,
-            outside: CIRCLE_PLATE,
+            inside,
+            outside,
         };
         triangles.extend([a, b]);
         materials.push(Material {
-            name: format!("circle-target-{}", t.id),
+            name: format!("{surface_name}-{}", t.id),
             albedo: texture.clone(),
             specular: None,
             emission: [0.0; 3],
