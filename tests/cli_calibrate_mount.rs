@@ -13,7 +13,10 @@
 //! registered calibration (`--camera-calibration`), and with the true mount
 //! and place (the known-pose run); the pseudo-albedos of each run against
 //! the simulator's truth, and the held-out time's re-render against its
-//! photographs. Then what the command says of views that cannot fix a
+//! photographs. The same views are then processed as photographs taken
+//! off the head (no head reading; the view's pose registered from a
+//! photograph of the tags taken from there, roll included), and with that
+//! roll dropped. Then what the command says of views that cannot fix a
 //! mount, and of bad input.
 
 mod common;
