@@ -97,18 +97,34 @@ fn calibration_text(m: &Mount, head: [f64; 3]) -> String {
 /// The example scene with one pose, "lawn", at the nominal place, aimed at
 /// the tower.
 fn nominal_scene_text() -> String {
+    let [x, y, z] = NOMINAL_HEAD;
+    let azimuth = (-x).atan2(-y).to_degrees().rem_euclid(360.0);
+    scene_text_with_lawn(&format!(
+        "position_m: ({x}, {y}, {z}), azimuth_deg: {azimuth:.2}, elevation_deg: 18.0"
+    ))
+}
+
+/// The example scene with one more pose, "lawn", of the given fields.
+fn scene_text_with_lawn(fields: &str) -> String {
     let text = std::fs::read_to_string(examples_dir().join("campanile-scene.ron")).expect("example scene");
     let geometry = examples_dir().join("campanile.obj");
     let text = text.replace("\"campanile.obj\"", &format!("{:?}", path(&geometry)));
-    let [x, y, z] = NOMINAL_HEAD;
-    let azimuth = (-x).atan2(-y).to_degrees().rem_euclid(360.0);
     let anchor = "(name: \"view-se\",";
     assert!(text.contains(anchor), "the example scene's poses changed");
-    text.replacen(
-        anchor,
-        &format!("(name: \"lawn\", position_m: ({x}, {y}, {z}), azimuth_deg: {azimuth:.2}, elevation_deg: 18.0),\n        {anchor}"),
-        1,
+    text.replacen(anchor, &format!("(name: \"lawn\", {fields}),\n        {anchor}"), 1)
+}
+
+/// Renders `pose` as `settings` say and writes it to `to` as a PNG.
+fn photograph_to(w: &World, pose: &CameraPose, settings: &PhotoSettings, to: &Path) {
+    let shot = photograph(w, pose, settings).expect("rendered");
+    image::save_buffer(
+        to,
+        &shot.rgb,
+        shot.width as u32,
+        shot.height as u32,
+        image::ExtendedColorType::Rgb8,
     )
+    .expect("png written");
 }
 
 /// Two training times and a held-out one, each with a sun shot, a sky scan
@@ -287,16 +303,8 @@ fn a_moved_tripod_is_processed_from_registered_poses_as_well_as_from_known_ones(
             pan_rad: f64::to_radians(pan),
             tilt_rad: f64::to_radians(tilt),
         };
-        let shot = photograph(&w, &pose_at(&m, head), &settings).expect("rendered");
         let photo = file(&format!("{name}.png"));
-        image::save_buffer(
-            &photo,
-            &shot.rgb,
-            shot.width as u32,
-            shot.height as u32,
-            image::ExtendedColorType::Rgb8,
-        )
-        .expect("png written");
+        photograph_to(&w, &pose_at(&m, head), &settings, &photo);
         csv += &format!("{name}.png,{pan},{tilt}\n");
         photos.push(photo);
     }
@@ -343,19 +351,12 @@ fn a_moved_tripod_is_processed_from_registered_poses_as_well_as_from_known_ones(
     // then from the true mount and place (the known-pose run).
     let nominal_scene = load_scene(&file("scene.ron")).expect("the nominal scene loads");
     let truth_world = World::new(&station, truth_scene);
-    let runs = [("registered", file("registered.ron")), ("known", file("known.ron"))];
-    let mut figures = Vec::new();
-    for (name, calibration) in &runs {
-        let out = file(&format!("processed-{name}"));
-        let args = [
-            "-q",
-            "process",
-            path(&session),
-            "--out",
-            path(&out),
-            "--camera-calibration",
-            path(calibration),
-        ];
+    // `campanile process SESSION EXTRA…` into `processed-NAME`: ρ_se's
+    // median and p95 error against the truth, and the held-out blocks' RMSE.
+    let measure = |name: &str, session: &Path, extra: &[&str]| {
+        let out = file(&format!("processed-{}", name.replace([' ', ','], "-")));
+        let mut args = vec!["-q", "process", path(session), "--out", path(&out)];
+        args.extend_from_slice(extra);
         run(&args, 0);
         let (median, p95, cells) = albedo_error(&out, &truth_world, &nominal_scene.scene);
         let held = held_out_block_rmse(&out);
@@ -365,10 +366,16 @@ fn a_moved_tripod_is_processed_from_registered_poses_as_well_as_from_known_ones(
             100.0 * p95,
             100.0 * held
         );
-        figures.push((median, p95, held));
         stage(name);
-    }
-    let [registered, known] = [figures[0], figures[1]];
+        (median, p95, held)
+    };
+    let (registered_file, known_file) = (file("registered.ron"), file("known.ron"));
+    let registered = measure(
+        "registered",
+        &session,
+        &["--camera-calibration", path(&registered_file)],
+    );
+    let known = measure("known", &session, &["--camera-calibration", path(&known_file)]);
     let agreement = cell_agreement(
         &file("processed-registered"),
         &file("processed-known"),
@@ -410,15 +417,7 @@ fn a_moved_tripod_is_processed_from_registered_poses_as_well_as_from_known_ones(
     let held_session = file("session-held");
     let lawn_head = strip_view_head_readings(&session, &held_session);
     let lawn_photo = file("lawn.png");
-    let shot = photograph(&w, &pose_at(&m, lawn_head), &settings).expect("rendered");
-    image::save_buffer(
-        &lawn_photo,
-        &shot.rgb,
-        shot.width as u32,
-        shot.height as u32,
-        image::ExtendedColorType::Rgb8,
-    )
-    .expect("png written");
+    photograph_to(&w, &pose_at(&m, lawn_head), &settings, &lawn_photo);
     let lawn_poses = file("lawn-poses.ron");
     run(
         &[
@@ -447,51 +446,35 @@ fn a_moved_tripod_is_processed_from_registered_poses_as_well_as_from_known_ones(
     );
     let held_scene = |roll_deg: f64| {
         let (x, y, z) = lawn.position_m;
-        let text = nominal_scene_text();
-        let start = text.find("(name: \"lawn\"").expect("the lawn pose");
-        let end = start + text[start..].find('\n').expect("its line's end");
-        format!(
-            "{}(name: \"lawn\", position_m: ({x}, {y}, {z}), azimuth_deg: {}, elevation_deg: {}, roll_deg: {roll_deg}),{}",
-            &text[..start],
-            lawn.azimuth_deg,
-            lawn.elevation_deg,
-            &text[end..]
-        )
+        scene_text_with_lawn(&format!(
+            "position_m: ({x}, {y}, {z}), azimuth_deg: {}, elevation_deg: {}, roll_deg: {roll_deg}",
+            lawn.azimuth_deg, lawn.elevation_deg
+        ))
     };
-    std::fs::write(file("held-scene.ron"), held_scene(lawn.roll_deg)).expect("scene");
-    std::fs::write(file("level-scene.ron"), held_scene(0.0)).expect("scene");
+    let (held_file, level_file) = (file("held-scene.ron"), file("level-scene.ron"));
+    std::fs::write(&held_file, held_scene(lawn.roll_deg)).expect("scene");
+    std::fs::write(&level_file, held_scene(0.0)).expect("scene");
     stage("views taken off the head, their pose registered");
-    let mut held_figures = Vec::new();
-    for (name, scene_file) in [
-        ("held", file("held-scene.ron")),
-        ("held, roll dropped", file("level-scene.ron")),
-    ] {
-        let out = file(&format!("processed-{}", name.replace([' ', ','], "-")));
-        let calibration = file("registered.ron");
-        let args = [
-            "-q",
-            "process",
-            path(&held_session),
+    let held = measure(
+        "held",
+        &held_session,
+        &[
             "--scene",
-            path(&scene_file),
-            "--out",
-            path(&out),
+            path(&held_file),
             "--camera-calibration",
-            path(&calibration),
-        ];
-        run(&args, 0);
-        let (median, p95, cells) = albedo_error(&out, &truth_world, &nominal_scene.scene);
-        let held = held_out_block_rmse(&out);
-        println!(
-            "{name:>10}: ρ_se error median {:.1}% p95 {:.1}% over {cells} cells; held-out RMSE per 4×4 block {:.1}%",
-            100.0 * median,
-            100.0 * p95,
-            100.0 * held
-        );
-        held_figures.push((median, p95, held));
-        stage(name);
-    }
-    let [held, level] = [held_figures[0], held_figures[1]];
+            path(&registered_file),
+        ],
+    );
+    let level = measure(
+        "held, roll dropped",
+        &held_session,
+        &[
+            "--scene",
+            path(&level_file),
+            "--camera-calibration",
+            path(&registered_file),
+        ],
+    );
     let held_agreement = cell_agreement(&file("processed-held"), &file("processed-known"), &nominal_scene.scene);
     println!(
         "held against known, per cell: median {:.2}%, p95 {:.2}%",

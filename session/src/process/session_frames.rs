@@ -132,20 +132,20 @@ impl SessionInputs {
         let mut described = Vec::with_capacity(entries.len());
         for e in &entries {
             let (purpose, pos) = self.purpose(e)?;
-            if let Some(p) = pos {
-                position = p;
-            }
             let (head, held_by, position_m) = match e.meta.pose_reached.or(e.meta.pose_requested) {
-                Some(pose) => (
-                    HeadPose {
+                Some(pose) => {
+                    if let Some(p) = pos {
+                        position = p;
+                    }
+                    let head = HeadPose {
                         pan_rad: pose.pan_deg.to_radians(),
                         tilt_rad: pose.tilt_deg.to_radians(),
-                    },
-                    None,
-                    self.head_position.unwrap_or(position),
-                ),
+                    };
+                    (head, None, self.head_position.unwrap_or(position))
+                }
                 // A photograph taken off the head stood where its pose
-                // says, wherever a calibration put the head.
+                // says, wherever a calibration put the head; the head did
+                // not move for it.
                 None => {
                     let (mount, head, at) = self.held(e, &purpose)?;
                     (head, Some(mount), at)
