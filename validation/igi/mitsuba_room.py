@@ -171,27 +171,8 @@ def truth():
 
 
 def scene_ron(vs, exr):
-    lines = ["IgiScene(", '    geometry: "room.obj",', "    surfaces: [],"]
-    if not exr:
-        lines += ["    ward_variant: Some(Duer),", "    interreflection: Some(true),"]
-    lines.append("    cameras: [")
-    for v in vs:
-        fov = f"vfov_deg: {v.vfov_deg:.6f}" if exr else f"hfov_deg: {v.hfov_deg:.6f}"
-        lines.append(
-            f'        (name: "{v.name}", position_m: {R.ron_tuple(v.position)}, look: {R.ron_tuple(v.direction)}, '
-            f"up: (0.0, 0.0, 1.0), {fov}, width: {v.width}, height: {v.height}),"
-        )
-    lines += ["    ],", "    lights: ["]
-    for light in LIGHTS:
-        lines.append(
-            f'        Known(name: "{light["name"]}", position_m: {R.ron_tuple(light["position"])}, '
-            f'radius_m: {light["radius"]}, intensity_w_sr: {R.ron_tuple(light["intensity"])}),'
-        )
-    lines += ["    ],", "    images: ["]
-    for v in vs:
-        lines.append(f'        (camera: "{v.name}", image: "views/{v.name}.exr", mask: Some("masks/{v.name}.png")),')
-    lines += ["    ],", ")"]
-    return "\n".join(lines) + "\n"
+    header = [] if exr else ["    ward_variant: Some(Duer),", "    interreflection: Some(true),"]
+    return R.exr_scene_ron(vs, LIGHTS, header, fov_key="vfov_deg" if exr else "hfov_deg")
 
 
 def main():

@@ -229,14 +229,42 @@ def write_rgbe(path, rgb):
     path.write_bytes(header + out.tobytes())
 
 
-def write_exr(path, rgb):
+def write_exr(path, rgb, half=False):
+    """ZIP-compressed RGB OpenEXR, float32 (or half with `half`)."""
     import OpenEXR
 
-    rgb = np.ascontiguousarray(rgb, np.float32)
+    rgb = np.ascontiguousarray(rgb, np.float16 if half else np.float32)
     channels = {"R": rgb[..., 0].copy(), "G": rgb[..., 1].copy(), "B": rgb[..., 2].copy()}
     header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
     with OpenEXR.File(header, channels) as f:
         f.write(str(path))
+
+
+def exr_scene_ron(views, lights, header, fov_key="hfov_deg", radius=None):
+    """A Campanile scene file over room.obj and views/<view>.exr with
+    masks/<view>.png: `header` are extra top-level lines (ward_variant,
+    interreflection), cameras give `fov_key` (hfov_deg or vfov_deg),
+    lights are `Known` points of their intensity with their radius, or
+    `radius` when given."""
+    lines = ["IgiScene(", '    geometry: "room.obj",', "    surfaces: [],"] + header + ["    cameras: ["]
+    for v in views:
+        fov = v.hfov_deg if fov_key == "hfov_deg" else v.vfov_deg
+        lines.append(
+            f'        (name: "{v.name}", position_m: {ron_tuple(v.position)}, look: {ron_tuple(v.direction)}, '
+            f"up: (0.0, 0.0, 1.0), {fov_key}: {fov:.6f}, width: {v.width}, height: {v.height}),"
+        )
+    lines += ["    ],", "    lights: ["]
+    for light in lights:
+        r = light["radius"] if radius is None else radius
+        lines.append(
+            f'        Known(name: "{light["name"]}", position_m: {ron_tuple(light["position"])}, '
+            f'radius_m: {r}, intensity_w_sr: {ron_tuple(light["intensity"])}),'
+        )
+    lines += ["    ],", "    images: ["]
+    for v in views:
+        lines.append(f'        (camera: "{v.name}", image: "views/{v.name}.exr", mask: Some("masks/{v.name}.png")),')
+    lines += ["    ],", ")"]
+    return "\n".join(lines) + "\n"
 
 
 def ron_tuple(v, fmt="{:.6f}"):
