@@ -27,7 +27,6 @@ use std::path::{Path, PathBuf};
 use campanile_capture::store::{JournalEntry, PROCESSED_DIR, ProcessedProducts, SessionReader};
 use campanile_capture::unattended::Heartbeat;
 use campanile_capture::unattended::day_rollover::{day_dir, existing_days};
-use campanile_config::load_station;
 use campanile_process::pipeline::TRIPLET_AGREEMENT;
 use campanile_process::sky::{SkyModel, angle_between, direction};
 use campanile_process::sky_series::{scan_path, series_width};
@@ -81,24 +80,12 @@ fn occurrence_of(key: &str) -> &str {
 #[test]
 fn station_run_processes_each_scan_and_the_budget_deletes_only_processed_frames() {
     let tmp = tempfile::tempdir().unwrap();
-    let plan = tmp.path().join("plan.ron");
-    let plan_text = std::fs::read_to_string(root().join("examples/sky-station.ron"))
-        .unwrap()
-        .replace("interval_min: 10.0", "interval_min: 120.0")
-        .replace("days: 3", "days: 2")
-        .replace(
-            "Some(\"sky-scene.ron\")",
-            &format!(
-                "Some({:?})",
-                root().join("examples/sky-scene.ron").display().to_string()
-            ),
-        );
-    assert!(plan_text.contains("interval_min: 120.0") && plan_text.contains("days: 2"));
-    std::fs::write(&plan, plan_text).unwrap();
-    let station_path = root().join("examples/sky-sim-station.ron");
-    let station = load_station(&station_path).unwrap().value;
-    let response = tmp.path().join("response.csv");
-    sim_response::write_true_response(&response, station.camera.bit_depth);
+    let sim_response::TwoDaySkyStation {
+        plan,
+        station_path,
+        station,
+        response,
+    } = sim_response::two_day_sky_station(tmp.path());
     let store = tmp.path().join("store");
     let budget = BUDGET_BYTES.to_string();
     let base = [

@@ -10,8 +10,9 @@
 //! from a calibration bracket, with the full-well gauge; see
 //! `campanile_process::pipeline`).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
+use campanile_config::{Station, load_station};
 use campanile_process::camera::sensor::CameraModel;
 use campanile_process::hdr::curve::{ChannelCurve, ResponseCurve, node_code, node_count};
 
@@ -35,4 +36,45 @@ pub fn write_true_response(path: &Path, bits: u8) -> ResponseCurve {
     };
     std::fs::write(path, curve.to_csv("simulator truth")).unwrap();
     curve
+}
+
+/// The example sky station's plan (`examples/sky-station.ron`: a sun
+/// triplet and a sky scan) every 2 hours for 2 days, its scene path made
+/// absolute, written to `dir/plan.ron`; the 64×48
+/// `examples/sky-sim-station.ron`; and its true response in
+/// `dir/response.csv` (the plan has no calibration bracket).
+// Not every test crate that includes this module reads every field.
+#[allow(dead_code)]
+pub struct TwoDaySkyStation {
+    pub plan: PathBuf,
+    pub station_path: PathBuf,
+    pub station: Station,
+    pub response: PathBuf,
+}
+
+// Not every test crate that includes this module uses it.
+#[allow(dead_code)]
+pub fn two_day_sky_station(dir: &Path) -> TwoDaySkyStation {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let plan = dir.join("plan.ron");
+    let plan_text = std::fs::read_to_string(root.join("examples/sky-station.ron"))
+        .unwrap()
+        .replace("interval_min: 10.0", "interval_min: 120.0")
+        .replace("days: 3", "days: 2")
+        .replace(
+            "Some(\"sky-scene.ron\")",
+            &format!("Some({:?})", root.join("examples/sky-scene.ron").display().to_string()),
+        );
+    assert!(plan_text.contains("interval_min: 120.0") && plan_text.contains("days: 2"));
+    std::fs::write(&plan, plan_text).unwrap();
+    let station_path = root.join("examples/sky-sim-station.ron");
+    let station = load_station(&station_path).unwrap().value;
+    let response = dir.join("response.csv");
+    write_true_response(&response, station.camera.bit_depth);
+    TwoDaySkyStation {
+        plan,
+        station_path,
+        station,
+        response,
+    }
 }
