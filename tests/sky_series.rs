@@ -102,6 +102,36 @@ fn scans_dir_files(out: &Path) -> Vec<(String, Vec<u8>)> {
     v
 }
 
+/// The rows of a sky-series Parquet file, each cell as the CSV writes it:
+/// (column, text); null is the empty cell, a timestamp RFC 3339 with
+/// milliseconds.
+fn parquet_cells(path: &Path) -> Vec<Vec<(String, String)>> {
+    use parquet::file::reader::{FileReader, SerializedFileReader};
+    use parquet::record::Field;
+    let reader = SerializedFileReader::new(std::fs::File::open(path).unwrap()).unwrap();
+    reader
+        .get_row_iter(None)
+        .unwrap()
+        .map(|row| {
+            row.unwrap()
+                .get_column_iter()
+                .map(|(name, field)| {
+                    let text = match field {
+                        Field::Null => String::new(),
+                        Field::Double(v) => format!("{v}"),
+                        Field::Str(s) => s.clone(),
+                        Field::TimestampMillis(ms) => chrono::DateTime::from_timestamp_millis(*ms)
+                            .unwrap()
+                            .to_rfc3339_opts(chrono::SecondsFormat::Millis, true),
+                        other => panic!("{name}: unexpected Parquet value {other:?}"),
+                    };
+                    (name.clone(), text)
+                })
+                .collect()
+        })
+        .collect()
+}
+
 #[test]
 fn a_sky_day_is_processed_incrementally_sharded_and_matches_the_simulator() {
     let tmp = tempfile::tempdir().unwrap();
@@ -189,6 +219,19 @@ fn a_sky_day_is_processed_incrementally_sharded_and_matches_the_simulator() {
     assert_eq!(rows.len(), total + 1, "header and one row per scan");
     for r in &rows {
         assert_eq!(r.split(',').count(), series_width(), "{r}");
+    }
+    // The Parquet file holds the same cells, typed (the CSV writes each
+    // number in its shortest exact form, so they compare exactly).
+    let parquet_rows = parquet_cells(&out.join("sky-series.parquet"));
+    assert_eq!(parquet_rows.len(), total);
+    let header: Vec<&str> = rows[0].split(',').collect();
+    for (r, p) in rows[1..].iter().zip(&parquet_rows) {
+        let cells: Vec<&str> = r.split(',').collect();
+        assert_eq!(p.len(), cells.len());
+        for ((name, want), (pname, got)) in header.iter().zip(&cells).zip(p) {
+            assert_eq!(name, pname);
+            assert_eq!(want, got, "{name} in row {r}");
+        }
     }
     for f in [
         "extinction.csv",
@@ -329,6 +372,10 @@ fn a_sky_day_is_processed_incrementally_sharded_and_matches_the_simulator() {
     run(&args);
     assert_eq!(scans_dir_files(&merged), scans_dir_files(&out), "per-scan files differ");
     assert_eq!(std::fs::read_to_string(merged.join("sky-series.csv")).unwrap(), csv);
+    assert_eq!(
+        std::fs::read(merged.join("sky-series.parquet")).unwrap(),
+        std::fs::read(out.join("sky-series.parquet")).unwrap()
+    );
     assert_eq!(
         std::fs::read_to_string(merged.join("extinction.csv")).unwrap(),
         std::fs::read_to_string(out.join("extinction.csv")).unwrap()

@@ -11,8 +11,8 @@
 //! `station run` on the 64×48 `examples/sky-sim-station.ron`; the response
 //! given is the simulator's own (the plan has no calibration bracket).
 //! Each merged day must be byte-equal, file by file, to the unsharded
-//! `campanile process DAY --out …` of the same day (17 files a day: the
-//! per-scan records, the series and extinction CSVs, plots, keograms, the
+//! `campanile process DAY --out …` of the same day (18 files a day: the
+//! per-scan records, the series (CSV and Parquet), the extinction CSV, plots, keograms, the
 //! response, the verdicts), except the report page, which also says what
 //! the run itself processed (a merge processes nothing).
 //!

@@ -39,6 +39,7 @@ use crate::cli::verdicts;
 /// scans still being captured wait) and shardable:
 ///   scans/<occurrence>.ron         one scan's products (the source of every per-day product)
 ///   sky-series.csv                 one row per scan, every column documented in its header
+///   sky-series.parquet             the same rows, typed columns, each column's unit in its metadata
 ///   extinction.csv                 β and E₀ per day and channel (Langley)
 ///   plots/*.svg, keogram.png, keogram-residual.png, report.html
 ///   response.csv                   the response used (given, or from the calibration bracket)

@@ -17,6 +17,7 @@ mod quality;
 mod report;
 mod scan;
 mod series_csv;
+mod series_parquet;
 mod shard;
 pub mod store;
 
@@ -30,6 +31,7 @@ pub use quality::{HIGH_MASKED_FRACTION, POOR_FIT_RMS, QualityFlags};
 pub use report::sky_series_sections;
 pub use scan::{ScanProducts, SunRecord, scan_file_stem, scan_products};
 pub use series_csv::{EXTINCTION_COLUMNS, SERIES_COLUMNS, extinction_csv, series_csv, series_width};
+pub use series_parquet::{PARQUET_FORMAT, series_parquet, unit_key};
 pub use shard::{Shard, ShardParseError, stable_hash};
 pub use store::{read_scans, scan_path, write_day, write_scan};
 

@@ -82,7 +82,8 @@ pub const EXTINCTION_COLUMNS: &[(&str, &str)] = &[
     ("note", "text: why there is no fit, if there is none"),
 ];
 
-fn expand(columns: &[(&str, &str)]) -> Vec<(String, String)> {
+/// The columns with `{c}` expanded to r, g, b: (name, unit and meaning).
+pub(crate) fn expand(columns: &[(&str, &str)]) -> Vec<(String, String)> {
     let mut out = Vec::new();
     for (name, doc) in columns {
         if name.contains("{c}") {
@@ -94,6 +95,28 @@ fn expand(columns: &[(&str, &str)]) -> Vec<(String, String)> {
         }
     }
     out
+}
+
+/// One cell of a series row, typed: what the CSV formats and the Parquet
+/// file stores.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Cell {
+    /// Text; `None` where there is nothing (an empty CSV cell, a Parquet null).
+    Text(Option<String>),
+    /// A number; `None` (or a non-finite value) where there is none.
+    Number(Option<f64>),
+    /// The scan's time.
+    Time(chrono::DateTime<chrono::Utc>),
+}
+
+impl Cell {
+    fn csv(&self) -> String {
+        match self {
+            Cell::Text(t) => t.as_deref().map_or(String::new(), text_cell),
+            Cell::Number(v) => v.map_or(String::new(), num),
+            Cell::Time(t) => t.to_rfc3339_opts(chrono::SecondsFormat::Millis, true),
+        }
+    }
 }
 
 fn header(text: &mut String, title: &str, columns: &[(String, String)]) {
@@ -117,40 +140,41 @@ fn text_cell(s: &str) -> String {
     }
 }
 
-fn row(s: &ScanProducts) -> Vec<String> {
+/// A scan's row, in [`SERIES_COLUMNS`]' order (expanded).
+pub(crate) fn cells(s: &ScanProducts) -> Vec<Cell> {
     let mut r = vec![
-        text_cell(&s.occurrence),
-        s.time_utc.to_rfc3339_opts(chrono::SecondsFormat::Millis, true),
-        num(s.sun_zenith_deg),
-        num(s.sun_azimuth_deg),
+        Cell::Text(Some(s.occurrence.clone())),
+        Cell::Time(s.time_utc),
+        Cell::Number(Some(s.sun_zenith_deg)),
+        Cell::Number(Some(s.sun_azimuth_deg)),
     ];
     let sun = s.sun.as_ref();
-    r.push(sun.map_or(String::new(), |m| num(m.air_mass)));
+    r.push(Cell::Number(sun.map(|m| m.air_mass)));
     for c in 0..3 {
-        r.push(sun.map_or(String::new(), |m| num(m.irradiance_w_m2[c])));
+        r.push(Cell::Number(sun.map(|m| m.irradiance_w_m2[c])));
     }
     for c in 0..3 {
-        r.push(sun.map_or(String::new(), |m| num(m.spread[c])));
+        r.push(Cell::Number(sun.map(|m| m.spread[c])));
     }
     let sky = s.sky.as_ref().filter(|k| k.len() == 3);
-    let per = |f: &dyn Fn(&crate::sky::ChannelSky) -> String| -> Vec<String> {
-        (0..3).map(|c| sky.map_or(String::new(), |k| f(&k[c]))).collect()
+    let per = |f: &dyn Fn(&crate::sky::ChannelSky) -> f64| -> Vec<Cell> {
+        (0..3).map(|c| Cell::Number(sky.map(|k| f(&k[c])))).collect()
     };
-    r.extend(per(&|k| text_cell(&k.chosen)));
-    r.extend(per(&|k| num(k.model.lz)));
-    r.extend(per(&|k| num(k.model.a)));
-    r.extend(per(&|k| num(k.model.b)));
-    r.extend(per(&|k| num(k.model.c)));
-    r.extend(per(&|k| num(k.model.d)));
-    r.extend(per(&|k| num(k.model.e)));
-    r.extend(per(&|k| num(k.model.h)));
-    r.extend(per(&|k| num(k.rms_relative)));
-    r.extend(per(&|k| num(k.masked_fraction)));
+    r.extend((0..3).map(|c| Cell::Text(sky.map(|k| k[c].chosen.clone()))));
+    r.extend(per(&|k| k.model.lz));
+    r.extend(per(&|k| k.model.a));
+    r.extend(per(&|k| k.model.b));
+    r.extend(per(&|k| k.model.c));
+    r.extend(per(&|k| k.model.d));
+    r.extend(per(&|k| k.model.e));
+    r.extend(per(&|k| k.model.h));
+    r.extend(per(&|k| k.rms_relative));
+    r.extend(per(&|k| k.masked_fraction));
     let prms = s.profile.rms_relative();
     for c in 0..3 {
-        r.push(prms.map_or(String::new(), |p| num(p[c])));
+        r.push(Cell::Number(prms.map(|p| p[c])));
     }
-    r.push(s.quality.names());
+    r.push(Cell::Text(Some(s.quality.names())));
     r
 }
 
@@ -163,7 +187,8 @@ pub fn series_csv(series: &SkySeries) -> String {
         &expand(SERIES_COLUMNS),
     );
     for s in &series.scans {
-        let _ = writeln!(text, "{}", row(s).join(","));
+        let row: Vec<String> = cells(s).iter().map(Cell::csv).collect();
+        let _ = writeln!(text, "{}", row.join(","));
     }
     text
 }

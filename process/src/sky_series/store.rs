@@ -3,6 +3,7 @@
 //! ```text
 //! OUT/scans/<occurrence>.ron    one ScanProducts per scan (the source of truth)
 //! OUT/sky-series.csv            one row per scan, columns documented in its header
+//! OUT/sky-series.parquet        the same, typed columns, units in its metadata
 //! OUT/extinction.csv            β and E₀ per day and channel
 //! OUT/plots/*.svg               sky scale, sky shape, irradiance, Langley
 //! OUT/keogram.png, OUT/keogram-residual.png
@@ -23,6 +24,7 @@ use super::keogram::{keogram_png, keogram_residual_png};
 use super::plots::{irradiance_svg, langley_svg, shape_parameters_svg, zenith_scale_svg};
 use super::scan::{ScanProducts, scan_file_stem};
 use super::series_csv::{extinction_csv, series_csv};
+use super::series_parquet::series_parquet;
 
 /// Directory of the per-scan files inside OUT.
 pub const SCANS_DIR: &str = "scans";
@@ -135,6 +137,13 @@ pub fn merge_scan_dirs(out: &Path, shards: &[PathBuf]) -> Result<usize, SkySerie
 pub fn write_day(out: &Path) -> Result<SkySeries, SkySeriesError> {
     let series = SkySeries::new(read_scans(out)?);
     write_atomic(&out.join("sky-series.csv"), series_csv(&series).as_bytes())?;
+    let parquet_path = out.join("sky-series.parquet");
+    let parquet = series_parquet(&series).map_err(|e| SkySeriesError::Io {
+        action: "encode the series as Parquet for",
+        path: parquet_path.clone(),
+        source: std::io::Error::other(e),
+    })?;
+    write_atomic(&parquet_path, &parquet)?;
     write_atomic(&out.join("extinction.csv"), extinction_csv(&series).as_bytes())?;
     if !series.scans.is_empty() {
         let plots = out.join("plots");
