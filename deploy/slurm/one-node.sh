@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # A one-node Slurm cluster on this machine, for tests and trials: munged,
 # slurmctld and slurmd with their configuration, keys, spool, logs and PID
-# files under DIR, on ports of our own (nothing under /etc is touched).
+# files under DIR (munged's socket in a /tmp/campanile-munge.* directory,
+# removed by stop), on ports of our own (nothing under /etc is touched).
 #
 #   deploy/slurm/one-node.sh start DIR [CTLD_PORT SLURMD_PORT]   # prints: export SLURM_CONF=DIR/slurm.conf
 #   deploy/slurm/one-node.sh stop DIR                             # kills the three daemons by their PID files
@@ -24,6 +25,10 @@ stop() {
             rm -f "$f"
         fi
     done
+    if [ -f "$dir/munge/socket-dir" ]; then
+        rm -rf "$(cat "$dir/munge/socket-dir")"
+        rm -f "$dir/munge/socket-dir"
+    fi
 }
 case "$cmd" in
     stop) stop; exit 0 ;;
@@ -43,20 +48,25 @@ mkdir -p "$dir"
 dir="$(cd "$dir" && pwd)"
 mkdir -p "$dir/munge" "$dir/spool/ctld" "$dir/spool/d" "$dir/log"
 chmod 700 "$dir/munge"
+# munged wants every directory above its socket searchable by all (DIR may
+# be a private temporary directory), so the socket lives in /tmp.
+sock_dir="$(mktemp -d /tmp/campanile-munge.XXXXXX)"
+chmod 755 "$sock_dir"
+echo "$sock_dir" > "$dir/munge/socket-dir"
 user="$(id -un)"
 host="$(hostname -s)"
 # A key of our own, so that a non-root user can run munged.
 [ -f "$dir/munge/munge.key" ] || { head -c 1024 /dev/urandom > "$dir/munge/munge.key"; chmod 400 "$dir/munge/munge.key"; }
 force=()
 [ "$(id -u)" -eq 0 ] && force=(--force)
-munged "${force[@]}" --socket="$dir/munge/munge.socket" --key-file="$dir/munge/munge.key" \
+munged "${force[@]}" --socket="$sock_dir/munge.socket" --key-file="$dir/munge/munge.key" \
     --pid-file="$dir/munge/munged.pid" --log-file="$dir/munge/munged.log" --seed-file="$dir/munge/munged.seed"
 cat > "$dir/slurm.conf" <<CONF
 # one-node.sh: a one-node cluster for tests ($(date -u +%FT%TZ))
 ClusterName=campanile-one-node
 SlurmctldHost=$host(127.0.0.1)
 AuthType=auth/munge
-AuthInfo=socket=$dir/munge/munge.socket
+AuthInfo=socket=$sock_dir/munge.socket
 CredType=cred/munge
 SlurmUser=$user
 SlurmdUser=$user
