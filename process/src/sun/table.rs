@@ -48,13 +48,13 @@ pub struct SunAnswer {
 }
 
 /// Positions for many requests, in parallel (rayon, chunks of 512 rows).
-/// Every instant gets SPA's full series, exactly, with no interpolation;
-/// consecutive requests at the same instant and ΔT share them, so the rows
-/// may come in any order. The series and the per-site steps run eight
-/// instants or rows at a time in vector registers (the module `sun::spa`);
-/// the result differs from [`Ephemeris::position`] (the
-/// `solar-positioning` crate's SPA) by rounding only: below 1e-11° on a
-/// dense grid (tested), against pvlib's SPA as the crate's.
+/// Every instant gets SPA's full series, with no interpolation, so rows may
+/// come in any order and isolated instants are exact; consecutive requests
+/// at the same instant and ΔT share the series. The series and the
+/// per-site steps run eight instants or rows at a time in vector registers
+/// (the module `sun::spa`). The result differs from
+/// [`Ephemeris::position`] (the `solar-positioning` crate's SPA) by
+/// rounding only: below 1e-11° on a dense grid (tested).
 pub fn sun_positions(requests: &[SunRequest]) -> Vec<Result<SunAnswer, SunError>> {
     requests.par_chunks(CHUNK).flat_map_iter(positions_of_chunk).collect()
 }
