@@ -1,8 +1,11 @@
-"""Solar position: Campanile (NREL SPA via solar-positioning) against pvlib's
+"""Solar position: Campanile (NREL SPA, `process::sun`) against pvlib's
 vectorized NREL SPA, on the same instants and sites, in the same run.
 
-Writes the grid, times pvlib, reads Campanile's positions and rate, and
-prints the error and the throughput ratio as a Markdown table row.
+Writes the grid, times pvlib, reads Campanile's positions and rate (the
+library, `sun_positions`, timed inside the process), times the CLI
+(`campanile sun --csv IN --out OUT`, wall clock of the whole process: start,
+CSV parsing and writing included), and prints the error and the throughput
+ratio as Markdown table rows, library then CLI.
 """
 import csv, subprocess, sys, time
 import numpy as np
@@ -13,6 +16,7 @@ M = int(sys.argv[1]) if len(sys.argv) > 1 else 200   # instants
 S = int(sys.argv[2]) if len(sys.argv) > 2 else 50    # sites per instant (1: every row its own instant)
 workdir = sys.argv[3]
 campanile_bin = sys.argv[4]
+cli_bin = sys.argv[5] if len(sys.argv) > 5 else None
 N = M * S
 rng = np.random.default_rng(20261122)
 
@@ -60,3 +64,17 @@ da = np.abs((ours[:, 1] - azimuth + 180.0) % 360.0 - 180.0)
 da_sky = da * np.sin(np.radians(apparent_zenith))
 print(f"| {M} instants × {S} sites = {N}, 1950–2080, all latitudes | pvlib {pvlib.__version__} `spa.solar_position_numpy` | "
       f"{dz.max():.2e}° | {da_sky.max():.2e}° (max az. {da.max():.2e}°) | {rate:,.0f} /s | {pv_rate:,.0f} /s | {rate / pv_rate:.1f}× |")
+
+if cli_bin:
+    cli_out = f"{workdir}/sun_cli.csv"
+    walls = []
+    for _ in range(3):
+        start = time.perf_counter()
+        subprocess.check_call([cli_bin, "sun", "--csv", grid, "--out", cli_out], stdout=subprocess.DEVNULL)
+        walls.append(time.perf_counter() - start)
+    wall = sorted(walls)[1]
+    cli = np.loadtxt(cli_out, delimiter=",", skiprows=1, usecols=(7, 8))
+    cz = np.abs(cli[:, 0] - apparent_zenith)
+    ca = np.abs((cli[:, 1] - azimuth + 180.0) % 360.0 - 180.0) * np.sin(np.radians(apparent_zenith))
+    print(f"| CLI `campanile sun --csv` (median of 3 runs, {wall * 1e3:.0f} ms wall; output to 1e-7°) | pvlib {pvlib.__version__} `spa.solar_position_numpy` | "
+          f"{cz.max():.2e}° | {ca.max():.2e}° | {N / wall:,.0f} /s | {pv_rate:,.0f} /s | {N / wall / pv_rate:.1f}× |")

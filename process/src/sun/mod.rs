@@ -3,15 +3,20 @@
 //! it (§5.5.1).
 //!
 //! Positions come from NREL's Solar Position Algorithm (Reda & Andreas,
-//! 2004; ±0.0003° for years −2000 to 6000) as implemented by the
-//! `solar-positioning` crate, which this module wraps in Campanile's
+//! 2004; ±0.0003° for years −2000 to 6000). One instant at a time
+//! ([`Ephemeris`], [`sun_position`]) and the rise, transit and set times use
+//! the `solar-positioning` crate, which this module wraps in Campanile's
 //! conventions and verifies against NREL's published test case and against
-//! pvlib (see `BENCHMARKS.md`).
+//! pvlib (see `BENCHMARKS.md`). Tables of instants ([`sun_positions`],
+//! `campanile sun --csv`) use this crate's own SPA, vectorized (`spa`),
+//! which the tests hold to the crate's results within 1e-11°.
 
 mod disc;
 mod events;
 mod extinction;
 mod position;
+mod spa;
+mod spa_terms;
 mod table;
 
 pub use disc::{SunDisc, SunDiscError, SunFrame, measure_sun};
