@@ -245,7 +245,8 @@ def render_view(scene, view, spp, batch, seed0):
     for b in range(nb):
         sampler.seed(seed0 + b, npx * batch)
         L, _, _ = integrator.sample(scene, sampler, ray)
-        arr = np.array(L, dtype=np.float64).reshape(batch, npx, 3) if np.array(L).shape[0] != 3 else np.array(L, dtype=np.float64).T.reshape(batch, npx, 3)
+        arr = np.array(L, dtype=np.float64)  # (3, N) channel-major
+        arr = arr.T.reshape(batch, npx, 3)
         acc[b % 2] += arr.sum(0)
         cnt[b % 2] += batch
     halves = [acc[i] / max(cnt[i], 1) for i in range(2)]

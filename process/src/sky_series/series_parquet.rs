@@ -32,8 +32,7 @@ pub fn unit_key(column: &str) -> String {
     format!("campanile.unit.{column}")
 }
 
-/// The kind of each column, from the first row's cells (every row has the
-/// same kinds in the same places).
+/// What a column holds, in Parquet terms.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Kind {
     Text,
@@ -58,9 +57,9 @@ fn kinds() -> Vec<Kind> {
         .collect()
 }
 
-fn schema() -> Result<Type, ParquetError> {
+fn schema(kinds: &[Kind]) -> Result<Type, ParquetError> {
     let mut fields = Vec::new();
-    for ((name, _), kind) in expand(SERIES_COLUMNS).iter().zip(kinds()) {
+    for ((name, _), kind) in expand(SERIES_COLUMNS).iter().zip(kinds) {
         let field = match kind {
             Kind::Time => Type::primitive_type_builder(name, PhysicalType::INT64)
                 .with_logical_type(Some(LogicalType::timestamp(true, TimeUnit::MILLIS)))
@@ -92,12 +91,13 @@ pub fn series_parquet(series: &SkySeries) -> Result<Vec<u8>, ParquetError> {
         .set_created_by(format!("campanile {}", env!("CARGO_PKG_VERSION")))
         .build();
     let rows: Vec<Vec<Cell>> = series.scans.iter().map(cells).collect();
-    let mut writer = SerializedFileWriter::new(Vec::new(), Arc::new(schema()?), Arc::new(props))?;
+    let kinds = kinds();
+    let mut writer = SerializedFileWriter::new(Vec::new(), Arc::new(schema(&kinds)?), Arc::new(props))?;
     let mut group = writer.next_row_group()?;
     let mut index = 0;
     while let Some(mut column) = group.next_column()? {
         let cells = rows.iter().map(|r| &r[index]);
-        match kinds()[index] {
+        match kinds[index] {
             Kind::Time => {
                 let values: Vec<i64> = cells
                     .map(|c| match c {

@@ -307,18 +307,26 @@ fn wrap_360(x: f64) -> f64 {
 #[multiversion(targets("x86_64+avx512f+avx512vl+avx2+fma", "x86_64+avx2+fma"))]
 pub(crate) fn geocentric(jd: &[f64], delta_t_s: &[f64]) -> Vec<Geocentric> {
     let fma = selected_target!().supports_feature_str("fma");
-    let mut out = Vec::with_capacity(jd.len());
-    for (j, d) in jd.chunks(LANES).zip(delta_t_s.chunks(LANES)) {
-        // A short last group is padded with its first instant.
-        let (mut a, mut b) = ([j[0]; LANES], [d[0]; LANES]);
-        a[..j.len()].copy_from_slice(j);
-        b[..d.len()].copy_from_slice(d);
-        let g = if fma {
-            geocentric_with::<LANES, true>(&a, &b)
+    by_lanes(jd, delta_t_s, |a, b| {
+        if fma {
+            geocentric_with::<LANES, true>(a, b)
         } else {
-            geocentric_with::<LANES, false>(&a, &b)
-        };
-        out.extend_from_slice(&g[..j.len()]);
+            geocentric_with::<LANES, false>(a, b)
+        }
+    })
+}
+
+/// `f` over `a` and `b` (of equal length) [`LANES`] at a time; a short last
+/// group is padded with its first element and the padding's results
+/// dropped. Inlined into each target of its multiversioned callers.
+#[inline(always)]
+fn by_lanes<A: Copy, B: Copy, R: Copy>(a: &[A], b: &[B], f: impl Fn(&[A; LANES], &[B; LANES]) -> [R; LANES]) -> Vec<R> {
+    let mut out = Vec::with_capacity(a.len());
+    for (x, y) in a.chunks(LANES).zip(b.chunks(LANES)) {
+        let (mut xs, mut ys) = ([x[0]; LANES], [y[0]; LANES]);
+        xs[..x.len()].copy_from_slice(x);
+        ys[..y.len()].copy_from_slice(y);
+        out.extend_from_slice(&f(&xs, &ys)[..x.len()]);
     }
     out
 }
@@ -399,20 +407,13 @@ const EARTH_RADIUS_M: f64 = 6_378_140.0;
 #[multiversion(targets("x86_64+avx512f+avx512vl+avx2+fma", "x86_64+avx2+fma"))]
 pub(crate) fn topocentric(geo: &[Geocentric], site: &[Site]) -> Vec<Topocentric> {
     let fma = selected_target!().supports_feature_str("fma");
-    let mut out = Vec::with_capacity(geo.len());
-    for (g, s) in geo.chunks(LANES).zip(site.chunks(LANES)) {
-        // A short last group is padded with its first row.
-        let (mut a, mut b) = ([g[0]; LANES], [s[0]; LANES]);
-        a[..g.len()].copy_from_slice(g);
-        b[..s.len()].copy_from_slice(s);
-        let t = if fma {
-            topocentric_with::<LANES, true>(&a, &b)
+    by_lanes(geo, site, |a, b| {
+        if fma {
+            topocentric_with::<LANES, true>(a, b)
         } else {
-            topocentric_with::<LANES, false>(&a, &b)
-        };
-        out.extend_from_slice(&t[..g.len()]);
-    }
-    out
+            topocentric_with::<LANES, false>(a, b)
+        }
+    })
 }
 
 #[inline(always)]
