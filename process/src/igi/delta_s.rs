@@ -26,6 +26,7 @@ use super::observation::Observation;
 use super::radiosity::{REFLECTION_DEPTH, RadiosityField, SurfaceLobe, surface_lobes};
 use super::specular_albedo::SpecularAlbedo;
 use super::stratified::Strata;
+use super::texel_groups::TEXTURED_RAY_FACTOR;
 use crate::brdf::{WardLobe, WardMaterial};
 use crate::render::Ray;
 
@@ -63,6 +64,7 @@ pub(crate) fn indirect_specular(
     albedos: &[Option<SpecularAlbedo>],
     observations: &[Observation],
     shapes: &[Option<WardLobe>],
+    textured: &[bool],
     rays: u32,
     factor_max: u32,
     block: usize,
@@ -74,7 +76,10 @@ pub(crate) fn indirect_specular(
         .iter()
         .enumerate()
         .map(|(s, shape)| {
-            let factor = ray_factor(materials.get(s).copied().flatten().as_ref(), factor_max);
+            let mut factor = ray_factor(materials.get(s).copied().flatten().as_ref(), factor_max);
+            if textured.get(s).copied().unwrap_or(false) {
+                factor = factor.max(TEXTURED_RAY_FACTOR);
+            }
             shape.map(|l| (SurfaceLobe::new(l), rays * factor))
         })
         .collect();
@@ -256,6 +261,7 @@ mod tests {
                     pixel: [x, y],
                     lights: Vec::new(),
                     e_direct: [0.0; 3],
+                    footprint_m: 0.01,
                 }
             })
             .collect();
@@ -277,6 +283,7 @@ mod tests {
                 &albedos,
                 &observations,
                 &shapes,
+                &[false; 6],
                 16,
                 1,
                 block,

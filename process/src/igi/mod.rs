@@ -44,6 +44,7 @@ pub mod scene_file;
 mod specular_albedo;
 mod stratified;
 pub mod table;
+pub mod texel_groups;
 pub mod uncertainty;
 pub mod variant_choice;
 mod ward_fit;

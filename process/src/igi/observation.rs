@@ -52,6 +52,9 @@ pub(crate) struct Observation {
     pub lights: Vec<LightTerm>,
     /// Direct irradiance, the sum of the terms.
     pub e_direct: [f64; 3],
+    /// Side of the pixel's patch on the surface, metres: distance × pixel
+    /// angle (× stride) / √cos θ (the geometric mean of its two sides).
+    pub footprint_m: f64,
 }
 
 /// Why pixels were not used, per view.
@@ -194,6 +197,7 @@ pub(crate) fn observations(
                         pixel: [x / stride, y / stride],
                         lights,
                         e_direct,
+                        footprint_m: (hit.point - cam.position).norm() * pixel_rad * stride as f64 / wo.z.sqrt(),
                     });
                 }
                 (obs, d)

@@ -20,8 +20,9 @@ use super::interreflection_check::{self, InterreflectionCheck};
 use super::observation::{DroppedPixels, Observation, observations};
 use super::radiosity::RadiosityField;
 use super::specular_albedo::SpecularAlbedo;
+use super::texel_groups::{MIN_TEXTURE_SPREAD, group_keys, texel_side, texture_spread};
 use super::uncertainty::{MaterialSigma, bootstrap};
-use super::ward_fit::{FitSample, Shape, anisotropic, isotropic, linear_fit};
+use super::ward_fit::{Albedo, FitSample, Shape, anisotropic, isotropic, linear_fit, number_groups};
 use crate::brdf::{WardKernel, WardLobe, WardMaterial, WardVariant};
 use crate::model_choice::bic;
 
@@ -214,6 +215,17 @@ pub fn recover_with_progress(
     for (i, o) in obs.iter().enumerate() {
         by_surface[o.surface].push(i);
     }
+    // Each observation's texel group on its surface (texel_groups).
+    let texels: Vec<Option<f64>> = by_surface.iter().map(|ix| texel_side(&obs, ix)).collect();
+    let mut group_key = vec![0usize; obs.len()];
+    for (s, ix) in by_surface.iter().enumerate() {
+        if let Some(t) = texels[s] {
+            for (&i, k) in ix.iter().zip(group_keys(&geometry, &obs, ix, t)) {
+                group_key[i] = k;
+            }
+        }
+    }
+    let mut textured = vec![false; n_surf];
 
     let mut materials: Vec<Option<WardMaterial>> = vec![None; n_surf];
     let mut shapes: Vec<Option<WardLobe>> = (0..n_surf)
@@ -250,6 +262,7 @@ pub fn recover_with_progress(
             &obs,
             &materials,
             &shapes,
+            &textured,
             &mut kind_ind,
             it,
             options,
@@ -284,12 +297,21 @@ pub fn recover_with_progress(
             .into_par_iter()
             .map(|s| {
                 let floor = weight_floor(&by_surface[s], &obs);
-                let samples: Vec<FitSample> = by_surface[s]
+                let mut samples: Vec<FitSample> = by_surface[s]
                     .iter()
-                    .map(|&i| fit_sample(&obs[i], &field, kind_ind[i], materials[s].as_ref(), floor))
+                    .map(|&i| fit_sample(&obs[i], &field, kind_ind[i], materials[s].as_ref(), floor, group_key[i]))
                     .collect();
+                let groups = number_groups(&mut samples);
                 let sparse = sparse_set(&by_surface[s], &obs, &samples, options.sparse_samples);
-                fit_surface(&samples, &sparse, &highlights[s], options, previous.get(s))
+                fit_surface(
+                    &samples,
+                    &sparse,
+                    groups,
+                    texels[s],
+                    &highlights[s],
+                    options,
+                    previous.get(s),
+                )
             })
             .collect();
         let fit_seconds = tt.elapsed().as_secs_f64();
@@ -300,6 +322,7 @@ pub fn recover_with_progress(
             }
             materials[s] = f.material;
             shapes[s] = f.material.and_then(|m| m.lobe).or(shapes[s]);
+            textured[s] = f.textured;
         }
         if it == 0 {
             change = f64::INFINITY;
@@ -352,15 +375,22 @@ pub fn recover_with_progress(
                 alpha_y: l.alpha_y,
                 gamma_rad: l.gamma_rad,
             });
+            let textured = f.textured;
             let refit = |draw: &[usize]| -> Option<WardMaterial> {
-                let dense: Vec<FitSample> = draw
+                let mut dense: Vec<FitSample> = draw
                     .iter()
-                    .map(|&i| fit_sample(&obs[i], &field, kind_ind[i], Some(&reference), floor))
+                    .map(|&i| fit_sample(&obs[i], &field, kind_ind[i], Some(&reference), floor, group_key[i]))
                     .collect();
+                let groups = number_groups(&mut dense);
+                let albedo = if textured {
+                    Albedo::PerGroup(groups)
+                } else {
+                    Albedo::Uniform
+                };
                 let lobe = match (model, shape) {
                     (SurfaceModel::Isotropic, Some(_)) => {
                         let sparse = sparse_set(draw, &obs, &dense, options.sparse_samples);
-                        let (a, _, _) = isotropic(&sparse, options.variant, 25);
+                        let (a, _, _) = isotropic(&sparse, options.variant, 25, albedo);
                         Some(
                             Shape {
                                 alpha_x: a,
@@ -372,12 +402,12 @@ pub fn recover_with_progress(
                     }
                     (SurfaceModel::Anisotropic, Some(shape)) => {
                         let sparse = sparse_set(draw, &obs, &dense, options.sparse_samples);
-                        let (sh, _, _) = anisotropic(&sparse, options.variant, &[shape], 0.1);
+                        let (sh, _, _) = anisotropic(&sparse, options.variant, &[shape], 0.1, albedo);
                         Some(sh.lobe(options.variant))
                     }
                     _ => None,
                 };
-                let fit = linear_fit(&dense, lobe.as_ref());
+                let fit = linear_fit(&dense, lobe.as_ref(), albedo);
                 Some(WardMaterial {
                     rho_d: fit.rho_d,
                     lobe: lobe.map(|l| WardLobe { rho_s: fit.rho_s, ..l }),
@@ -512,6 +542,7 @@ pub fn predict(
             &obs,
             materials,
             &shapes,
+            &[],
             &mut kind_ind,
             it,
             options,
@@ -551,6 +582,8 @@ struct SurfaceFit {
     /// The best anisotropic shape found (chosen or not): the next pass's
     /// simplex starts from it.
     anisotropic: Option<Shape>,
+    /// Whether ρd was fitted per texel group ([`Albedo::PerGroup`]; `texel_groups`).
+    textured: bool,
 }
 
 impl Default for SurfaceFit {
@@ -563,6 +596,7 @@ impl Default for SurfaceFit {
             bic: [None; 3],
             rms: 0.0,
             anisotropic: None,
+            textured: false,
         }
     }
 }
@@ -632,6 +666,7 @@ fn light_pass(
     obs: &[Observation],
     materials: &[Option<WardMaterial>],
     shapes: &[Option<WardLobe>],
+    textured: &[bool],
     kind_ind: &mut Vec<[f64; 3]>,
     pass: u32,
     options: &IgiOptions,
@@ -658,6 +693,7 @@ fn light_pass(
         &albedos,
         obs,
         shapes,
+        textured,
         options.lobe_rays,
         options.lobe_ray_factor_max,
         options.lobe_ray_block,
@@ -752,6 +788,7 @@ fn fit_sample(
     kind: [f64; 3],
     previous: Option<&WardMaterial>,
     floor: f64,
+    group: usize,
 ) -> FitSample {
     let e = total_irradiance(o, field);
     let diffuse = e.map(|v| v * std::f64::consts::FRAC_1_PI);
@@ -770,6 +807,7 @@ fn fit_sample(
         indirect: kind,
         radiance: o.radiance,
         weight: 1.0 / (p * p),
+        group,
     }
 }
 
@@ -793,11 +831,23 @@ fn sparse_set(indices: &[usize], obs: &[Observation], samples: &[FitSample], tar
         .collect()
 }
 
+/// Whether a surface's albedo varies over it, and over which groups.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct TextureTest {
+    textured: bool,
+    /// [`texture_spread`] of the groups.
+    spread: f64,
+    /// The group side, metres.
+    texel_m: f64,
+}
+
 /// Fits one surface: model choice, roughness search on the sparse set,
 /// final linear step on the dense set.
 fn fit_surface(
     dense: &[FitSample],
     sparse: &[FitSample],
+    groups: usize,
+    texel_m: Option<f64>,
     highlights: &[HighlightReport],
     options: &IgiOptions,
     previous: Option<&SurfaceFit>,
@@ -805,14 +855,58 @@ fn fit_surface(
     if dense.is_empty() {
         return SurfaceFit::default();
     }
+    // The uniform fit first: the test measures texture in what its
+    // specular estimate leaves.
+    let uniform = fit_model(dense, sparse, Albedo::Uniform, highlights, options, previous);
+    let texture = texel_m.map(|texel_m| {
+        let spread = texture_spread(dense, groups, uniform.material.as_ref());
+        TextureTest {
+            textured: spread >= MIN_TEXTURE_SPREAD,
+            spread,
+            texel_m,
+        }
+    });
+    let textured = texture.is_some_and(|t| t.textured);
+    let mut fit = if textured {
+        fit_model(dense, sparse, Albedo::PerGroup(groups), highlights, options, previous)
+    } else {
+        uniform
+    };
+    fit.textured = textured;
+    if let Some(t) = texture {
+        fit.reason.push_str(&format!(
+            "; {}: the ρd of {:.1} cm texel groups deviates from their median by {:.1} % of the apparent reflectance (median; {} {:.0} %)",
+            if t.textured {
+                "textured, ρd fitted per texel group"
+            } else {
+                "untextured"
+            },
+            100.0 * t.texel_m,
+            100.0 * t.spread,
+            if t.textured { "≥" } else { "<" },
+            100.0 * MIN_TEXTURE_SPREAD
+        ));
+    }
+    fit
+}
+
+/// [`fit_surface`] with the albedo model chosen.
+fn fit_model(
+    dense: &[FitSample],
+    sparse: &[FitSample],
+    albedo: Albedo,
+    highlights: &[HighlightReport],
+    options: &IgiOptions,
+    previous: Option<&SurfaceFit>,
+) -> SurfaceFit {
     let variant = options.variant;
     let n = 3 * sparse.len();
-    let diffuse_fit = linear_fit(sparse, None);
+    let diffuse_fit = linear_fit(sparse, None, albedo);
     let bic_d = bic(diffuse_fit.error, n, 3);
     let seen: Vec<&HighlightReport> = highlights.iter().filter(|h| h.seen).collect();
     let rms = |e: f64, m: usize| (e / (3 * m).max(1) as f64).sqrt();
     if seen.is_empty() {
-        let fit = linear_fit(dense, None);
+        let fit = linear_fit(dense, None, Albedo::Uniform);
         let reason = if highlights.is_empty() {
             "diffuse only: no light's mirror direction falls in any view of this surface, so ρs and α cannot be measured".to_string()
         } else {
@@ -835,9 +929,10 @@ fn fit_surface(
             bic: [Some(bic_d), None, None],
             rms: rms(fit.error, dense.len()),
             anisotropic: None,
+            textured: false,
         };
     }
-    let (alpha, iso, _) = isotropic(sparse, variant, 25);
+    let (alpha, iso, _) = isotropic(sparse, variant, 25, albedo);
     let bic_i = bic(iso.error, n, 7);
     let mut chosen = Shape {
         alpha_x: alpha,
@@ -873,7 +968,7 @@ fn fit_surface(
                 0.5,
             ),
         };
-        let (shape, aniso, _) = anisotropic(sparse, variant, &starts, step);
+        let (shape, aniso, _) = anisotropic(sparse, variant, &starts, step, albedo);
         aniso_shape = Some(shape);
         aniso_error = aniso.error;
         let b = bic(aniso.error, n, 9);
@@ -923,7 +1018,7 @@ fn fit_surface(
         0.0
     };
     if lobe_bic >= bic_d || gain < MIN_LOBE_GAIN {
-        let fit = linear_fit(dense, None);
+        let fit = linear_fit(dense, None, Albedo::Uniform);
         return SurfaceFit {
             model: SurfaceModel::DiffuseOnly,
             reason: format!(
@@ -944,10 +1039,11 @@ fn fit_surface(
             bic: [Some(bic_d), Some(bic_i), bic_a],
             rms: rms(fit.error, dense.len()),
             anisotropic: aniso_shape,
+            textured: false,
         };
     }
     let lobe_shape = chosen.lobe(variant);
-    let fit = linear_fit(dense, Some(&lobe_shape));
+    let fit = linear_fit(dense, Some(&lobe_shape), albedo);
     let lobe = WardLobe {
         rho_s: fit.rho_s,
         ..lobe_shape
@@ -978,6 +1074,7 @@ fn fit_surface(
         bic: [Some(bic_d), Some(bic_i), bic_a],
         rms: rms(fit.error, dense.len()),
         anisotropic: aniso_shape,
+        textured: false,
     }
 }
 
