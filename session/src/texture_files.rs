@@ -728,7 +728,7 @@ fn igi_chart_of(
             let off = (0..3)
                 .map(|v| (have[v] - nalgebra::Vector3::from(t.vertices[v])).norm())
                 .fold(0.0, f64::max);
-            if t.index != i || !(off <= 1e-6) {
+            if t.index != i || off.is_nan() || off > 1e-6 {
                 return Err(err(
                     format!("maps[{m}].layout.triangles[{k}]"),
                     format!("triangle {} at {:?}", t.index, t.vertices),

@@ -75,9 +75,13 @@ pub fn igi_albedo_synthesis(
             .iter()
             .find(|&&t| chart_of.get(t).copied().flatten().is_none_or(|c| c >= charts.len()))
         {
-            return Err(TextureError::NotInProducts {
-                name: scene.surfaces()[p.surface].clone(),
-                covered: format!("every triangle but {t}, which has no albedo map"),
+            return Err(TextureError::BadSetting {
+                field: "charts",
+                value: format!(
+                    "no albedo map for triangle {t} of surface {:?}",
+                    scene.surfaces()[p.surface]
+                ),
+                expected: "a map for every triangle of the surfaces textured".into(),
             });
         }
     }
