@@ -641,7 +641,7 @@ pub struct IgiAlbedoTextureManifest {
     pub patches: Vec<PatchRecord>,
     /// The maps of the surfaces textured.
     pub maps: Vec<MapUse>,
-    /// Surfaces not textured (some group has no map), with the reason.
+    /// Faces not textured (a triangle of theirs has no map), with the reason.
     pub not_textured: Vec<String>,
     /// The verdict and its figures (coverage: texels on map texels a view saw).
     pub quality: Quality,
@@ -861,57 +861,62 @@ pub fn igi_albedo_texture_files(
         .collect();
     let scene = Scene::new(geometry.triangles.clone(), materials, geometry.surfaces.clone())
         .map_err(|e| bad_input(format!("{}: {e}", geometry.obj.display())))?;
-    // The surfaces with a map on every triangle; the others and why.
-    let mut complete = Vec::new();
-    let mut not_textured = Vec::new();
-    for (s, name) in scene.surfaces().iter().enumerate() {
-        let tris: Vec<usize> = (0..scene.triangles().len())
-            .filter(|&i| scene.triangles()[i].surface as usize == s)
-            .collect();
-        if tris.is_empty() {
+    // The faces with a map on every triangle; the others, by surface and
+    // group, and why.
+    let wanted: Vec<String> = request.surfaces.clone().unwrap_or_else(|| scene.surfaces().to_vec());
+    let texel_m = request.texel_m.unwrap_or(index.texel_m);
+    let all = patches(&scene, Some(&wanted), texel_m, MAX_TEXELS)
+        .map_err(|e| bad_input(format!("{}: {e}", request.scene.display())))?;
+    let mut ps = Vec::with_capacity(all.len());
+    // (surface, group, faces, triangles)
+    let mut lacking: Vec<(usize, usize, usize, usize)> = Vec::new();
+    for p in all {
+        let Some(&i) = p.triangles.iter().find(|&&i| chart_of[i].is_none()) else {
+            ps.push(p);
             continue;
-        }
-        match tris.iter().find(|&&i| chart_of[i].is_none()) {
-            None => complete.push(name.clone()),
-            Some(&i) => {
-                let group = &geometry.groups[geometry.triangle_group[i]];
-                let why = index
-                    .skipped
-                    .iter()
-                    .find(|k| &k.group == group)
-                    .map_or("no map".to_string(), |k| k.reason.clone());
-                not_textured.push(format!("{name}: group {group:?} has no albedo map ({why})"));
+        };
+        let g = geometry.triangle_group[i];
+        match lacking.iter_mut().find(|l| (l.0, l.1) == (p.surface, g)) {
+            Some(l) => {
+                l.2 += 1;
+                l.3 += p.triangles.len();
             }
+            None => lacking.push((p.surface, g, 1, p.triangles.len())),
         }
     }
-    let surfaces = match &request.surfaces {
-        Some(wanted) => {
-            for w in wanted {
-                if let Some(reason) = not_textured
-                    .iter()
-                    .find(|r| r.split_once(':').is_some_and(|(n, _)| n == w))
-                {
-                    return Err(bad_input(format!(
-                        "--surface {w}: {}: expected a surface whose groups all have albedo maps ({})",
-                        reason,
-                        complete.join(", ")
-                    )));
-                }
-            }
-            wanted.clone()
-        }
-        None => complete.clone(),
-    };
-    if surfaces.is_empty() {
+    let not_textured: Vec<String> = lacking
+        .iter()
+        .map(|&(s, g, faces, triangles)| {
+            let group = &geometry.groups[g];
+            let why = index
+                .skipped
+                .iter()
+                .find(|k| &k.group == group)
+                .map_or("no map".to_string(), |k| k.reason.clone());
+            format!(
+                "{}: {faces} face(s), {triangles} triangle(s): group {group:?} has no albedo map ({why})",
+                scene.surfaces()[s]
+            )
+        })
+        .collect();
+    if request.surfaces.is_some() && !not_textured.is_empty() {
         return Err(bad_input(format!(
-            "{}: no surface has an albedo map on every triangle: {}",
-            layout.display(),
-            not_textured.join("; ")
+            "--surface: {}: expected surfaces whose faces all have albedo maps in {}",
+            not_textured.join("; "),
+            layout.display()
         )));
     }
-    let texel_m = request.texel_m.unwrap_or(index.texel_m);
-    let ps = patches(&scene, Some(&surfaces), texel_m, MAX_TEXELS)
-        .map_err(|e| bad_input(format!("{}: {e}", request.scene.display())))?;
+    if ps.is_empty() {
+        return Err(bad_input(format!(
+            "{}: no face has an albedo map on every triangle{}",
+            layout.display(),
+            if not_textured.is_empty() {
+                String::new()
+            } else {
+                format!(": {}", not_textured.join("; "))
+            }
+        )));
+    }
     let used: Vec<usize> = (0..index.maps.len())
         .filter(|&m| ps.iter().any(|p| p.triangles.iter().any(|&t| chart_of[t] == Some(m))))
         .collect();

@@ -70,9 +70,10 @@ use super::exit::{EXIT_OK, EXIT_QUALITY};
 /// directory above it, or layout.json. SCENE is then the IGI scene file
 /// the maps were recovered from (for `room`, OUT/room/scene.ron); its OBJ
 /// must be the one the maps were made on (every group, triangle and
-/// corner is checked). Default --texel: the maps' (1 cm); default
-/// surfaces: those with a map on every triangle (the others are listed
-/// with the reason). Each texel is the mean of the map texels under it
+/// corner is checked). Default --texel: the maps' (1 cm). Every face
+/// with a map on each of its triangles is textured; faces of groups that
+/// have no map (not planar) are listed with the reason (a --surface
+/// holding one is refused). Each texel is the mean of the map texels under it
 /// that a view saw; a texel on none is counted unseen and filled from its
 /// neighbours (a surface no view saw keeps the maps' own fill: its
 /// recovered ρd). Out: model.obj, model.mtl (map_Kd page_N.png: ρd, sRGB),
