@@ -525,6 +525,11 @@ fn igi_albedo_maps_make_an_albedo_texture_that_meets_the_truth() {
     let verdict = if q.coverage < 0.95 { "poor" } else { "ok" };
     assert_eq!(q.verdict, verdict);
     assert!(stdout.contains(&format!("albedo texture: {verdict}")), "{stdout}");
+    assert_eq!(
+        stdout.contains("texels on map texels no view saw were filled from their neighbours"),
+        verdict == "poor",
+        "{stdout}"
+    );
     let (models, materials) = tobj::load_obj(
         out.join("model.obj"),
         &tobj::LoadOptions {

@@ -832,7 +832,7 @@ pub fn igi_albedo_texture_files(
     use campanile_process::igi::albedo_chart::AlbedoMapIndex;
     use campanile_process::igi::scene_file::load_geometry;
     use campanile_process::texture::export::export_scaled;
-    use campanile_process::texture::{igi_albedo_synthesis, judge_albedo};
+    use campanile_process::texture::{AlbedoSource, igi_albedo_synthesis, judge_albedo_from};
 
     if let Some(t) = request.texel_m
         && !(t.is_finite() && t > 0.0)
@@ -947,7 +947,7 @@ pub fn igi_albedo_texture_files(
     let atlas = pack(&scene, &ps, &syn.textures, &AtlasSettings::default()).map_err(|e| bad_input(e.to_string()))?;
     let exported = export_scaled(&scene, &ps, &atlas, &request.out, Some(1.0))?;
     let seconds = start.elapsed().as_secs_f64();
-    let quality = judge_albedo(&syn.report, &request.limits);
+    let quality = judge_albedo_from(&syn.report, &request.limits, AlbedoSource::IgiMapTexels);
     let name_of = |p: &Path| {
         p.file_name()
             .map(|n| n.to_string_lossy().into_owned())

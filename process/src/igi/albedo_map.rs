@@ -802,20 +802,6 @@ fn tangents(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     (a, n.cross(&a))
 }
 
-impl AlbedoMap {
-    /// The map of triangles `members` (of `triangles`, the solver's input)
-    /// as one image over their shared planar texture coordinates, when they
-    /// are coplanar (row 0 at the largest `t`; unseen texels filled as in
-    /// [`AlbedoMap::albedo_at`]); `None` when they are not coplanar, are
-    /// empty, or the image would exceed 4096 texels a side. The image with
-    /// its layout and each texel's origin: [`super::albedo_chart::chart`].
-    pub fn chart(&self, triangles: &[Triangle], members: &[usize]) -> Option<crate::camera::image::RadianceImage> {
-        super::albedo_chart::chart(self, triangles, members)
-            .ok()
-            .map(|c| c.image)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -49,7 +49,7 @@ pub mod seam;
 pub mod synthesis;
 pub mod weight;
 
-pub use albedo::{PseudoAlbedo, albedo_synthesis, judge_albedo};
+pub use albedo::{AlbedoSource, PseudoAlbedo, albedo_synthesis, judge_albedo, judge_albedo_from};
 pub use atlas::{Atlas, AtlasSettings, pack};
 pub use igi_albedo::{ChartData, igi_albedo_synthesis};
 pub use patch::{Patch, patches, patches_on_lattice};
