@@ -590,7 +590,8 @@ pub fn albedo_texture_files(
 /// The `layout.json` of `campanile igi`'s albedo maps that `path` names:
 /// that file, or in `path` (the albedo directory), `path/albedo` (the
 /// `igi` output directory) or `path/room/igi/albedo` (a session's output
-/// directory after `campanile room`); `None` when there is none.
+/// directory after `campanile process` on a room session); `None` when
+/// there is none.
 pub fn igi_layout_file(path: &Path) -> Option<PathBuf> {
     use campanile_process::igi::albedo_chart::LAYOUT_FILE;
     if path.is_file() {

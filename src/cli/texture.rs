@@ -65,10 +65,11 @@ use super::exit::{EXIT_OK, EXIT_QUALITY};
 /// IGI albedo maps: --albedo DIR also takes the diffuse albedo maps (ρd,
 /// thesis §4.6) that `campanile igi` writes to OUT/albedo/ (one EXR per
 /// planar OBJ group, GROUP.seen.png saying which texels a view saw, and
-/// layout.json placing every texel on the geometry) and `campanile room`
-/// to OUT/room/igi/albedo/; DIR may be that directory, the output
-/// directory above it, or layout.json. SCENE is then the IGI scene file
-/// the maps were recovered from (for `room`, OUT/room/scene.ron); its OBJ
+/// layout.json placing every texel on the geometry), and `campanile
+/// process` on a room session to OUT/room/igi/albedo/; DIR may be that
+/// directory, the directory above it, layout.json, or a room session's
+/// process OUT. SCENE is then the IGI scene file the maps were recovered
+/// from (for a room session, OUT/room/scene.ron); its OBJ
 /// must be the one the maps were made on (every group, triangle and
 /// corner is checked). Default --texel: the maps' (1 cm). Every face
 /// with a map on each of its triangles is textured; faces of groups that

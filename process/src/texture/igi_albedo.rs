@@ -1,5 +1,5 @@
 //! Albedo textures from the diffuse albedo maps of inverse global
-//! illumination (thesis §4.6; `campanile igi` and `campanile room` write
+//! illumination (thesis §4.6; `campanile igi` and `campanile process` on a room session write
 //! them as one chart per planar OBJ group, [`crate::igi::albedo_chart`]),
 //! laid out as the radiance textures are (§3.4): one patch per face, packed
 //! into atlas pages, exported as OBJ + MTL + EXR/PNG.
