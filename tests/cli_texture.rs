@@ -737,7 +737,12 @@ fn igi_albedo_maps_make_an_albedo_texture_that_meets_the_truth() {
         &["--surface", "floor"],
         &["floor.seen.png", "origin mask"],
     );
-    // Another surface still textures without it.
-    let run = texture(&scene_file, &igi, &bad, &["--surface", "wall_east", "--texel", "0.25"]);
+    // Another surface still textures without it (the albedo directory itself given).
+    let run = texture(
+        &scene_file,
+        &albedo,
+        &bad,
+        &["--surface", "wall_east", "--texel", "0.25"],
+    );
     assert_eq!(run.status.code(), Some(0), "{}", String::from_utf8_lossy(&run.stderr));
 }

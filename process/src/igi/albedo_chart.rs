@@ -74,7 +74,9 @@ pub struct ChartTriangle {
     pub index: usize,
     /// Its corners, world frame, metres.
     pub vertices: [[f64; 3]; 3],
-    /// Its own texel grid: the lower corner `(s_g, t_g)`, metres.
+    /// Its own texel grid: the lower corner `(s_g, t_g)`, metres, on the
+    /// chart's axes (a triangle's axes follow from its normal alone, so
+    /// coplanar triangles share them).
     pub grid_origin_m: [f64; 2],
     /// Its grid's texels along `s` (columns) and `t` (rows).
     pub grid_size: [usize; 2],
