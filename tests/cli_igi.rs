@@ -161,6 +161,64 @@ fn igi_recovers_the_simulated_room_from_its_scene_file_and_relights_it() {
         let img = read_rgb_exr(&out.join("albedo").join(format!("{g}.exr"))).unwrap();
         assert!(img.width > 10 && img.height > 10, "{g}");
     }
+    // The spheres are not planar: no map, and layout.json says why;
+    // `campanile texture --albedo` textures the faces with maps and lists
+    // the spheres' faces as not textured.
+    let index: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("albedo").join("layout.json")).unwrap()).unwrap();
+    let skipped = index["skipped"].as_array().unwrap();
+    let mut groups: Vec<&str> = skipped.iter().map(|k| k["group"].as_str().unwrap()).collect();
+    groups.sort_unstable();
+    assert_eq!(groups, ["sphere-diffuse", "sphere-metal", "sphere-plastic"]);
+    assert!(
+        skipped
+            .iter()
+            .all(|k| k["reason"].as_str().unwrap().contains("not coplanar")),
+        "{skipped:?}"
+    );
+    let textured = dir.path().join("textured");
+    let o = campanile(&[
+        "texture",
+        scene.to_str().unwrap(),
+        "--albedo",
+        out.to_str().unwrap(),
+        "--texel",
+        "0.05",
+        "--out",
+        textured.to_str().unwrap(),
+    ]);
+    let tex_out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        matches!(o.status.code(), Some(0 | 3)),
+        "{tex_out}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        tex_out.contains("not textured: ") && tex_out.contains("\"sphere-metal\" has no albedo map"),
+        "{tex_out}"
+    );
+    let manifest: campanile_session::texture_files::IgiAlbedoTextureManifest =
+        ron::from_str(&std::fs::read_to_string(textured.join("texture.ron")).unwrap()).unwrap();
+    assert!(!manifest.patches.is_empty() && textured.join("model.obj").is_file());
+    for g in ["sphere-diffuse", "sphere-metal", "sphere-plastic"] {
+        assert!(
+            manifest.not_textured.iter().any(|n| n.contains(&format!("{g:?}"))),
+            "{g}: {:?}",
+            manifest.not_textured
+        );
+    }
+    assert!(
+        manifest.not_textured.iter().all(|n| n.contains("\"sphere-")),
+        "{:?}",
+        manifest.not_textured
+    );
+    eprintln!(
+        "room albedo texture: {} ({:.1} % of {} texels seen), {} groups not textured",
+        manifest.quality.verdict,
+        100.0 * manifest.quality.coverage,
+        manifest.quality.texels_on_faces,
+        manifest.not_textured.len()
+    );
     // Relit from the first wide view against the simulator's render of the same lamps.
     let relit = read_rgb_exr(&out.join("relit-wide-sw.exr")).unwrap();
     let camera = room.cameras(shot.wide_vfov_deg, 64, 48).swap_remove(0).1;

@@ -12,6 +12,7 @@ use campanile_process::brdf::WardVariant;
 use campanile_process::camera::image::RadianceImage;
 use campanile_process::exr_io::write_radiance_exr;
 use campanile_process::hdr::merge::RadianceMap;
+use campanile_process::igi::albedo_chart::{AlbedoMapIndex, LAYOUT_FILE, MapRecord, SkippedGroup, chart, origin_code};
 use campanile_process::igi::albedo_map::{AlbedoMap, AlbedoMapOptions};
 use campanile_process::igi::material_record::{records, seen_frame, variant_name};
 use campanile_process::igi::relight::{RelightSettings, relight};
@@ -196,20 +197,51 @@ pub fn write_exr(image: &RadianceImage, path: &Path) -> Result<()> {
     Ok(write_radiance_exr(&map, path).with_context(|| format!("writing {}", path.display()))?)
 }
 
-/// Writes the albedo map of every planar OBJ group to `dir/GROUP.exr`;
-/// returns the groups written.
+/// Writes the albedo map of every planar OBJ group to `dir/GROUP.exr`,
+/// each pixel's origin (seen, filled, the surface's ρd) to
+/// `dir/GROUP.seen.png`, and their layout, with the groups that have no
+/// map and why, to `dir/layout.json`
+/// ([`campanile_process::igi::albedo_chart`]); returns the groups written.
 pub fn write_albedo_maps(r: &Recovered, dir: &Path) -> Result<Vec<String>> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut written = Vec::new();
+    let mut index = AlbedoMapIndex::new(r.map.texel_m);
+    let triangles = &r.loaded.input.triangles;
     for (g, name) in r.loaded.groups.iter().enumerate() {
         let members: Vec<usize> = (0..r.loaded.triangle_group.len())
             .filter(|&i| r.loaded.triangle_group[i] == g)
             .collect();
-        if let Some(img) = r.map.chart(&r.loaded.input.triangles, &members) {
-            write_exr(&img, &dir.join(format!("{name}.exr")))?;
-            written.push(name.clone());
+        let surface = members
+            .first()
+            .and_then(|&i| r.loaded.input.surfaces.get(triangles[i].surface as usize))
+            .cloned()
+            .unwrap_or_default();
+        match chart(&r.map, triangles, &members) {
+            Ok(c) => {
+                let record = MapRecord::new(name, &surface, &c);
+                write_exr(&c.image, &dir.join(&record.exr))?;
+                let codes: Vec<u8> = c.origin.iter().map(|&o| origin_code(o)).collect();
+                let seen = dir.join(&record.seen);
+                image::GrayImage::from_raw(c.image.width as u32, c.image.height as u32, codes)
+                    .ok_or_else(|| anyhow!("{}: the origin mask does not match the chart's size", seen.display()))?
+                    .save(&seen)
+                    .with_context(|| format!("writing {}", seen.display()))?;
+                index.maps.push(record);
+                written.push(name.clone());
+            }
+            Err(reason) => index.skipped.push(SkippedGroup {
+                group: name.clone(),
+                surface,
+                reason,
+            }),
         }
     }
+    let path = dir.join(LAYOUT_FILE);
+    std::fs::write(
+        &path,
+        serde_json::to_string_pretty(&index).map_err(anyhow::Error::from)? + "\n",
+    )
+    .with_context(|| format!("writing {}", path.display()))?;
     Ok(written)
 }
 

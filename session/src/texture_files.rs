@@ -462,12 +462,12 @@ fn materials_file(path: &Path) -> anyhow::Result<PathBuf> {
         })
         .unwrap_or(false);
     Err(bad_input(format!(
-        "--albedo {}: no materials.ron here or in albedo/; expected the pseudo-albedo products of `campanile process` \
-         or `campanile outdoor recover`{}",
+        "--albedo {}: no materials.ron here or in albedo/ and no layout.json; expected the pseudo-albedo products of \
+         `campanile process` or `campanile outdoor recover`, or the albedo maps of `campanile igi`{}",
         path.display(),
         if igi_maps {
-            " (the EXR files here look like `campanile igi`'s per-group albedo maps, which record no layout and \
-             are not textured yet)"
+            " (the EXR files here look like `campanile igi`'s per-group albedo maps, but their layout.json is \
+             missing: run `campanile igi` again to write it)"
         } else {
             ""
         }
@@ -584,5 +584,421 @@ pub fn albedo_texture_files(
         manifest_path,
         exported,
         report: se.report,
+    })
+}
+
+/// The `layout.json` of `campanile igi`'s albedo maps that `path` names:
+/// that file, or in `path` (the albedo directory), `path/albedo` (the
+/// `igi` output directory) or `path/room/igi/albedo` (a session's output
+/// directory after `campanile process` on a room session); `None` when
+/// there is none.
+pub fn igi_layout_file(path: &Path) -> Option<PathBuf> {
+    use campanile_process::igi::albedo_chart::LAYOUT_FILE;
+    if path.is_file() {
+        return (path.file_name().is_some_and(|n| n == LAYOUT_FILE)).then(|| path.to_path_buf());
+    }
+    [
+        path.join(LAYOUT_FILE),
+        path.join("albedo").join(LAYOUT_FILE),
+        path.join("room").join("igi").join("albedo").join(LAYOUT_FILE),
+    ]
+    .into_iter()
+    .find(|p| p.is_file())
+}
+
+/// One albedo map as used.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MapUse {
+    /// The OBJ group.
+    pub group: String,
+    /// Its surface.
+    pub surface: String,
+    /// The map's texels on the group, and of them seen by a view, filled
+    /// from neighbours, and the surface's recovered ρd (the index's counts).
+    pub texels: usize,
+    /// Seen by a view.
+    pub seen: usize,
+    /// Filled from seen texels within 3 texels.
+    pub filled: usize,
+    /// The surface's recovered ρd.
+    pub surface_mean: usize,
+}
+
+/// `texture.ron` of an albedo texture from `campanile igi`'s albedo maps.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename = "IgiAlbedoTextureMaps")]
+pub struct IgiAlbedoTextureManifest {
+    /// The maps' index read.
+    pub layout: PathBuf,
+    /// The maps' texel side, metres.
+    pub maps_texel_m: f64,
+    /// Texel side, metres.
+    pub texel_m: f64,
+    /// The OBJ, relative to the manifest.
+    pub obj: String,
+    /// ρd pages: (EXR, PNG) file names; the MTL's `map_Kd` is the PNG.
+    pub pages: Vec<(String, String)>,
+    /// The patches.
+    pub patches: Vec<PatchRecord>,
+    /// The maps of the surfaces textured.
+    pub maps: Vec<MapUse>,
+    /// Faces not textured (a triangle of theirs has no map), with the reason.
+    pub not_textured: Vec<String>,
+    /// The verdict and its figures (coverage: texels on map texels a view saw).
+    pub quality: Quality,
+    /// Wall time of reading, resampling, packing and export, seconds.
+    pub seconds: f64,
+}
+
+/// What `texture --albedo` did with `campanile igi`'s maps.
+#[derive(Debug, Clone)]
+pub struct IgiAlbedoTextureRun {
+    /// The manifest written.
+    pub manifest: IgiAlbedoTextureManifest,
+    /// Where it was written.
+    pub manifest_path: PathBuf,
+    /// The files written.
+    pub exported: Exported,
+    /// The resampling report.
+    pub report: SynthesisReport,
+}
+
+/// The maps of `index` (read from `layout`) checked against `geometry`
+/// (errors name the file, the field, the value and what was expected);
+/// per triangle of `geometry`, its map.
+fn igi_chart_of(
+    layout: &Path,
+    index: &campanile_process::igi::albedo_chart::AlbedoMapIndex,
+    geometry: &campanile_process::igi::scene_file::IgiGeometry,
+) -> anyhow::Result<Vec<Option<usize>>> {
+    use campanile_process::igi::albedo_chart::{LAYOUT_FORMAT, LAYOUT_VERSION};
+    let err = |field: String, value: String, expected: String| {
+        bad_input(format!("{}: {field} = {value}: expected {expected}", layout.display()))
+    };
+    if index.format != LAYOUT_FORMAT || index.version != LAYOUT_VERSION {
+        return Err(err(
+            "format, version".into(),
+            format!("{:?}, {}", index.format, index.version),
+            format!("{LAYOUT_FORMAT:?}, {LAYOUT_VERSION}"),
+        ));
+    }
+    if !(index.texel_m.is_finite() && index.texel_m > 0.0) {
+        return Err(err(
+            "texel_m".into(),
+            index.texel_m.to_string(),
+            "a length > 0 m".into(),
+        ));
+    }
+    let obj = geometry.obj.display();
+    let mut chart_of = vec![None; geometry.triangles.len()];
+    for (m, rec) in index.maps.iter().enumerate() {
+        let Some(g) = geometry.groups.iter().position(|n| n == &rec.group) else {
+            return Err(err(
+                format!("maps[{m}].group"),
+                format!("{:?}", rec.group),
+                format!(
+                    "an OBJ group of {obj} (it has: {}); the maps were recovered on another geometry",
+                    geometry.groups.join(", ")
+                ),
+            ));
+        };
+        let members: Vec<usize> = (0..geometry.triangles.len())
+            .filter(|&i| geometry.triangle_group[i] == g)
+            .collect();
+        let l = &rec.layout;
+        if l.triangles.len() != members.len() {
+            return Err(err(
+                format!("maps[{m}].layout.triangles"),
+                format!("{} triangles", l.triangles.len()),
+                format!(
+                    "the {} triangles of group {:?} in {obj}; the maps were recovered on another geometry",
+                    members.len(),
+                    rec.group
+                ),
+            ));
+        }
+        if !(l.texel_m.is_finite() && l.texel_m > 0.0 && l.width > 0 && l.height > 0) {
+            return Err(err(
+                format!("maps[{m}].layout"),
+                format!("texel_m {}, {} × {} texels", l.texel_m, l.width, l.height),
+                "a texel > 0 m and at least one texel".into(),
+            ));
+        }
+        for (k, (t, &i)) in l.triangles.iter().zip(&members).enumerate() {
+            let have = &geometry.triangles[i].vertices;
+            let off = (0..3)
+                .map(|v| (have[v] - nalgebra::Vector3::from(t.vertices[v])).norm())
+                .fold(0.0, f64::max);
+            if t.index != i || off.is_nan() || off > 1e-6 {
+                return Err(err(
+                    format!("maps[{m}].layout.triangles[{k}]"),
+                    format!("triangle {} at {:?}", t.index, t.vertices),
+                    format!(
+                        "triangle {i} of group {:?} in {obj}, at {:?} (within 1 µm); the maps were recovered on another \
+                         geometry",
+                        rec.group,
+                        have.each_ref().map(|v| [v.x, v.y, v.z])
+                    ),
+                ));
+            }
+            chart_of[i] = Some(m);
+        }
+    }
+    for (g, name) in geometry.groups.iter().enumerate() {
+        let has_triangles = geometry.triangle_group.contains(&g);
+        if has_triangles
+            && !index.maps.iter().any(|r| &r.group == name)
+            && !index.skipped.iter().any(|s| &s.group == name)
+        {
+            return Err(err(
+                "maps, skipped".into(),
+                format!("no entry for group {name:?}"),
+                format!("one entry per OBJ group of {obj}; the maps were recovered on another geometry"),
+            ));
+        }
+    }
+    Ok(chart_of)
+}
+
+/// Reads map `rec`'s image and origins beside `layout`.
+fn read_chart(
+    layout: &Path,
+    m: usize,
+    rec: &campanile_process::igi::albedo_chart::MapRecord,
+) -> anyhow::Result<campanile_process::texture::ChartData> {
+    use campanile_process::exr_io::read_rgb_exr;
+    use campanile_process::igi::albedo_chart::origin_of_code;
+    let dir = layout.parent().unwrap_or(Path::new("."));
+    let (w, h) = (rec.layout.width, rec.layout.height);
+    let exr = dir.join(&rec.exr);
+    let image = read_rgb_exr(&exr).map_err(|e| bad_input(format!("{}: {e}", exr.display())))?;
+    if (image.width, image.height) != (w, h) {
+        return Err(bad_input(format!(
+            "{}: {} × {} texels, but {} maps[{m}].layout says {w} × {h}: expected the map the index describes",
+            exr.display(),
+            image.width,
+            image.height,
+            layout.display()
+        )));
+    }
+    let png = dir.join(&rec.seen);
+    let mask = image::open(&png)
+        .map_err(|e| {
+            bad_input(format!(
+                "{}: {e}: expected the map's 8-bit grey origin mask",
+                png.display()
+            ))
+        })?
+        .into_luma8();
+    if (mask.width() as usize, mask.height() as usize) != (w, h) {
+        return Err(bad_input(format!(
+            "{}: {} × {} pixels, but {} maps[{m}].layout says {w} × {h}: expected the map's origin mask",
+            png.display(),
+            mask.width(),
+            mask.height(),
+            layout.display()
+        )));
+    }
+    let origin = mask
+        .as_raw()
+        .iter()
+        .enumerate()
+        .map(|(k, &c)| {
+            origin_of_code(c).map_err(|c| {
+                bad_input(format!(
+                    "{}: pixel ({}, {}) = {c}: expected 255 (seen), 128 (filled), 64 (surface ρd) or 0 (outside)",
+                    png.display(),
+                    k % w,
+                    k / w
+                ))
+            })
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    Ok(campanile_process::texture::ChartData {
+        layout: rec.layout.clone(),
+        image,
+        origin,
+    })
+}
+
+/// Runs `texture --albedo` on `campanile igi`'s albedo maps (`layout`, from
+/// [`igi_layout_file`]): `request.scene` is the IGI scene file the maps were
+/// recovered from ([`campanile_process::texture::igi_albedo`]). `bar` gets
+/// the patches' count, then one tick per patch.
+pub fn igi_albedo_texture_files(
+    request: &AlbedoTextureRequest,
+    layout: &Path,
+    bar: &indicatif::ProgressBar,
+) -> anyhow::Result<IgiAlbedoTextureRun> {
+    use campanile_process::igi::albedo_chart::AlbedoMapIndex;
+    use campanile_process::igi::scene_file::load_geometry;
+    use campanile_process::texture::export::export_scaled;
+    use campanile_process::texture::{AlbedoSource, igi_albedo_synthesis, judge_albedo_from};
+
+    if let Some(t) = request.texel_m
+        && !(t.is_finite() && t > 0.0)
+    {
+        return Err(bad_input(format!("--texel {t}: expected a positive length in metres")));
+    }
+    let start = Instant::now();
+    let text = std::fs::read_to_string(layout).map_err(|e| bad_input(format!("{}: {e}", layout.display())))?;
+    let index: AlbedoMapIndex = serde_json::from_str(&text).map_err(|e| {
+        bad_input(format!(
+            "{}: {e}: expected the albedo maps' index that `campanile igi` writes (format {:?})",
+            layout.display(),
+            campanile_process::igi::albedo_chart::LAYOUT_FORMAT
+        ))
+    })?;
+    let geometry = load_geometry(&request.scene).map_err(|e| {
+        bad_input(format!(
+            "{e} (with `campanile igi`'s albedo maps, SCENE is the IGI scene file they were recovered from)"
+        ))
+    })?;
+    let chart_of = igi_chart_of(layout, &index, &geometry)?;
+    let materials = geometry
+        .surfaces
+        .iter()
+        .map(|n| Material::diffuse(n, [0.5; 3]))
+        .collect();
+    let scene = Scene::new(geometry.triangles.clone(), materials, geometry.surfaces.clone())
+        .map_err(|e| bad_input(format!("{}: {e}", geometry.obj.display())))?;
+    // The faces with a map on every triangle; the others, by surface and
+    // group, and why.
+    let wanted: Vec<String> = request.surfaces.clone().unwrap_or_else(|| scene.surfaces().to_vec());
+    let texel_m = request.texel_m.unwrap_or(index.texel_m);
+    let all = patches(&scene, Some(&wanted), texel_m, MAX_TEXELS)
+        .map_err(|e| bad_input(format!("{}: {e}", request.scene.display())))?;
+    let mut ps = Vec::with_capacity(all.len());
+    // (surface, group, faces, triangles)
+    let mut lacking: Vec<(usize, usize, usize, usize)> = Vec::new();
+    for p in all {
+        let Some(&i) = p.triangles.iter().find(|&&i| chart_of[i].is_none()) else {
+            ps.push(p);
+            continue;
+        };
+        let g = geometry.triangle_group[i];
+        match lacking.iter_mut().find(|l| (l.0, l.1) == (p.surface, g)) {
+            Some(l) => {
+                l.2 += 1;
+                l.3 += p.triangles.len();
+            }
+            None => lacking.push((p.surface, g, 1, p.triangles.len())),
+        }
+    }
+    let not_textured: Vec<String> = lacking
+        .iter()
+        .map(|&(s, g, faces, triangles)| {
+            let group = &geometry.groups[g];
+            let why = index
+                .skipped
+                .iter()
+                .find(|k| &k.group == group)
+                .map_or("no map".to_string(), |k| k.reason.clone());
+            format!(
+                "{}: {faces} face(s), {triangles} triangle(s): group {group:?} has no albedo map ({why})",
+                scene.surfaces()[s]
+            )
+        })
+        .collect();
+    if request.surfaces.is_some() && !not_textured.is_empty() {
+        return Err(bad_input(format!(
+            "--surface: {}: expected surfaces whose faces all have albedo maps in {}",
+            not_textured.join("; "),
+            layout.display()
+        )));
+    }
+    if ps.is_empty() {
+        return Err(bad_input(format!(
+            "{}: no face has an albedo map on every triangle{}",
+            layout.display(),
+            if not_textured.is_empty() {
+                String::new()
+            } else {
+                format!(": {}", not_textured.join("; "))
+            }
+        )));
+    }
+    let used: Vec<usize> = (0..index.maps.len())
+        .filter(|&m| ps.iter().any(|p| p.triangles.iter().any(|&t| chart_of[t] == Some(m))))
+        .collect();
+    let mut charts = Vec::with_capacity(index.maps.len());
+    for (m, rec) in index.maps.iter().enumerate() {
+        charts.push(if used.contains(&m) {
+            read_chart(layout, m, rec)?
+        } else {
+            // Not needed: an empty stand-in that no patch reads.
+            campanile_process::texture::ChartData {
+                layout: campanile_process::igi::albedo_chart::ChartLayout {
+                    width: 0,
+                    height: 0,
+                    ..rec.layout.clone()
+                },
+                image: campanile_process::camera::image::RadianceImage {
+                    width: 0,
+                    height: 0,
+                    data: Vec::new(),
+                },
+                origin: Vec::new(),
+            }
+        });
+    }
+    bar.set_length(ps.len() as u64);
+    let syn = igi_albedo_synthesis(&scene, &ps, &charts, &chart_of, &|| bar.inc(1))
+        .map_err(|e| bad_input(format!("{}: {e}", layout.display())))?;
+    let atlas = pack(&scene, &ps, &syn.textures, &AtlasSettings::default()).map_err(|e| bad_input(e.to_string()))?;
+    let exported = export_scaled(&scene, &ps, &atlas, &request.out, Some(1.0))?;
+    let seconds = start.elapsed().as_secs_f64();
+    let quality = judge_albedo_from(&syn.report, &request.limits, AlbedoSource::IgiMapTexels);
+    let name_of = |p: &Path| {
+        p.file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    };
+    let r = &syn.report;
+    let manifest = IgiAlbedoTextureManifest {
+        layout: layout.to_path_buf(),
+        maps_texel_m: index.texel_m,
+        texel_m,
+        obj: name_of(&exported.obj),
+        pages: exported.pages.iter().map(|(e, p)| (name_of(e), name_of(p))).collect(),
+        patches: ps
+            .iter()
+            .zip(&atlas.placements)
+            .zip(&r.per_patch)
+            .map(|((p, pl), &(texels, unseen))| PatchRecord {
+                surface: scene.surfaces()[p.surface].clone(),
+                page: pl.page,
+                rect: (pl.x, pl.y, p.cols + 2 * atlas.gutter, p.rows + 2 * atlas.gutter),
+                texels,
+                unseen,
+            })
+            .collect(),
+        maps: used
+            .iter()
+            .map(|&m| {
+                let rec = &index.maps[m];
+                MapUse {
+                    group: rec.group.clone(),
+                    surface: rec.surface.clone(),
+                    texels: rec.texels,
+                    seen: rec.seen_texels,
+                    filled: rec.filled_texels,
+                    surface_mean: rec.surface_mean_texels,
+                }
+            })
+            .collect(),
+        not_textured,
+        quality,
+        seconds,
+    };
+    let manifest_path = request.out.join("texture.ron");
+    let text =
+        ron::ser::to_string_pretty(&manifest, ron::ser::PrettyConfig::default()).context("serializing texture.ron")?;
+    std::fs::write(&manifest_path, text + "\n").with_context(|| format!("writing {}", manifest_path.display()))?;
+    Ok(IgiAlbedoTextureRun {
+        manifest,
+        manifest_path,
+        exported,
+        report: syn.report,
     })
 }

@@ -22,8 +22,11 @@ use clap::Args;
 /// materials.txt (Table 4.1's layout, with each surface's model and why),
 /// materials.rad (RADIANCE plastic/plastic2/metal/metal2) and materials.xml
 /// (Mitsuba 3; see docs/reference/igi-scene-file.md for the conversions),
-/// summary.json, albedo/GROUP.exr for each planar OBJ group, and with
-/// --relight LIGHTS.ron, relit-CAMERA.exr for every camera with an image.
+/// summary.json, albedo/GROUP.exr for each planar OBJ group (with
+/// albedo/GROUP.seen.png, which texels a view saw, and albedo/layout.json,
+/// where each texel lies; `campanile texture --albedo OUT` textures the
+/// model from them), and with --relight LIGHTS.ron, relit-CAMERA.exr for
+/// every camera with an image.
 ///
 /// Example: campanile igi room/scene.ron --out room/igi
 #[derive(Debug, Args)]

@@ -6,13 +6,16 @@ use std::path::PathBuf;
 use anyhow::Result;
 use campanile_process::texture::QualityLimits;
 use campanile_session::progress::bar;
-use campanile_session::texture_files::{AlbedoTextureRequest, TextureRequest, albedo_texture_files, texture_files};
+use campanile_session::texture_files::{
+    AlbedoTextureRequest, TextureRequest, albedo_texture_files, igi_albedo_texture_files, igi_layout_file,
+    texture_files,
+};
 use clap::Args;
 
 use super::exit::{EXIT_OK, EXIT_QUALITY};
 
 /// Texture maps from registered HDR photographs (thesis §3.4), or albedo
-/// textures from the recovered pseudo-albedos (--albedo).
+/// textures from the recovered pseudo-albedos or IGI albedo maps (--albedo).
 ///
 /// Every face of the scene (coplanar triangles of one named surface) gets a
 /// patch of square texels of --texel metres; each texel is the weighted
@@ -57,8 +60,26 @@ use super::exit::{EXIT_OK, EXIT_QUALITY};
 /// tone-mapped), page_N.exr (ρ^se), sun_page_N.exr (ρ^sun, same layout)
 /// and texture.ron. Texels on cells no photograph saw are counted as
 /// unseen and filled from their neighbours; the verdict follows the same
-/// coverage thresholds. (The per-group albedo maps of `campanile igi` are
-/// not taken yet.)
+/// coverage thresholds.
+///
+/// IGI albedo maps: --albedo DIR also takes the diffuse albedo maps (ρd,
+/// thesis §4.6) that `campanile igi` writes to OUT/albedo/ (one EXR per
+/// planar OBJ group, GROUP.seen.png saying which texels a view saw, and
+/// layout.json placing every texel on the geometry), and `campanile
+/// process` on a room session to OUT/room/igi/albedo/; DIR may be that
+/// directory, the directory above it, layout.json, or a room session's
+/// process OUT. SCENE is then the IGI scene file the maps were recovered
+/// from (for a room session, OUT/room/scene.ron); its OBJ
+/// must be the one the maps were made on (every group, triangle and
+/// corner is checked). Default --texel: the maps' (1 cm). Every face
+/// with a map on each of its triangles is textured; faces of groups that
+/// have no map (not planar) are listed with the reason (a --surface
+/// holding one is refused). Each texel is the mean of the map texels under it
+/// that a view saw; a texel on none is counted unseen and filled from its
+/// neighbours (a surface no view saw keeps the maps' own fill: its
+/// recovered ρd). Out: model.obj, model.mtl (map_Kd page_N.png: ρd, sRGB),
+/// page_N.exr (ρd, linear) and texture.ron; the same verdict and exit
+/// status.
 ///
 /// Example:
 ///   campanile register shots/*.png --targets examples/campanile-targets.ron \
@@ -67,6 +88,8 @@ use super::exit::{EXIT_OK, EXIT_QUALITY};
 ///       --station examples/sim-station.ron --texel 0.1 --out textured/
 ///   campanile texture examples/campanile-scene.ron --albedo processed/albedo \
 ///       --out albedo-textured/
+///   campanile igi room/scene.ron --out room/igi
+///   campanile texture room/scene.ron --albedo room/igi --texel 0.05 --out room/textured/
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct TextureArgs {
@@ -85,13 +108,14 @@ pub struct TextureArgs {
     /// Output directory.
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
-    /// Texel side, metres (default 0.1; with --albedo the products' grid spacing).
+    /// Texel side, metres (default 0.1; with --albedo the products' grid spacing or the IGI maps' texel).
     #[arg(long, value_name = "M")]
     texel: Option<f64>,
     /// Texture only this surface (repeat for several; default: all).
     #[arg(long = "surface", value_name = "NAME")]
     surfaces: Vec<String>,
-    /// Albedo textures from the pseudo-albedo products in DIR (`process`'s albedo/) instead of radiance.
+    /// Albedo textures from the pseudo-albedo products in DIR (`process`'s albedo/), or from the IGI albedo
+    /// maps in DIR (`igi`'s albedo/), instead of radiance.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["poses", "photos"])]
     albedo: Option<PathBuf>,
 }
@@ -161,6 +185,9 @@ pub fn run(args: TextureArgs) -> Result<u8> {
 }
 
 fn run_albedo(request: AlbedoTextureRequest) -> Result<u8> {
+    if let Some(layout) = igi_layout_file(&request.albedo) {
+        return run_igi_albedo(request, &layout);
+    }
     let progress = bar(0, "albedo texture");
     let run = albedo_texture_files(&request, &progress);
     progress.finish_and_clear();
@@ -181,6 +208,42 @@ fn run_albedo(request: AlbedoTextureRequest) -> Result<u8> {
         q.unseen,
         m.texel_m,
         m.spacing_m,
+        m.pages.len(),
+        m.seconds,
+        if q.reasons.is_empty() {
+            String::new()
+        } else {
+            format!(": {}", q.reasons.join("; "))
+        }
+    );
+    println!("written to {}", run.manifest_path.display());
+    Ok(if q.verdict == "failed" { EXIT_QUALITY } else { EXIT_OK })
+}
+
+fn run_igi_albedo(request: AlbedoTextureRequest, layout: &std::path::Path) -> Result<u8> {
+    let progress = bar(0, "albedo texture");
+    let run = igi_albedo_texture_files(&request, layout, &progress);
+    progress.finish_and_clear();
+    let run = run?;
+    let m = &run.manifest;
+    for u in &m.maps {
+        println!(
+            "{} (surface {}): map texels {} seen, {} filled from neighbours, {} the surface's rho_d, of {}",
+            u.group, u.surface, u.seen, u.filled, u.surface_mean, u.texels
+        );
+    }
+    for n in &m.not_textured {
+        println!("not textured: {n}");
+    }
+    let q = &m.quality;
+    println!(
+        "albedo texture: {} (coverage {:.1}% of {} texels, {} on map texels no view saw filled from neighbours; {} m texels on {} m map texels; {} page(s), {:.1} s){}",
+        q.verdict,
+        100.0 * q.coverage,
+        q.texels_on_faces,
+        q.unseen,
+        m.texel_m,
+        m.maps_texel_m,
         m.pages.len(),
         m.seconds,
         if q.reasons.is_empty() {

@@ -141,6 +141,19 @@ pub struct TriangleTexels {
     pub weight: Vec<f32>,
 }
 
+/// How a texel of the map got its value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum TexelOrigin {
+    /// Seen by at least one view (its samples' weighted mean).
+    Seen,
+    /// No view saw it: the mean of the seen texels in the nearest ring
+    /// within [`FILL_RADIUS`] texels.
+    Filled,
+    /// No view saw it nor any texel within [`FILL_RADIUS`]: its surface's
+    /// recovered ρd.
+    SurfaceMean,
+}
+
 /// The albedo map of every triangle.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AlbedoMap {
@@ -211,7 +224,23 @@ impl AlbedoMap {
     /// The albedo at point `p` of triangle `triangle` (module doc: unseen
     /// texels are filled from neighbours, then from the surface's ρd).
     pub fn albedo_at(&self, triangle: usize, surface: usize, tri: &Triangle, p: &Vector3<f64>) -> [f64; 3] {
-        let fallback = self.fallback.get(surface).copied().unwrap_or([0.5; 3]);
+        self.albedo_and_origin_at(triangle, surface, tri, p).0
+    }
+
+    /// [`AlbedoMap::albedo_at`], and how that value was obtained: seen by
+    /// a view, filled from seen texels within [`FILL_RADIUS`], or the
+    /// surface's recovered ρd.
+    pub fn albedo_and_origin_at(
+        &self,
+        triangle: usize,
+        surface: usize,
+        tri: &Triangle,
+        p: &Vector3<f64>,
+    ) -> ([f64; 3], TexelOrigin) {
+        let fallback = (
+            self.fallback.get(surface).copied().unwrap_or([0.5; 3]),
+            TexelOrigin::SurfaceMean,
+        );
         let Some(t) = self.triangles.get(triangle) else {
             return fallback;
         };
@@ -238,7 +267,8 @@ impl AlbedoMap {
                 }
             }
             if w > 0.0 {
-                return sum.map(|v| v / w);
+                let origin = if r == 0 { TexelOrigin::Seen } else { TexelOrigin::Filled };
+                return (sum.map(|v| v / w), origin);
             }
         }
         fallback
@@ -770,74 +800,6 @@ fn tangents(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     let helper = if n.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
     let a = n.cross(&helper).normalize();
     (a, n.cross(&a))
-}
-
-impl AlbedoMap {
-    /// The map of triangles `members` (of `triangles`, the solver's input)
-    /// as one image over their shared planar texture coordinates, when they
-    /// are coplanar (row 0 at the largest `t`; unseen texels filled as in
-    /// [`AlbedoMap::albedo_at`]); `None` when they are not coplanar, are
-    /// empty, or the image would exceed 4096 texels a side.
-    pub fn chart(&self, triangles: &[Triangle], members: &[usize]) -> Option<crate::camera::image::RadianceImage> {
-        let first = triangles.get(*members.first()?)?;
-        let (n, d) = (first.normal, first.normal.dot(&first.vertices[0]));
-        let coplanar = members.iter().all(|&i| {
-            triangles.get(i).is_some_and(|t| {
-                t.normal.dot(&n) > 1.0 - 1e-9 && t.vertices.iter().all(|v| (v.dot(&n) - d).abs() < 1e-6)
-            })
-        });
-        if !coplanar {
-            return None;
-        }
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for &i in members {
-            let t = &triangles[i];
-            for v in &t.vertices {
-                let st = t.texture_coordinates(v);
-                for k in 0..2 {
-                    lo[k] = lo[k].min(st[k]);
-                    hi[k] = hi[k].max(st[k]);
-                }
-            }
-        }
-        let w = ((hi[0] - lo[0]) / self.texel_m).ceil() as usize;
-        let h = ((hi[1] - lo[1]) / self.texel_m).ceil() as usize;
-        if w == 0 || h == 0 || w > 4096 || h > 4096 {
-            return None;
-        }
-        let mut data = vec![0f32; w * h * 3];
-        for y in 0..h {
-            for x in 0..w {
-                let st = [
-                    lo[0] + (x as f64 + 0.5) * self.texel_m,
-                    hi[1] - (y as f64 + 0.5) * self.texel_m,
-                ];
-                // The point in the plane with these coordinates: s and t
-                // axes are orthonormal in the face.
-                let t0 = &triangles[members[0]];
-                let p = t0.texture_axes[0] * st[0] + t0.texture_axes[1] * st[1] + n * d;
-                let inside = members.iter().find(|&&i| {
-                    let t = &triangles[i];
-                    let (a, b, c) = (t.vertices[0], t.vertices[1], t.vertices[2]);
-                    let s1 = (b - a).cross(&(p - a)).dot(&t.normal);
-                    let s2 = (c - b).cross(&(p - b)).dot(&t.normal);
-                    let s3 = (a - c).cross(&(p - c)).dot(&t.normal);
-                    s1 >= -1e-9 && s2 >= -1e-9 && s3 >= -1e-9
-                });
-                if let Some(&i) = inside {
-                    let a = self.albedo_at(i, triangles[i].surface as usize, &triangles[i], &p);
-                    for c in 0..3 {
-                        data[(y * w + x) * 3 + c] = a[c] as f32;
-                    }
-                }
-            }
-        }
-        Some(crate::camera::image::RadianceImage {
-            width: w,
-            height: h,
-            data,
-        })
-    }
 }
 
 #[cfg(test)]

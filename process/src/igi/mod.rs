@@ -23,6 +23,7 @@
 // Colour channels are indexed 0..3 alike across several arrays at once.
 #![allow(clippy::needless_range_loop)]
 
+pub mod albedo_chart;
 pub mod albedo_map;
 pub mod camera;
 mod delta_s;

@@ -557,14 +557,33 @@ pub fn parse(path: &Path, text: &str) -> Result<IgiScene, SceneFileError> {
         })
 }
 
-/// Reads scene file `path`, its geometry and images, and triangulates the
-/// lights given by bulb images.
-pub fn load(path: &Path) -> Result<LoadedIgiScene, SceneFileError> {
+/// A scene file's geometry: its OBJ's triangles, each tagged with its
+/// surface (a group sharing one BRDF) and its OBJ group.
+#[derive(Debug, Clone)]
+pub struct IgiGeometry {
+    /// The OBJ file read.
+    pub obj: PathBuf,
+    /// Surface names, indexed by `Triangle::surface` (and `material`).
+    pub surfaces: Vec<String>,
+    /// OBJ group names.
+    pub groups: Vec<String>,
+    /// The triangles, in the OBJ's face order (degenerate faces skipped).
+    pub triangles: Vec<Triangle>,
+    /// Per triangle, its OBJ group.
+    pub triangle_group: Vec<usize>,
+}
+
+/// Reads scene file `path`'s geometry only (no images, cameras or lights):
+/// the triangles [`load`] gives the solver, with their surfaces and groups.
+pub fn load_geometry(path: &Path) -> Result<IgiGeometry, SceneFileError> {
     let text = std::fs::read_to_string(path).map_err(|e| SceneFileError::File {
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
-    let scene = parse(path, &text)?;
+    geometry(path, &parse(path, &text)?)
+}
+
+fn geometry(path: &Path, scene: &IgiScene) -> Result<IgiGeometry, SceneFileError> {
     let base = path.parent().unwrap_or(Path::new("."));
     let field = |field: String, value: String, expected: &str| SceneFileError::Field {
         path: path.to_path_buf(),
@@ -572,8 +591,6 @@ pub fn load(path: &Path) -> Result<LoadedIgiScene, SceneFileError> {
         value,
         expected: expected.to_string(),
     };
-
-    // Geometry.
     let obj = base.join(&scene.geometry);
     let (models, _) = tobj::load_obj(
         &obj,
@@ -640,6 +657,39 @@ pub fn load(path: &Path) -> Result<LoadedIgiScene, SceneFileError> {
             message: "no triangles: expected at least one face".into(),
         });
     }
+    Ok(IgiGeometry {
+        obj,
+        surfaces,
+        groups,
+        triangles,
+        triangle_group,
+    })
+}
+
+/// Reads scene file `path`, its geometry and images, and triangulates the
+/// lights given by bulb images.
+pub fn load(path: &Path) -> Result<LoadedIgiScene, SceneFileError> {
+    let text = std::fs::read_to_string(path).map_err(|e| SceneFileError::File {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    let scene = parse(path, &text)?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let field = |field: String, value: String, expected: &str| SceneFileError::Field {
+        path: path.to_path_buf(),
+        field,
+        value,
+        expected: expected.to_string(),
+    };
+
+    // Geometry.
+    let IgiGeometry {
+        obj,
+        surfaces,
+        groups,
+        triangles,
+        triangle_group,
+    } = geometry(path, &scene)?;
 
     // Cameras.
     let mut cameras = Vec::new();

@@ -147,31 +147,67 @@ pub fn albedo_synthesis(
     Ok(Synthesis { textures, report })
 }
 
+/// What an albedo texture's texels are resampled from, for the verdict's wording.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AlbedoSource {
+    /// The pseudo-albedo products' surface-grid cells (this module).
+    ProductCells,
+    /// The texels of inverse global illumination's albedo maps ([`super::igi_albedo`]).
+    IgiMapTexels,
+}
+
+impl AlbedoSource {
+    fn none_seen(self) -> &'static str {
+        match self {
+            AlbedoSource::ProductCells => {
+                "no texel lies on a cell that a photograph saw: the products hold no measured albedo here"
+            }
+            AlbedoSource::IgiMapTexels => {
+                "no texel lies on a map texel that a view saw: the maps hold no measured albedo here"
+            }
+        }
+    }
+
+    fn unseen(self) -> &'static str {
+        match self {
+            AlbedoSource::ProductCells => "cells no photograph saw",
+            AlbedoSource::IgiMapTexels => "map texels no view saw",
+        }
+    }
+}
+
 /// The verdict on an albedo texture: `failed` when no texel or less than
 /// [`QualityLimits::min_coverage_poor`] of them lie on cells a photograph
 /// saw, `poor` below [`QualityLimits::min_coverage_ok`], else `ok` (there
 /// are no photographs to disagree at seams: the seam figures are empty).
 pub fn judge_albedo(report: &SynthesisReport, limits: &QualityLimits) -> Quality {
+    judge_albedo_from(report, limits, AlbedoSource::ProductCells)
+}
+
+/// [`judge_albedo`] on texels resampled from `source` (the reasons name it).
+pub fn judge_albedo_from(report: &SynthesisReport, limits: &QualityLimits, source: AlbedoSource) -> Quality {
     let coverage = report.coverage();
     let mut reasons = Vec::new();
     let seen = report.texels_on_faces - report.unseen;
     let verdict = if seen == 0 {
-        reasons.push("no texel lies on a cell that a photograph saw: the products hold no measured albedo here".into());
+        reasons.push(source.none_seen().into());
         "failed"
     } else if coverage < limits.min_coverage_poor {
         reasons.push(format!(
-            "coverage {:.1}% below {:.0}%: {} texels lie on cells no photograph saw",
+            "coverage {:.1}% below {:.0}%: {} texels lie on {}",
             100.0 * coverage,
             100.0 * limits.min_coverage_poor,
-            report.unseen
+            report.unseen,
+            source.unseen()
         ));
         "failed"
     } else if coverage < limits.min_coverage_ok {
         reasons.push(format!(
-            "coverage {:.1}% below {:.0}%: {} texels on cells no photograph saw were filled from their neighbours",
+            "coverage {:.1}% below {:.0}%: {} texels on {} were filled from their neighbours",
             100.0 * coverage,
             100.0 * limits.min_coverage_ok,
-            report.unseen
+            report.unseen,
+            source.unseen()
         ));
         "poor"
     } else {

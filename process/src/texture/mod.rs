@@ -27,6 +27,8 @@
 //!   through a tone map).
 //! - [`albedo`]: the same patches from the recovered pseudo-albedos
 //!   (thesis ch. 5) instead of photographs: albedo textures.
+//! - [`igi_albedo`]: the same patches from the diffuse albedo maps of
+//!   inverse global illumination (thesis §4.6).
 //! - [`seam`]: how visible the patch borders are (the difference across
 //!   shared edges against the difference between neighbouring texels
 //!   inside a patch), and the verdict.
@@ -40,14 +42,16 @@ pub mod albedo;
 pub mod atlas;
 pub mod export;
 pub mod fill;
+pub mod igi_albedo;
 pub mod patch;
 pub mod photo;
 pub mod seam;
 pub mod synthesis;
 pub mod weight;
 
-pub use albedo::{PseudoAlbedo, albedo_synthesis, judge_albedo};
+pub use albedo::{AlbedoSource, PseudoAlbedo, albedo_synthesis, judge_albedo, judge_albedo_from};
 pub use atlas::{Atlas, AtlasSettings, pack};
+pub use igi_albedo::{ChartData, igi_albedo_synthesis};
 pub use patch::{Patch, patches, patches_on_lattice};
 pub use photo::{TexturePhoto, pose_from_angles};
 pub use seam::{Quality, QualityLimits, SeamFigures, judge, seam_figures};
