@@ -20,7 +20,6 @@ or mismatched input (a surface of the truth missing from the results).
 
 import argparse
 import json
-import math
 import sys
 from pathlib import Path
 
