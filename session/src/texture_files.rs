@@ -23,8 +23,8 @@ use campanile_process::render::{Material, Scene};
 use campanile_process::scene_geometry::load_obj;
 use campanile_process::texture::export::{Exported, export};
 use campanile_process::texture::{
-    AtlasSettings, Quality, QualityLimits, SynthesisReport, SynthesisSettings, TexturePhoto, judge, pack, patches,
-    pose_from_angles, seam_figures, synthesize_with_progress,
+    Atlas, AtlasSettings, Patch, Quality, QualityLimits, SynthesisReport, SynthesisSettings, TexturePhoto, judge, pack,
+    patches, pose_from_angles, seam_figures, synthesize_with_progress,
 };
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -252,14 +252,50 @@ fn photo_file(request: &TextureRequest, entry: &PoseEntry) -> anyhow::Result<Pat
     )))
 }
 
+/// `--texel` must be a positive length.
+fn check_texel(t: f64) -> anyhow::Result<()> {
+    if t.is_finite() && t > 0.0 {
+        Ok(())
+    } else {
+        Err(bad_input(format!("--texel {t}: expected a positive length in metres")))
+    }
+}
+
+/// A written file's name, as the manifest records it (relative to it).
+fn file_name(p: &Path) -> String {
+    p.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// Each patch's record: its surface, atlas rectangle (gutter included)
+/// and texel counts.
+fn patch_records(scene: &Scene, ps: &[Patch], atlas: &Atlas, per_patch: &[(usize, usize)]) -> Vec<PatchRecord> {
+    ps.iter()
+        .zip(&atlas.placements)
+        .zip(per_patch)
+        .map(|((p, pl), &(texels, unseen))| PatchRecord {
+            surface: scene.surfaces()[p.surface].clone(),
+            page: pl.page,
+            rect: (pl.x, pl.y, p.cols + 2 * atlas.gutter, p.rows + 2 * atlas.gutter),
+            texels,
+            unseen,
+        })
+        .collect()
+}
+
+/// Writes `manifest` as `out/texture.ron`; returns its path.
+fn write_manifest(out: &Path, manifest: &impl Serialize) -> anyhow::Result<PathBuf> {
+    let path = out.join("texture.ron");
+    let text =
+        ron::ser::to_string_pretty(manifest, ron::ser::PrettyConfig::default()).context("serializing texture.ron")?;
+    std::fs::write(&path, text + "\n").with_context(|| format!("writing {}", path.display()))?;
+    Ok(path)
+}
+
 /// Runs `texture` (module doc); `bar` gets the steps' count, then one tick per step.
 pub fn texture_files(request: &TextureRequest, bar: &indicatif::ProgressBar) -> anyhow::Result<TextureRun> {
-    if !(request.texel_m.is_finite() && request.texel_m > 0.0) {
-        return Err(bad_input(format!(
-            "--texel {}: expected a positive length in metres",
-            request.texel_m
-        )));
-    }
+    check_texel(request.texel_m)?;
     let (description, scene) = load_geometry(&request.scene)?;
     let station = campanile_config::load_station(&request.station)?.value;
     let configured = Pinhole::of_camera(&station.camera);
@@ -311,15 +347,14 @@ pub fn texture_files(request: &TextureRequest, bar: &indicatif::ProgressBar) -> 
     let seams = seam_figures(&ps, &synthesis.textures);
     let quality = judge(&synthesis.report, &seams, &request.limits);
     let r = &synthesis.report;
-    let name_of = |p: &Path| {
-        p.file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default()
-    };
     let manifest = TextureManifest {
         texel_m: request.texel_m,
-        obj: name_of(&exported.obj),
-        pages: exported.pages.iter().map(|(e, p)| (name_of(e), name_of(p))).collect(),
+        obj: file_name(&exported.obj),
+        pages: exported
+            .pages
+            .iter()
+            .map(|(e, p)| (file_name(e), file_name(p)))
+            .collect(),
         preview_scale: exported.preview_scale,
         photos: photos
             .iter()
@@ -334,25 +369,11 @@ pub fn texture_files(request: &TextureRequest, bar: &indicatif::ProgressBar) -> 
                 shift_px: r.offsets.get(k).copied().flatten().map(|o| o.shift_px),
             })
             .collect(),
-        patches: ps
-            .iter()
-            .zip(&atlas.placements)
-            .zip(&r.per_patch)
-            .map(|((p, pl), &(texels, unseen))| PatchRecord {
-                surface: scene.surfaces()[p.surface].clone(),
-                page: pl.page,
-                rect: (pl.x, pl.y, p.cols + 2 * atlas.gutter, p.rows + 2 * atlas.gutter),
-                texels,
-                unseen,
-            })
-            .collect(),
+        patches: patch_records(&scene, &ps, &atlas, &r.per_patch),
         quality,
         seconds,
     };
-    let manifest_path = request.out.join("texture.ron");
-    let text =
-        ron::ser::to_string_pretty(&manifest, ron::ser::PrettyConfig::default()).context("serializing texture.ron")?;
-    std::fs::write(&manifest_path, text + "\n").with_context(|| format!("writing {}", manifest_path.display()))?;
+    let manifest_path = write_manifest(&request.out, &manifest)?;
     Ok(TextureRun {
         manifest,
         manifest_path,
@@ -485,10 +506,8 @@ pub fn albedo_texture_files(
     use campanile_process::texture::export::{export_scaled, write_page_exrs};
     use campanile_process::texture::{PseudoAlbedo, albedo_synthesis, judge_albedo, patches_on_lattice};
 
-    if let Some(t) = request.texel_m
-        && !(t.is_finite() && t > 0.0)
-    {
-        return Err(bad_input(format!("--texel {t}: expected a positive length in metres")));
+    if let Some(t) = request.texel_m {
+        check_texel(t)?;
     }
     let materials = materials_file(&request.albedo)?;
     let (_, scene) = load_geometry(&request.scene)?;
@@ -522,11 +541,6 @@ pub fn albedo_texture_files(
     let sun_pages = write_page_exrs(&sun_atlas, &request.out, "sun_")?;
     let seconds = start.elapsed().as_secs_f64();
     let quality = judge_albedo(&se.report, &request.limits);
-    let name_of = |p: &Path| {
-        p.file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default()
-    };
     let mut products: Vec<ProductCells> = Vec::new();
     for f in &file.faces {
         let entry = match products.iter_mut().find(|p| p.surface == f.surface) {
@@ -555,30 +569,20 @@ pub fn albedo_texture_files(
         materials: materials.clone(),
         spacing_m: refl.grid.spacing_m,
         texel_m,
-        obj: name_of(&exported.obj),
-        pages: exported.pages.iter().map(|(e, p)| (name_of(e), name_of(p))).collect(),
-        sun_pages: sun_pages.iter().map(|p| name_of(p)).collect(),
-        patches: ps
+        obj: file_name(&exported.obj),
+        pages: exported
+            .pages
             .iter()
-            .zip(&atlas.placements)
-            .zip(&r.per_patch)
-            .map(|((p, pl), &(texels, unseen))| PatchRecord {
-                surface: scene.surfaces()[p.surface].clone(),
-                page: pl.page,
-                rect: (pl.x, pl.y, p.cols + 2 * atlas.gutter, p.rows + 2 * atlas.gutter),
-                texels,
-                unseen,
-            })
+            .map(|(e, p)| (file_name(e), file_name(p)))
             .collect(),
+        sun_pages: sun_pages.iter().map(|p| file_name(p)).collect(),
+        patches: patch_records(&scene, &ps, &atlas, &r.per_patch),
         products,
         diagnostics: file.diagnostics,
         quality,
         seconds,
     };
-    let manifest_path = request.out.join("texture.ron");
-    let text =
-        ron::ser::to_string_pretty(&manifest, ron::ser::PrettyConfig::default()).context("serializing texture.ron")?;
-    std::fs::write(&manifest_path, text + "\n").with_context(|| format!("writing {}", manifest_path.display()))?;
+    let manifest_path = write_manifest(&request.out, &manifest)?;
     Ok(AlbedoTextureRun {
         manifest,
         manifest_path,
@@ -835,10 +839,8 @@ pub fn igi_albedo_texture_files(
     use campanile_process::texture::export::export_scaled;
     use campanile_process::texture::{AlbedoSource, igi_albedo_synthesis, judge_albedo_from};
 
-    if let Some(t) = request.texel_m
-        && !(t.is_finite() && t > 0.0)
-    {
-        return Err(bad_input(format!("--texel {t}: expected a positive length in metres")));
+    if let Some(t) = request.texel_m {
+        check_texel(t)?;
     }
     let start = Instant::now();
     let text = std::fs::read_to_string(layout).map_err(|e| bad_input(format!("{}: {e}", layout.display())))?;
@@ -949,30 +951,18 @@ pub fn igi_albedo_texture_files(
     let exported = export_scaled(&scene, &ps, &atlas, &request.out, Some(1.0))?;
     let seconds = start.elapsed().as_secs_f64();
     let quality = judge_albedo_from(&syn.report, &request.limits, AlbedoSource::IgiMapTexels);
-    let name_of = |p: &Path| {
-        p.file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default()
-    };
     let r = &syn.report;
     let manifest = IgiAlbedoTextureManifest {
         layout: layout.to_path_buf(),
         maps_texel_m: index.texel_m,
         texel_m,
-        obj: name_of(&exported.obj),
-        pages: exported.pages.iter().map(|(e, p)| (name_of(e), name_of(p))).collect(),
-        patches: ps
+        obj: file_name(&exported.obj),
+        pages: exported
+            .pages
             .iter()
-            .zip(&atlas.placements)
-            .zip(&r.per_patch)
-            .map(|((p, pl), &(texels, unseen))| PatchRecord {
-                surface: scene.surfaces()[p.surface].clone(),
-                page: pl.page,
-                rect: (pl.x, pl.y, p.cols + 2 * atlas.gutter, p.rows + 2 * atlas.gutter),
-                texels,
-                unseen,
-            })
+            .map(|(e, p)| (file_name(e), file_name(p)))
             .collect(),
+        patches: patch_records(&scene, &ps, &atlas, &r.per_patch),
         maps: used
             .iter()
             .map(|&m| {
@@ -991,10 +981,7 @@ pub fn igi_albedo_texture_files(
         quality,
         seconds,
     };
-    let manifest_path = request.out.join("texture.ron");
-    let text =
-        ron::ser::to_string_pretty(&manifest, ron::ser::PrettyConfig::default()).context("serializing texture.ron")?;
-    std::fs::write(&manifest_path, text + "\n").with_context(|| format!("writing {}", manifest_path.display()))?;
+    let manifest_path = write_manifest(&request.out, &manifest)?;
     Ok(IgiAlbedoTextureRun {
         manifest,
         manifest_path,

@@ -174,11 +174,7 @@ pub fn run(args: TextureArgs) -> Result<u8> {
         q.seams.interior_spread,
         m.pages.len(),
         m.seconds,
-        if q.reasons.is_empty() {
-            String::new()
-        } else {
-            format!(": {}", q.reasons.join("; "))
-        }
+        reasons(q)
     );
     println!("written to {}", run.manifest_path.display());
     Ok(if q.verdict == "failed" { EXIT_QUALITY } else { EXIT_OK })
@@ -210,11 +206,7 @@ fn run_albedo(request: AlbedoTextureRequest) -> Result<u8> {
         m.spacing_m,
         m.pages.len(),
         m.seconds,
-        if q.reasons.is_empty() {
-            String::new()
-        } else {
-            format!(": {}", q.reasons.join("; "))
-        }
+        reasons(q)
     );
     println!("written to {}", run.manifest_path.display());
     Ok(if q.verdict == "failed" { EXIT_QUALITY } else { EXIT_OK })
@@ -246,12 +238,17 @@ fn run_igi_albedo(request: AlbedoTextureRequest, layout: &std::path::Path) -> Re
         m.maps_texel_m,
         m.pages.len(),
         m.seconds,
-        if q.reasons.is_empty() {
-            String::new()
-        } else {
-            format!(": {}", q.reasons.join("; "))
-        }
+        reasons(q)
     );
     println!("written to {}", run.manifest_path.display());
     Ok(if q.verdict == "failed" { EXIT_QUALITY } else { EXIT_OK })
+}
+
+/// A verdict's reasons as the line's tail (`: a; b`), or nothing.
+fn reasons(q: &campanile_process::texture::Quality) -> String {
+    if q.reasons.is_empty() {
+        String::new()
+    } else {
+        format!(": {}", q.reasons.join("; "))
+    }
 }

@@ -70,6 +70,49 @@ pub fn albedo_synthesis(
             });
         }
     }
+    Ok(resample(
+        scene,
+        patches,
+        |patch| subsamples(patch.texel_m, grid.spacing_m),
+        |tri, p| {
+            let cell = grid
+                .cell_at(scene, tri, p)
+                .or_else(|| grid.nearest_cell(scene, tri, p))?;
+            let est = &refl.cells[cell];
+            if est.status == CellStatus::Unseen {
+                return None;
+            }
+            let rho = match which {
+                PseudoAlbedo::SkyEnvironment => est.rho_se,
+                PseudoAlbedo::Sun => est.rho_sun,
+            };
+            rho.iter().all(|v| v.is_finite()).then_some(SubSample::Seen(rho))
+        },
+        step,
+    ))
+}
+
+/// What one sub-sample of a texel reads from the products.
+pub(crate) enum SubSample {
+    /// A measured albedo (a cell or map texel a view saw).
+    Seen([f64; 3]),
+    /// The products' own fill where nothing was seen.
+    Unseen([f64; 3]),
+}
+
+/// Resamples every on-face texel of `patches` at `n × n` points
+/// (`n = subsamples_of(patch)`), each read by `lookup(triangle, point)`:
+/// a texel is the mean of its `Seen` points, or, with none, unseen and
+/// filled from its neighbours ([`super::fill`]). A patch with no seen
+/// texel at all keeps the mean of its texels' `Unseen` points (the
+/// products' own fill) instead. `step` is called after each patch.
+pub(crate) fn resample(
+    scene: &Scene,
+    patches: &[Patch],
+    subsamples_of: impl Fn(&Patch) -> usize,
+    lookup: impl Fn(usize, &nalgebra::Vector3<f64>) -> Option<SubSample>,
+    step: &dyn Fn(),
+) -> Synthesis {
     let tris = scene.triangles();
     let mut report = SynthesisReport {
         used: vec![0],
@@ -79,7 +122,7 @@ pub fn albedo_synthesis(
     };
     let mut textures = Vec::with_capacity(patches.len());
     for patch in patches {
-        let n = subsamples(patch.texel_m, grid.spacing_m);
+        let n = subsamples_of(patch);
         let size = patch.cols * patch.rows;
         let mut tex = PatchTexture {
             rgb: vec![[0.0; 3]; size],
@@ -88,6 +131,8 @@ pub fn albedo_synthesis(
             photos: vec![0; size],
             spread: vec![0.0; size],
         };
+        // The products' own values of the texels nothing saw.
+        let mut own: Vec<Option<[f32; 3]>> = vec![None; size];
         let (mut on_face, mut unseen) = (0usize, 0usize);
         for j in 0..patch.rows {
             for i in 0..patch.cols {
@@ -96,7 +141,8 @@ pub fn albedo_synthesis(
                     continue;
                 }
                 on_face += 1;
-                let (mut sum, mut seen) = ([0.0f64; 3], 0usize);
+                let (mut seen_sum, mut seen) = ([0.0f64; 3], 0usize);
+                let (mut other_sum, mut other) = ([0.0f64; 3], 0usize);
                 for a in 0..n {
                     for b in 0..n {
                         let s = patch.origin[0] + (i as f64 + (a as f64 + 0.5) / n as f64) * patch.texel_m;
@@ -105,28 +151,17 @@ pub fn albedo_synthesis(
                         let Some(&tri) = patch.triangles.iter().find(|&&k| inside(&tris[k], &p)) else {
                             continue;
                         };
-                        let Some(cell) = grid
-                            .cell_at(scene, tri, &p)
-                            .or_else(|| grid.nearest_cell(scene, tri, &p))
-                        else {
-                            continue;
+                        let (v, sum, count) = match lookup(tri, &p) {
+                            Some(SubSample::Seen(v)) => (v, &mut seen_sum, &mut seen),
+                            Some(SubSample::Unseen(v)) => (v, &mut other_sum, &mut other),
+                            None => continue,
                         };
-                        let est = &refl.cells[cell];
-                        if est.status == CellStatus::Unseen {
-                            continue;
-                        }
-                        let rho = match which {
-                            PseudoAlbedo::SkyEnvironment => est.rho_se,
-                            PseudoAlbedo::Sun => est.rho_sun,
-                        };
-                        if rho.iter().all(|v| v.is_finite()) {
-                            (0..3).for_each(|c| sum[c] += rho[c]);
-                            seen += 1;
-                        }
+                        (0..3).for_each(|c| sum[c] += v[c]);
+                        *count += 1;
                     }
                 }
                 if seen > 0 {
-                    tex.rgb[idx] = sum.map(|v| (v / seen as f64) as f32);
+                    tex.rgb[idx] = seen_sum.map(|v| (v / seen as f64) as f32);
                     tex.weight[idx] = seen as f32 / (n * n) as f32;
                     tex.status[idx] = TexelStatus::Seen;
                     tex.photos[idx] = 1;
@@ -134,17 +169,46 @@ pub fn albedo_synthesis(
                 } else {
                     tex.status[idx] = TexelStatus::Filled;
                     unseen += 1;
+                    if other > 0 {
+                        own[idx] = Some(other_sum.map(|v| (v / other as f64) as f32));
+                    }
                 }
             }
         }
+        let none_seen = !tex.status.contains(&TexelStatus::Seen);
         fill_patch(&mut tex, patch.cols, patch.rows);
+        if none_seen {
+            keep_own_fill(&mut tex, &own);
+        }
         report.texels_on_faces += on_face;
         report.unseen += unseen;
         report.per_patch.push((on_face, unseen));
         textures.push(tex);
         step();
     }
-    Ok(Synthesis { textures, report })
+    Synthesis { textures, report }
+}
+
+/// A patch nothing saw: its on-face texels take the products' own values
+/// (`own`), the padding their mean.
+fn keep_own_fill(tex: &mut PatchTexture, own: &[Option<[f32; 3]>]) {
+    let (mut sum, mut count) = ([0.0f64; 3], 0usize);
+    for (rgb, o) in tex.rgb.iter_mut().zip(own) {
+        if let Some(v) = o {
+            *rgb = *v;
+            (0..3).for_each(|c| sum[c] += f64::from(v[c]));
+            count += 1;
+        }
+    }
+    if count == 0 {
+        return;
+    }
+    let mean = sum.map(|v| (v / count as f64) as f32);
+    for (rgb, s) in tex.rgb.iter_mut().zip(&tex.status) {
+        if *s == TexelStatus::Padding {
+            *rgb = mean;
+        }
+    }
 }
 
 /// What an albedo texture's texels are resampled from, for the verdict's wording.

@@ -19,10 +19,9 @@
 //! the surface.
 
 use super::TextureError;
-use super::albedo::subsamples;
-use super::fill::fill_patch;
-use super::patch::{Patch, inside};
-use super::synthesis::{PatchTexture, Synthesis, SynthesisReport, TexelStatus};
+use super::albedo::{SubSample, resample, subsamples};
+use super::patch::Patch;
+use super::synthesis::Synthesis;
 use crate::camera::image::RadianceImage;
 use crate::igi::albedo_chart::ChartLayout;
 use crate::igi::albedo_map::TexelOrigin;
@@ -68,7 +67,6 @@ pub fn igi_albedo_synthesis(
             });
         }
     }
-    let tris = scene.triangles();
     for p in patches {
         if let Some(&t) = p
             .triangles
@@ -85,91 +83,27 @@ pub fn igi_albedo_synthesis(
             });
         }
     }
-    let mut report = SynthesisReport {
-        used: vec![0],
-        occluded: vec![0],
-        grazing: vec![0],
-        ..Default::default()
-    };
-    let mut textures = Vec::with_capacity(patches.len());
-    for patch in patches {
-        let size = patch.cols * patch.rows;
-        let mut tex = PatchTexture {
-            rgb: vec![[0.0; 3]; size],
-            weight: vec![0.0; size],
-            status: vec![TexelStatus::Padding; size],
-            photos: vec![0; size],
-            spread: vec![0.0; size],
-        };
-        // The maps' own values of the texels no view saw (module doc).
-        let mut own: Vec<Option<[f32; 3]>> = vec![None; size];
-        let (mut on_face, mut unseen) = (0usize, 0usize);
-        let n = patch_subsamples(patch, charts, chart_of);
-        for j in 0..patch.rows {
-            for i in 0..patch.cols {
-                let idx = j * patch.cols + i;
-                if patch.texel_triangle[idx].is_none() {
-                    continue;
-                }
-                on_face += 1;
-                let (mut seen_sum, mut seen) = ([0.0f64; 3], 0usize);
-                let (mut other_sum, mut other) = ([0.0f64; 3], 0usize);
-                for a in 0..n {
-                    for b in 0..n {
-                        let s = patch.origin[0] + (i as f64 + (a as f64 + 0.5) / n as f64) * patch.texel_m;
-                        let t = patch.origin[1] + (j as f64 + (b as f64 + 0.5) / n as f64) * patch.texel_m;
-                        let p = patch.point_at(s, t);
-                        let Some(&tri) = patch.triangles.iter().find(|&&k| inside(&tris[k], &p)) else {
-                            continue;
-                        };
-                        let Some(c) = chart_of[tri].map(|c| &charts[c]) else {
-                            continue;
-                        };
-                        let (x, y) = c.layout.pixel_of(&p);
-                        let k = y * c.layout.width + x;
-                        let Some(origin) = c.origin[k] else {
-                            continue;
-                        };
-                        let v = [0, 1, 2].map(|ch| f64::from(c.image.data[3 * k + ch]));
-                        if !v.iter().all(|x| x.is_finite()) {
-                            continue;
-                        }
-                        let (sum, count) = if origin == TexelOrigin::Seen {
-                            (&mut seen_sum, &mut seen)
-                        } else {
-                            (&mut other_sum, &mut other)
-                        };
-                        (0..3).for_each(|ch| sum[ch] += v[ch]);
-                        *count += 1;
-                    }
-                }
-                if seen > 0 {
-                    tex.rgb[idx] = seen_sum.map(|v| (v / seen as f64) as f32);
-                    tex.weight[idx] = seen as f32 / (n * n) as f32;
-                    tex.status[idx] = TexelStatus::Seen;
-                    tex.photos[idx] = 1;
-                    report.used[0] += 1;
-                } else {
-                    tex.status[idx] = TexelStatus::Filled;
-                    unseen += 1;
-                    if other > 0 {
-                        own[idx] = Some(other_sum.map(|v| (v / other as f64) as f32));
-                    }
-                }
+    Ok(resample(
+        scene,
+        patches,
+        |patch| patch_subsamples(patch, charts, chart_of),
+        |tri, p| {
+            let c = &charts[chart_of[tri]?];
+            let (x, y) = c.layout.pixel_of(p);
+            let k = y * c.layout.width + x;
+            let origin = c.origin[k]?;
+            let v = [0, 1, 2].map(|ch| f64::from(c.image.data[3 * k + ch]));
+            if !v.iter().all(|x| x.is_finite()) {
+                return None;
             }
-        }
-        let none_seen = !tex.status.contains(&TexelStatus::Seen);
-        fill_patch(&mut tex, patch.cols, patch.rows);
-        if none_seen {
-            keep_own_fill(&mut tex, &own);
-        }
-        report.texels_on_faces += on_face;
-        report.unseen += unseen;
-        report.per_patch.push((on_face, unseen));
-        textures.push(tex);
-        step();
-    }
-    Ok(Synthesis { textures, report })
+            Some(if origin == TexelOrigin::Seen {
+                SubSample::Seen(v)
+            } else {
+                SubSample::Unseen(v)
+            })
+        },
+        step,
+    ))
 }
 
 /// Sub-samples per side for `patch` over its charts (their texel side;
@@ -189,28 +123,6 @@ fn patch_subsamples(patch: &Patch, charts: &[ChartData], chart_of: &[Option<usiz
     }
 }
 
-/// A patch no view saw: its on-face texels take the maps' own values
-/// (`own`), the padding their mean.
-fn keep_own_fill(tex: &mut PatchTexture, own: &[Option<[f32; 3]>]) {
-    let (mut sum, mut count) = ([0.0f64; 3], 0usize);
-    for (rgb, o) in tex.rgb.iter_mut().zip(own) {
-        if let Some(v) = o {
-            *rgb = *v;
-            (0..3).for_each(|c| sum[c] += f64::from(v[c]));
-            count += 1;
-        }
-    }
-    if count == 0 {
-        return;
-    }
-    let mean = sum.map(|v| (v / count as f64) as f32);
-    for (rgb, s) in tex.rgb.iter_mut().zip(&tex.status) {
-        if *s == TexelStatus::Padding {
-            *rgb = mean;
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use nalgebra::Vector3;
@@ -220,6 +132,7 @@ mod tests {
     use crate::igi::albedo_map::{AlbedoMap, TriangleTexels};
     use crate::render::{Material, Triangle};
     use crate::texture::patch::patches;
+    use crate::texture::synthesis::TexelStatus;
 
     /// A 0.4 m × 0.2 m wall (y = 0, s = x, t = z; two triangles) whose map
     /// on 0.05 m texels holds albedo 0.2 left of x = 0.2 and 0.6 right of
