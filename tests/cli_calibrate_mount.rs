@@ -28,7 +28,7 @@ use campanile_process::registration::CameraPose;
 use campanile_session::process::outdoor_report::{albedo_errors, quantile};
 use campanile_sim::world::target_photos::{PhotoSettings, photograph, with_targets};
 use campanile_sim::world::{World, examples_dir, load_scene};
-use common::campanile;
+use common::{campanile, campanile_exits as run};
 use nalgebra::Vector3;
 
 /// Where the head truly stands (about 21 m south-east of the tower).
@@ -160,18 +160,6 @@ fn plan_text(scene: &Path) -> String {
 "#,
         scene = path(scene)
     )
-}
-
-/// Runs `campanile ARGS`, asserting the exit code; returns stdout + stderr.
-fn run(args: &[&str], code: i32) -> String {
-    let out = campanile(args);
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert_eq!(out.status.code(), Some(code), "campanile {args:?}:\n{text}");
-    text
 }
 
 /// The held-out view's relative RMSE per 4 × 4 block, from `outdoor.json`.

@@ -382,3 +382,102 @@ fn strip_app1(bytes: &[u8]) -> Vec<u8> {
     out.extend_from_slice(&bytes[i..]);
     out
 }
+
+/// `bytes` (a little-endian EXIF JPEG) with its FocalLength rational set to
+/// `mm`/1: the entry found by walking IFD0 to the Exif IFD, as the camera
+/// wrote them (the file's structure is unchanged).
+fn with_focal_length(mut bytes: Vec<u8>, mm: u32) -> Vec<u8> {
+    let tiff = bytes.windows(6).position(|w| w == b"Exif\0\0").expect("an EXIF block") + 6;
+    assert_eq!(&bytes[tiff..tiff + 2], b"II", "a little-endian EXIF");
+    let u16_at = |b: &[u8], o: usize| u16::from_le_bytes([b[tiff + o], b[tiff + o + 1]]) as usize;
+    let u32_at = |b: &[u8], o: usize| u32::from_le_bytes(b[tiff + o..tiff + o + 4].try_into().unwrap()) as usize;
+    let entry = |b: &[u8], ifd: usize, tag: usize| {
+        (0..u16_at(b, ifd))
+            .map(|k| ifd + 2 + 12 * k)
+            .find(|&e| u16_at(b, e) == tag)
+            .expect("the tag")
+    };
+    let exif_ifd = u32_at(&bytes, entry(&bytes, u32_at(&bytes, 4), 0x8769) + 8);
+    let focal = entry(&bytes, exif_ifd, 0x920A);
+    assert_eq!(u16_at(&bytes, focal + 2), 5, "FocalLength is a RATIONAL");
+    let value = tiff + u32_at(&bytes, focal + 8);
+    bytes[value..value + 4].copy_from_slice(&mm.to_le_bytes());
+    bytes[value + 4..value + 8].copy_from_slice(&1u32.to_le_bytes());
+    bytes
+}
+
+/// Photographs at another focal length than most (a zoom lens zoomed in):
+/// with a scene, their bracket journals the zoom's focal length in pixels
+/// (the camera's, estimated from EXIF at 8 mm, times 32 / 8), and the
+/// record says it was estimated; without a scene, or as a sky bracket, they
+/// are refused naming the file and what was expected.
+#[test]
+fn zoom_photographs_journal_their_own_focal_length() {
+    let dir = tempfile::tempdir().expect("temp");
+    let photos = folder(dir.path(), false);
+    for n in 6960..=6966 {
+        let mut bytes = with_focal_length(fixture(&format!("IMG_{n}.JPG")), 32);
+        assert!(replace_all(&mut bytes, b"2017:07:13 15:4", b"2017:07:13 15:5") >= 3);
+        std::fs::write(photos.join(format!("ZOOM_{n}.JPG")), bytes).unwrap();
+    }
+    let poses = dir.path().join("poses.ron");
+    std::fs::write(
+        &poses,
+        r#"ImportPoses(brackets: [
+    (files: "IMG_*.JPG", position_m: (0.0, -20.0, 1.5), azimuth_deg: 180.0, elevation_deg: 10.0),
+    (files: "ZOOM_*.JPG", position_m: (0.0, -20.0, 1.5), azimuth_deg: 185.0, elevation_deg: 12.0),
+])"#,
+    )
+    .unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/campanile-scene.ron");
+    let clock = ["--clock-offset-s", "0", "--utc-offset", "-07:00"];
+    let with_scene = [&clock[..], &["--scene", s(&scene)]].concat();
+    let session = dir.path().join("session");
+    let o = import(&photos, &session, &poses, &with_scene);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let journal = std::fs::read_to_string(session.join("journal.jsonl")).unwrap();
+    let lines: Vec<serde_json::Value> = journal.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(lines.len(), 25);
+    // The 18 frames at 8 mm are the session's camera (1212.4 px at the
+    // frame's 5616 px, estimated from FocalLength and FocalPlaneXResolution);
+    // the 7 at 32 mm journal four times that.
+    let focal: Vec<Option<f64>> = lines.iter().map(|l| l["meta"]["focal_px"].as_f64()).collect();
+    assert!(focal[..18].iter().all(Option::is_none), "{focal:?}");
+    for f in &focal[18..] {
+        let f = f.expect("a zoom frame's focal length");
+        assert!((f - 4.0 * 1212.4).abs() < 0.5, "{f}");
+    }
+    let record = std::fs::read_to_string(session.join("import.json")).unwrap();
+    assert!(
+        record.contains("zoom photographs' focal lengths from EXIF: the camera's at 8 mm scaled by FocalLength / 8 mm"),
+        "{record}"
+    );
+    assert!(record.contains("ZOOM_6960.JPG (FocalLength 32 mm)"), "{record}");
+
+    let refused_with = |name: &str, extra: &[&str], want: &[&str]| {
+        let o = import(&photos, &dir.path().join(name), &poses, &[&clock[..], extra].concat());
+        let t = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{t}");
+        for w in want {
+            assert!(t.contains(w), "{w:?} not in {t}");
+        }
+    };
+    refused_with(
+        "no-scene",
+        &[],
+        &[
+            "photographs at 2 focal lengths (most at Some(8.0) mm; ZOOM_6960.JPG at Some(32.0) mm)",
+            "give --scene",
+        ],
+    );
+    refused_with(
+        "zoomed-sky",
+        &["--scene", s(&scene), "--sky", "ZOOM_*"],
+        &[
+            "ZOOM_6960.JPG",
+            "FocalLength",
+            "32 mm",
+            "sky frames are fitted through the station's lens",
+        ],
+    );
+}

@@ -275,6 +275,11 @@ pub struct OutdoorGates {
     /// Default poor 0.02 (the thesis-level pseudo-albedo figure: light
     /// known less well than that cannot give it), failed 0.5.
     pub estimated_light: Gate,
+    /// Of a zoom photograph's pixels on the target surfaces, the fraction
+    /// given high-resolution pseudo-albedos by eq. (5.16) (higher is
+    /// better); the others keep the grid's (a face's outline, a shadow
+    /// edge, invalid radiance). Default poor 0.5, failed 0.1.
+    pub zoom_coverage: Gate,
 }
 
 impl Default for OutdoorGates {
@@ -283,6 +288,7 @@ impl Default for OutdoorGates {
             residual: Gate::new(0.05, 0.15),
             render: Gate::new(0.03, 0.10),
             estimated_light: Gate::new(0.02, 0.5),
+            zoom_coverage: Gate::new(0.5, 0.1),
         }
     }
 }
@@ -290,7 +296,7 @@ impl Default for OutdoorGates {
 impl Validate for Quality {
     fn validate(&self, v: &mut Validator) {
         use Better::{Higher, Lower};
-        let gates: [(&str, &str, &Gate, Better); 19] = [
+        let gates: [(&str, &str, &Gate, Better); 20] = [
             ("response", "condition", &self.response.condition, Lower),
             ("response", "exposures_used", &self.response.exposures_used, Higher),
             ("response", "code_coverage", &self.response.code_coverage, Higher),
@@ -320,6 +326,7 @@ impl Validate for Quality {
             ("outdoor", "residual", &self.outdoor.residual, Lower),
             ("outdoor", "render", &self.outdoor.render, Lower),
             ("outdoor", "estimated_light", &self.outdoor.estimated_light, Lower),
+            ("outdoor", "zoom_coverage", &self.outdoor.zoom_coverage, Higher),
         ];
         for (product, figure, gate, better) in gates {
             v.at(product, |v| v.at(figure, |v| gate.validate_as(better, v)));

@@ -138,7 +138,11 @@ pub fn outdoor(opts: &ProcessOptions) -> Result<OutdoorRun> {
     }
     let mut quality = processed.quality.clone();
     if let Some(o) = &outdoor {
-        quality.push(outdoor_quality(&processed, o));
+        let albedos = outdoor_quality(&processed, o);
+        for z in &o.products.zoom {
+            quality.push(crate::process::zoom_quality(&processed, z, &albedos));
+        }
+        quality.insert(processed.quality.len(), albedos);
     }
     note_import_estimates(&opts.session, &mut quality)?;
     let quality = QualityReport::new(quality, &processed.thresholds);

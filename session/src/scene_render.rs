@@ -132,7 +132,7 @@ fn zoom_photo(path: &Path, rig: &CameraRig, focal_px: f64, time: DateTime<Utc>) 
 }
 
 /// Per-pixel pseudo-albedos as an image.
-fn albedo_image(rho: &[[f64; 3]], rig: &CameraRig) -> RadianceImage {
+pub(crate) fn albedo_image(rho: &[[f64; 3]], rig: &CameraRig) -> RadianceImage {
     RadianceImage {
         width: rig.width,
         height: rig.height,

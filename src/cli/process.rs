@@ -30,6 +30,15 @@ use crate::cli::verdicts;
 ///   summary.json                   every figure and diagnostic, with stage times
 ///   quality.json                   every product's verdict (ok, poor, failed), its figures and thresholds
 ///   report.html                    the same as a page with plots (self-contained), the verdicts in a banner
+/// and, with a scene: the pseudo-albedos (albedo/), the held-out views
+/// re-rendered (held-out/), outdoor.json, and for each zoom photograph (a
+/// view whose frames journal their own focal length, `focal_px`, as
+/// `session import` writes photographs taken at another focal length) its
+/// pixels' pseudo-albedos by eq. (5.16), kept out of the fit:
+///   zoom/<group>-albedo-sun.exr, -albedo-se.exr   per pixel of the photograph
+///   zoom/<group>-grid-albedo-se.exr               the grid's, interpolated there
+///   zoom/<group>-used.png                         pixels given eq. (5.16) (white)
+///   zoom/<group>-render.exr                       re-rendered with them at its own time
 ///
 /// A sky-only session (only sun shots, sky scans and brackets aimed at head
 /// angles) is processed as a sky time series instead: per scan the sun's

@@ -43,6 +43,13 @@ pub enum SessionCommand {
 ///              processed as a sky scan
 ///   camera     --station STATION.ron (calibrated), or estimated from EXIF
 ///              (focal length and pixel pitch) at --site LAT,LON[,ELEV_M]
+///   zoom       the camera is the lens at the focal length most files were
+///              taken at; brackets at another (EXIF FocalLength, needed on
+///              every file then) are zoom photographs: they need --scene,
+///              journal their focal length in pixels (the camera's scaled
+///              by the FocalLength ratio, an undistorted lens) and get
+///              eq. (5.16) pseudo-albedos per pixel from `process`. A sky
+///              bracket must be at the camera's focal length
 ///
 /// The frames are copied byte for byte into SESSION/frames and journaled
 /// with their CRCs; SESSION/import.json records where every value came from

@@ -10,3 +10,17 @@ pub fn campanile(args: &[&str]) -> Output {
         .output()
         .expect("the binary runs")
 }
+
+/// Runs `campanile ARGS…`, asserting its exit code; returns its stdout and
+/// stderr, which the assertion shows when the code differs.
+#[allow(dead_code)] // not every test binary that includes this module uses it
+pub fn campanile_exits(args: &[&str], code: i32) -> String {
+    let out = campanile(args);
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(out.status.code(), Some(code), "campanile {args:?}:\n{text}");
+    text
+}

@@ -113,6 +113,11 @@ pub struct ImportedBracket {
     /// takes its scene pose as it is (its roll too, as `campanile register`
     /// measures it).
     pub head_deg: Option<(f64, f64)>,
+    /// A zoom photograph's focal length (taken at another focal length
+    /// than the session's camera), pixels per pixel of the frame's width:
+    /// the station camera's, scaled by the ratio of the EXIF FocalLengths.
+    /// `None`: the station camera's.
+    pub focal_px_per_width: Option<f64>,
     /// Its key prefix, `{occurrence}/s{step}/t{target}`.
     pub group: String,
 }
@@ -200,18 +205,7 @@ pub fn plan_import(opts: &ImportOptions, progress: &dyn Fn(usize, usize)) -> Res
             list.join("; ")
         )));
     }
-    let focal: Vec<(Option<f64>, &str)> = files.iter().map(|f| (f.focal_length_mm, f.name.as_str())).collect();
-    if let Some((other, name)) = focal.iter().find(|(f, _)| *f != focal[0].0) {
-        return Err(ImportError::Tag {
-            path: opts.folder.join(name),
-            tag: "FocalLength",
-            value: format!("{other:?} mm"),
-            expected: format!(
-                "{:?} mm as in {}: a session has one camera geometry; import each focal length as its own session",
-                focal[0].0, focal[0].1
-            ),
-        });
-    }
+    let reference_focal_mm = reference_focal_length(opts, &files)?;
 
     // Times and exposures.
     let times = match &opts.times {
@@ -332,6 +326,13 @@ pub fn plan_import(opts: &ImportOptions, progress: &dyn Fn(usize, usize)) -> Res
         None => None,
     };
     let first_frame = &frames[kept[0].frames[0]];
+    // The camera (estimated from EXIF, or the station file's) is the lens at
+    // the session's focal length; brackets at another are zoom photographs.
+    let reference_frame = kept
+        .iter()
+        .map(|g| &frames[g.frames[0]])
+        .find(|f| f.file.focal_length_mm == reference_focal_mm)
+        .unwrap_or(first_frame);
     let exposures: Vec<f64> = frames.iter().map(|f| f.effective_s).collect();
     let lo = exposures.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = exposures.iter().copied().fold(0.0, f64::max);
@@ -345,14 +346,15 @@ pub fn plan_import(opts: &ImportOptions, progress: &dyn Fn(usize, usize)) -> Res
             (text, format!("station file {}", p.display()), Vec::new())
         }
         (None, Some(site)) => {
-            let (image, _) = campanile_process::hdr::image_file::read_frame(&first_frame.file.path).map_err(|e| {
-                ImportError::NotJpeg {
-                    path: first_frame.file.path.clone(),
-                    reason: format!("it does not decode: {e}"),
-                }
-            })?;
+            let (image, _) =
+                campanile_process::hdr::image_file::read_frame(&reference_frame.file.path).map_err(|e| {
+                    ImportError::NotJpeg {
+                        path: reference_frame.file.path.clone(),
+                        reason: format!("it does not decode: {e}"),
+                    }
+                })?;
             let (text, notes) =
-                station_estimate::estimate_station(&first_frame.file, image.width, image.height, site, (lo, hi))?;
+                station_estimate::estimate_station(&reference_frame.file, image.width, image.height, site, (lo, hi))?;
             (text, "estimated from EXIF".to_owned(), notes)
         }
         (None, None) => {
@@ -440,6 +442,7 @@ pub fn plan_import(opts: &ImportOptions, progress: &dyn Fn(usize, usize)) -> Res
         } else {
             None
         };
+        let focal_px_per_width = zoom_focal(&station, &members[0], reference_focal_mm, pose.sky, &last)?;
         firsts.push(&frames[g.frames[0]].file.name);
         placed_brackets.push(ImportedBracket {
             frames: members,
@@ -447,6 +450,7 @@ pub fn plan_import(opts: &ImportOptions, progress: &dyn Fn(usize, usize)) -> Res
             pose,
             pose_name,
             head_deg,
+            focal_px_per_width,
             group: String::new(),
         });
     }
@@ -596,6 +600,30 @@ pub fn plan_import(opts: &ImportOptions, progress: &dyn Fn(usize, usize)) -> Res
         how: "exposure from EXIF (ExposureTime, FNumber, ISO as labelled by the camera), not measured".into(),
         affects: all(&["response", "radiance"]),
     });
+    let zooms: Vec<String> = placed_brackets
+        .iter()
+        .filter(|b| b.focal_px_per_width.is_some())
+        .map(|b| {
+            format!(
+                "{} (FocalLength {} mm)",
+                b.frames[0].file.name,
+                b.frames[0].file.focal_length_mm.unwrap_or(f64::NAN)
+            )
+        })
+        .collect();
+    if !zooms.is_empty() {
+        estimated.push(Estimate {
+            what: "zoom".into(),
+            how: format!(
+                "zoom photographs' focal lengths from EXIF: the camera's at {} mm scaled by FocalLength / {} mm, an \
+                 undistorted lens centred on the frame with no falloff: {}",
+                reference_focal_mm.unwrap_or(f64::NAN),
+                reference_focal_mm.unwrap_or(f64::NAN),
+                zooms.join(", ")
+            ),
+            affects: all(&["zoom"]),
+        });
+    }
     let views = placed_brackets.iter().filter(|b| !b.pose.sky).count();
     let skies = placed_brackets.len() - views;
     if skies == 0 {
@@ -634,6 +662,109 @@ pub fn plan_import(opts: &ImportOptions, progress: &dyn Fn(usize, usize)) -> Res
     })
 }
 
+/// The session's focal length, mm: the one most of the files were taken
+/// at (the first file's among equals). Files at another are zoom
+/// photographs, which need every file's FocalLength, and a scene (a zoom
+/// photograph is processed at its scene pose, off the head).
+fn reference_focal_length(opts: &ImportOptions, files: &[CameraFile]) -> Result<Option<f64>, ImportError> {
+    let Some(first) = files.first() else {
+        return Ok(None);
+    };
+    if files.iter().all(|f| f.focal_length_mm == first.focal_length_mm) {
+        return Ok(first.focal_length_mm);
+    }
+    if let Some(f) = files.iter().find(|f| f.focal_length_mm.is_none()) {
+        return Err(ImportError::Tag {
+            path: f.path.clone(),
+            tag: "FocalLength",
+            value: "absent".into(),
+            expected: format!(
+                "the focal length, mm, as the other files have (e.g. {:?} mm in {}): photographs at several focal \
+                 lengths are told apart by it",
+                files.iter().find_map(|f| f.focal_length_mm),
+                files
+                    .iter()
+                    .find(|f| f.focal_length_mm.is_some())
+                    .map_or("", |f| f.name.as_str())
+            ),
+        });
+    }
+    let mut counts: Vec<(f64, usize)> = Vec::new();
+    for f in files.iter().filter_map(|f| f.focal_length_mm) {
+        match counts.iter_mut().find(|(v, _)| *v == f) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((f, 1)),
+        }
+    }
+    let most = counts.iter().map(|(_, n)| *n).max().unwrap_or(0);
+    let reference = counts.iter().find(|(_, n)| *n == most).map(|(v, _)| *v);
+    if opts.scene.is_none() {
+        let other = files
+            .iter()
+            .find(|f| f.focal_length_mm != reference)
+            .map_or_else(String::new, |f| format!("{} at {:?} mm", f.name, f.focal_length_mm));
+        return Err(ImportError::Option(format!(
+            "{}: photographs at {} focal lengths (most at {:?} mm; {other}): a zoom photograph is processed at its \
+             scene pose, off the head: give --scene SCENE.ron with the poses, or import each focal length as its own \
+             session",
+            opts.folder.display(),
+            counts.len(),
+            reference
+        )));
+    }
+    Ok(reference)
+}
+
+/// The focal length, pixels per pixel of the frame's width, of a bracket
+/// whose first frame is `frame`, when it was taken at another focal length
+/// than the session's `reference_mm`: the station camera's scaled by the
+/// ratio of the two. A sky bracket must be at the session's (it is fitted
+/// through the station's lens), and a zoom needs a rectilinear lens.
+fn zoom_focal(
+    station: &Station,
+    frame: &ImportedFrame,
+    reference_mm: Option<f64>,
+    sky: bool,
+    last: &str,
+) -> Result<Option<f64>, ImportError> {
+    let (Some(f), Some(reference)) = (frame.file.focal_length_mm, reference_mm) else {
+        return Ok(None);
+    };
+    if f == reference {
+        return Ok(None);
+    }
+    let first = &frame.file.name;
+    let bad = |why: String| {
+        Err(ImportError::Tag {
+            path: frame.file.path.clone(),
+            tag: "FocalLength",
+            value: format!("{f} mm"),
+            expected: why,
+        })
+    };
+    if !(f.is_finite() && f > 0.0) {
+        return bad("a focal length > 0 mm".into());
+    }
+    if sky {
+        return bad(format!(
+            "{reference} mm, the session's focal length, for the sky bracket {first} … {last}: sky frames are fitted \
+             through the station's lens"
+        ));
+    }
+    let i = &station.camera.intrinsics;
+    if !i.projection.is_pinhole() {
+        return bad(format!(
+            "{reference} mm, the session's focal length: the station's lens is a {:?} fisheye, and a zoom \
+             photograph is taken as a rectilinear lens",
+            i.projection
+        ));
+    }
+    let width = station.camera.resolution.width;
+    Ok(Some(
+        i.focal.pixels_for(i.projection, width) / f64::from(width) * f / reference,
+    ))
+}
+
 fn exposure_text(t: f64) -> String {
     if t < 1.0 {
         format!("ExposureTime 1/{:.0} s", 1.0 / t)
@@ -656,6 +787,7 @@ pub fn write_session(
     let mut sequence = 0u64;
     for b in &plan.brackets {
         let mut frames = Vec::with_capacity(b.frames.len());
+        let mut focal_px = None;
         for (k, f) in b.frames.iter().enumerate() {
             let path = &f.file.path;
             let bytes = std::fs::read(path).map_err(|source| ImportError::Read {
@@ -703,6 +835,8 @@ pub fn write_session(
             let mut meta = FrameMeta::from_frame(&frame, ShotKind::Data);
             meta.pose_requested = head;
             meta.pose_reached = head;
+            meta.focal_px = b.focal_px_per_width.map(|f| f * frame.width as f64);
+            focal_px = focal_px.or(meta.focal_px);
             meta.notes.push(format!(
                 "imported from {}: DateTimeOriginal {}, {}{}{}",
                 f.file.name,
@@ -739,6 +873,7 @@ pub fn write_session(
             elevation_deg: b.pose.elevation_deg,
             position_m: b.pose.position_m,
             head_deg: b.head_deg.map(|(pan, tilt)| [pan, tilt]),
+            focal_px,
             from: b.pose.from_entry.clone(),
             began: b.began.clone(),
             frames,

@@ -70,6 +70,10 @@ pub struct ImportedBracketRecord {
     /// earlier imports journaled one for every bracket.
     #[serde(default)]
     pub head_deg: Option<[f64; 2]>,
+    /// A zoom photograph's focal length, pixels (taken at another focal
+    /// length than the session's camera; journaled as `focal_px`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub focal_px: Option<f64>,
     /// The poses-file entry (or `--sky` pattern) that gave it.
     pub from: String,
     /// Why the bracket began where it did.

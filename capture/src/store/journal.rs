@@ -96,6 +96,14 @@ pub struct FrameMeta {
     /// `EXPTIME`, `DATE-OBS`, `CCD-TEMP`, `INSTRUME`, …).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub camera_report: Vec<String>,
+    /// The lens's focal length for this frame, pixels at the frame's size,
+    /// when it is not the station camera's: a zoom photograph (thesis
+    /// §5.6.4), such as `session import` writes for photographs taken at
+    /// another focal length than the session's camera. Processing takes
+    /// such a frame as an undistorted pinhole of this focal length centred
+    /// on the frame. `None`: the station camera's intrinsics.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub focal_px: Option<f64>,
 }
 
 /// The header cards of a frame the camera delivered as FITS.
@@ -134,6 +142,7 @@ impl FrameMeta {
             late_by_s: None,
             notes: Vec::new(),
             camera_report: camera_report(frame),
+            focal_px: None,
         }
     }
 
@@ -151,6 +160,11 @@ impl FrameMeta {
             .or_else(|| positive("exposure_actual_s", self.exposure_actual_s))
             .or_else(|| finite("gain_db", self.gain_db))
             .or_else(|| self.temperature_c.and_then(|t| finite("temperature_c", t)))
+            .or_else(|| {
+                self.focal_px.and_then(|f| {
+                    (!(f.is_finite() && f > 0.0)).then(|| format!("focal_px is {f}, expected > 0 pixels"))
+                })
+            })
             .or_else(|| {
                 self.late_by_s
                     .and_then(|l| (!(l.is_finite() && l >= 0.0)).then(|| format!("late_by_s is {l}, expected ≥ 0")))

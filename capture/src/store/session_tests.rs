@@ -108,6 +108,7 @@ fn meta_for(i: usize, frame: &Frame) -> FrameMeta {
         ]
     });
     meta.late_by_s = (i % 11 == 4).then_some(12.5);
+    meta.focal_px = (i % 7 == 2).then_some(1_234.567_890_123);
     if meta.late_by_s.is_some() {
         meta.notes.push("late by 12.5 s: head stalled".into());
     }

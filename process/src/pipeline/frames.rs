@@ -64,6 +64,11 @@ pub struct CapturedFrame {
     /// ([`crate::hdr::linear_codes`]), whose response is known, not a
     /// camera's processed output.
     pub linear: bool,
+    /// The lens's focal length for this frame, pixels at its size, when it
+    /// is not the station camera's: a zoom photograph (the journal's
+    /// `focal_px`), taken as an undistorted pinhole centred on the frame
+    /// with no falloff. `None`: the station camera.
+    pub focal_px: Option<f64>,
 }
 
 /// How far below the largest code a lossy (JPEG) frame's codes are taken

@@ -133,6 +133,22 @@ pub enum PipelineError {
         /// Why.
         source: crate::hdr::HdrError,
     },
+    /// A group's frames were taken at different focal lengths.
+    #[error(
+        "group {group}: its frames were taken at different focal lengths ({} and {} for {other}): a bracket is one view through one lens",
+        focal_text(*first),
+        focal_text(*other_focal_px)
+    )]
+    MixedFocalLengths {
+        /// The group.
+        group: String,
+        /// Its first frame's focal length, pixels (`None`: the station camera's).
+        first: Option<f64>,
+        /// A frame at another.
+        other: String,
+        /// That frame's focal length, pixels.
+        other_focal_px: Option<f64>,
+    },
     /// An occurrence has no sun or sky frames to process.
     #[error("occurrence {occurrence:?} has no sun shot and no sky scan")]
     NoScan {
@@ -147,4 +163,9 @@ pub enum PipelineError {
         /// Why.
         message: String,
     },
+}
+
+/// A frame's focal length as an error message says it.
+fn focal_text(focal_px: Option<f64>) -> String {
+    focal_px.map_or_else(|| "the station camera's".to_owned(), |f| format!("{f} px"))
 }

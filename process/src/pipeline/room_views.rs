@@ -254,6 +254,7 @@ mod tests {
             held_by: None,
             position_m: [1.0, 2.0, 1.5],
             pinhole,
+            zoom: false,
             map: RadianceMap {
                 width: w,
                 height: h,

@@ -37,6 +37,20 @@ impl Pinhole {
         }
     }
 
+    /// An undistorted rectilinear camera of focal length `focal_px`, its
+    /// principal point at the centre of a `width` × `height` frame: a
+    /// photograph whose lens is known only by its focal length (a zoom
+    /// photograph's EXIF).
+    pub fn centred(focal_px: f64, width: usize, height: usize) -> Pinhole {
+        Pinhole {
+            focal_px,
+            principal_px: (width as f64 / 2.0, height as f64 / 2.0),
+            k1: 0.0,
+            k2: 0.0,
+            projection: Projection::Pinhole,
+        }
+    }
+
     /// This camera, given for `from` = (width, height), rescaled to a frame
     /// of `width` × `height`: focal length and principal point scale.
     pub fn rescaled(&self, from: (usize, usize), width: usize, height: usize) -> Pinhole {

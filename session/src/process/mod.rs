@@ -165,6 +165,46 @@ pub fn outdoor_quality(p: &Processed, o: &Outdoor) -> ProductQuality {
     q
 }
 
+/// A zoom photograph's verdict: the share of its target pixels given
+/// high-resolution pseudo-albedos (eq. 5.16), and its re-render with them
+/// at its own time against the photograph; it inherits the pseudo-albedos'
+/// verdict, which it scales.
+pub fn zoom_quality(p: &Processed, z: &outdoor_stage::ZoomView, albedos: &ProductQuality) -> ProductQuality {
+    let r = &z.albedo.report;
+    let on_target = r.pixels - r.non_target;
+    let coverage = if on_target == 0 {
+        0.0
+    } else {
+        r.used as f64 / on_target as f64
+    };
+    let mut q = ProductQuality::new(
+        format!("zoom {}", z.label),
+        vec![
+            campanile_process::quality::Check::new(
+                format!(
+                    "fraction of the {on_target} target pixels given eq. (5.16) pseudo-albedos ({} at a face's outline, {} at a shadow edge, {} invalid, {} dark)",
+                    r.face_edge, r.shadow_edge, r.invalid_radiance, r.dark
+                ),
+                coverage,
+                p.thresholds.outdoor.zoom_coverage,
+                campanile_process::quality::Better::Higher,
+            ),
+            gates::outdoor_render(&z.label, z.rmse_block, z.blocks, &p.thresholds)
+                .checks
+                .remove(0),
+        ],
+    );
+    q.notes.push(format!(
+        "re-rendered at its own time under the {} light; with the grid's pseudo-albedos alone {:.1}% per 4x4 block, {:.1}% per pixel (with eq. 5.16 {:.1}%)",
+        z.light,
+        100.0 * z.rmse_block_grid,
+        100.0 * z.rmse_pixel_grid,
+        100.0 * z.rmse_pixel
+    ));
+    q.inherit(albedos);
+    q
+}
+
 /// Stages 1 and 2 on the session in `dir` (stage 2, the sun, sky and
 /// environment, only with `env` = its map's rows and columns), through the
 /// calibration file `camera_calibration` when given (see
@@ -362,6 +402,53 @@ pub fn write_outdoor(o: &Outdoor, out: &Path) -> Result<()> {
         campanile_process::exr_io::write_radiance_exr(&map, &path)
             .with_context(|| format!("{}: cannot write", path.display()))?;
     }
+    if !o.products.zoom.is_empty() {
+        std::fs::create_dir_all(out.join("zoom")).with_context(|| format!("{}: cannot create", out.display()))?;
+    }
+    for z in &o.products.zoom {
+        let a = &z.albedo;
+        let stem = file_name(&z.label);
+        for (name, image) in [
+            ("albedo-sun", crate::scene_render::albedo_image(&a.rho_sun, &a.rig)),
+            ("albedo-se", crate::scene_render::albedo_image(&a.rho_se, &a.rig)),
+            ("grid-albedo-se", crate::scene_render::albedo_image(&a.low_se, &a.rig)),
+            ("render", z.rendered.clone()),
+        ] {
+            crate::igi::write_exr(&image, &out.join("zoom").join(format!("{stem}-{name}.exr")))?;
+        }
+        // Which pixels were given eq. (5.16) pseudo-albedos (white); the
+        // others keep the grid's.
+        let used: Vec<u8> = a.valid().iter().map(|&u| if u { 255 } else { 0 }).collect();
+        let png = out.join("zoom").join(format!("{stem}-used.png"));
+        image::save_buffer(
+            &png,
+            &used,
+            a.rig.width as u32,
+            a.rig.height as u32,
+            image::ExtendedColorType::L8,
+        )
+        .with_context(|| format!("{}: cannot write", png.display()))?;
+    }
+    let zoom: Vec<serde_json::Value> = o
+        .products
+        .zoom
+        .iter()
+        .map(|z| {
+            let r = &z.albedo.report;
+            serde_json::json!({
+                "view": z.label,
+                "light": z.light,
+                "focal_px": z.albedo.rig.pinhole.focal_px,
+                "pixels": {"total": r.pixels, "used": r.used, "non_target": r.non_target, "invalid_radiance": r.invalid_radiance, "face_edge": r.face_edge, "shadow_edge": r.shadow_edge, "dark": r.dark},
+                "window_px": r.window_px,
+                "rmse_block_4x4": z.rmse_block,
+                "rmse_block_4x4_grid_only": z.rmse_block_grid,
+                "rmse_pixel": z.rmse_pixel,
+                "rmse_pixel_grid_only": z.rmse_pixel_grid,
+                "blocks": z.blocks,
+            })
+        })
+        .collect();
     let summary: Vec<serde_json::Value> = o
         .products
         .held_out
@@ -381,6 +468,7 @@ pub fn write_outdoor(o: &Outdoor, out: &Path) -> Result<()> {
         "pixels": {"used": refl.sampling.used, "shadow_edge": refl.sampling.shadow_edge, "mirror": refl.sampling.mirror, "grazing": refl.sampling.grazing, "invalid": refl.sampling.invalid, "mixed": refl.sampling.mixed},
         "diagnostics": refl.diagnostics,
         "held_out": summary,
+        "zoom": zoom,
         "stage_seconds": o.products.seconds,
     });
     std::fs::write(out.join("outdoor.json"), serde_json::to_vec_pretty(&json)?)
@@ -420,7 +508,11 @@ pub fn outdoor_sections(
     let held = outdoor_report::held_out_section(&o.products)?;
     let strip = outdoor_report::day_strip(p, scene, &o.products, &rig, strip_frames)?;
     let overcast = outdoor_report::overcast_strip(p, scene, &o.products, &rig)?;
-    Ok((vec![albedo, held, strip, overcast], figures))
+    let mut sections = vec![albedo, held, strip, overcast];
+    if !o.products.zoom.is_empty() {
+        sections.push(outdoor_report::zoom_section(&o.products)?);
+    }
+    Ok((sections, figures))
 }
 
 /// Writes a report page (through a temporary file).

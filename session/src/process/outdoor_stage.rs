@@ -4,6 +4,10 @@
 //! texture finer than the grid that the training photographs show (§5.6.4,
 //! eq. 5.16, [`campanile_process::outdoor::texture_transfer`]), and
 //! compared with what the camera saw (the grid-only figure is reported too).
+//! Zoom photographs (views taken at their own focal length) are kept out of
+//! the fit and the held-out comparison: each gets the high-resolution
+//! pseudo-albedos of eq. (5.16) at its own pixels, and a re-render with
+//! them at its own time under its occurrence's light, against itself.
 
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -12,11 +16,13 @@ use crate::Result;
 use anyhow::{Context, anyhow};
 use campanile_config::scene::MaterialModel;
 use campanile_process::camera::image::RadianceImage;
-use campanile_process::outdoor::novel_view::{compare_view, render_view};
-use campanile_process::outdoor::rerender::Reference;
+use campanile_process::outdoor::novel_view::{block_rmse, compare_view, render_view};
+use campanile_process::outdoor::rerender::{Reference, relative_rmse, target_mask};
 use campanile_process::outdoor::texture_transfer::texture_sources;
+use campanile_process::outdoor::zoom_albedo::ZoomAlbedo;
 use campanile_process::outdoor::{
-    Illumination, Photo, Reflectance, ReflectanceSettings, RerenderSettings, recover_reflectance,
+    Illumination, Photo, Reflectance, ReflectanceSettings, RerenderSettings, ZoomSettings, recover_reflectance,
+    rerender, rerender_zoom, zoom_albedo,
 };
 use campanile_process::pipeline::{
     EstimateSettings, EstimatedLight, KnownLight, MeasuredSky, MergedGroup, OccurrenceLight, Purpose, ScaleSource,
@@ -53,6 +59,31 @@ pub struct HeldOutView {
     pub rmse_block: f64,
 }
 
+/// A zoom photograph's view (thesis §5.6.4): its high-resolution
+/// pseudo-albedos, and the view re-rendered with them at its own time.
+pub struct ZoomView {
+    /// The group's key.
+    pub label: String,
+    /// The pseudo-albedos at the photograph's pixels (eq. 5.16), with what
+    /// became of each pixel.
+    pub albedo: ZoomAlbedo,
+    /// Where the light came from: measured at its occurrence, or predicted
+    /// (a held-out occurrence).
+    pub light: &'static str,
+    /// The view re-rendered with its own pseudo-albedos under that light.
+    pub rendered: RadianceImage,
+    /// Relative RMSE of 4×4-pixel block means of the re-render against the
+    /// photograph, over the target pixels valid in it.
+    pub rmse_block: f64,
+    /// Blocks compared.
+    pub blocks: usize,
+    /// The same with the grid's pseudo-albedos alone (no eq. 5.16).
+    pub rmse_block_grid: f64,
+    /// Relative RMSE per pixel of the re-render, and of the grid-only one.
+    pub rmse_pixel: f64,
+    pub rmse_pixel_grid: f64,
+}
+
 /// What the outdoor stages made.
 pub struct OutdoorProducts {
     /// The pseudo-albedos and their diagnostics.
@@ -65,6 +96,8 @@ pub struct OutdoorProducts {
     /// Held-out views lit by the clear-sky model scaled as the estimated
     /// training lights were (no measured light to predict from).
     pub predicted_from_model: Vec<String>,
+    /// The zoom photographs' views.
+    pub zoom: Vec<ZoomView>,
     /// Stage times.
     pub seconds: Vec<(String, f64)>,
 }
@@ -131,7 +164,7 @@ pub fn outdoor(p: &Processed, scene: &Scene, settings: &ReflectanceSettings) -> 
     // views (within a minute or two of each), the sun where it was then.
     let mut by_occurrence: BTreeMap<&str, Vec<&MergedGroup>> = BTreeMap::new();
     for g in &p.merged {
-        if matches!(g.purpose, Purpose::View { .. }) {
+        if matches!(g.purpose, Purpose::View { .. }) && !g.zoom {
             by_occurrence.entry(&g.occurrence).or_default().push(g);
         }
     }
@@ -211,25 +244,12 @@ pub fn outdoor(p: &Processed, scene: &Scene, settings: &ReflectanceSettings) -> 
     for g in p
         .merged
         .iter()
-        .filter(|g| g.held_out && matches!(g.purpose, Purpose::View { .. }))
+        .filter(|g| g.held_out && !g.zoom && matches!(g.purpose, Purpose::View { .. }))
     {
-        let sun = sun_position(g.time, &p.optics.observer, p.optics.delta_t_s)
-            .map_err(|e| anyhow!("sun position at {}: {e}", g.time))?;
-        let sky = match predicted_sky(&p.light, &sun) {
-            Ok(sky) => sky,
-            // No measured light to predict from: the model, scaled as the
-            // estimated training lights were (those not scaled to a fitted sky).
-            Err(_) if !estimated.is_empty() => {
-                let from_model: Vec<&EstimatedLight> = estimated
-                    .iter()
-                    .map(|(_, e)| e)
-                    .filter(|e| e.scale != ScaleSource::FittedSky)
-                    .collect();
-                predicted_from_model.push(g.key.clone());
-                predicted_estimated_light(&from_model, sun.direction(), &Atmosphere::clear())
-            }
-            Err(e) => return Err(anyhow!(e).context(format!("predicting the light of {}", g.key)).into()),
-        };
+        let (sky, from_model) = predicted_light(p, g, &estimated)?;
+        if from_model {
+            predicted_from_model.push(g.key.clone());
+        }
         let rig = rig_of(p, g);
         let light = Illumination {
             time: g.time,
@@ -265,12 +285,128 @@ pub fn outdoor(p: &Processed, scene: &Scene, settings: &ReflectanceSettings) -> 
         format!("held-out re-renders ({})", held_out.len()),
         t.elapsed().as_secs_f64(),
     ));
+
+    let t = Instant::now();
+    let mut zoom = Vec::new();
+    for g in p
+        .merged
+        .iter()
+        .filter(|g| g.zoom && matches!(g.purpose, Purpose::View { .. }))
+    {
+        zoom.push(zoom_view(p, scene, &reflectance, g, &estimated)?);
+    }
+    if !zoom.is_empty() {
+        seconds.push((
+            format!("zoom photographs' pseudo-albedos ({})", zoom.len()),
+            t.elapsed().as_secs_f64(),
+        ));
+    }
     Ok(OutdoorProducts {
         reflectance,
         held_out,
         estimated,
         predicted_from_model,
+        zoom,
         seconds,
+    })
+}
+
+/// The light at `g`'s time: its occurrence's measured sun and sky (the
+/// sun moved to that time), or, for a held-out occurrence or one without a
+/// sky scan and sun shot, [`predicted_light`]. Says which.
+fn light_at(
+    p: &Processed,
+    g: &MergedGroup,
+    estimated: &[(String, EstimatedLight)],
+) -> Result<(MeasuredSky, &'static str)> {
+    let own = p
+        .light
+        .iter()
+        .find(|l| l.occurrence == g.occurrence && !l.held_out && l.sky.is_some() && l.sun_irradiance.is_some());
+    if let Some(l) = own {
+        let sun = sun_position(g.time, &p.optics.observer, p.optics.delta_t_s)
+            .map_err(|e| anyhow!("sun position at {}: {e}", g.time))?;
+        let mut sky = measured_sky(l).with_context(|| format!("the light of {}", g.occurrence))?;
+        sky.sun_direction = sun.direction();
+        return Ok((sky, "measured"));
+    }
+    let (sky, from_model) = predicted_light(p, g, estimated)?;
+    Ok((
+        sky,
+        if from_model {
+            "predicted from the clear-sky model"
+        } else {
+            "predicted"
+        },
+    ))
+}
+
+/// The light at `g`'s time predicted from the measured ones (§5.5.1), or,
+/// with no measured light to predict from, the clear-sky model scaled as
+/// the estimated training lights were (those not scaled to a fitted sky;
+/// then `true`).
+fn predicted_light(
+    p: &Processed,
+    g: &MergedGroup,
+    estimated: &[(String, EstimatedLight)],
+) -> Result<(MeasuredSky, bool)> {
+    let sun = sun_position(g.time, &p.optics.observer, p.optics.delta_t_s)
+        .map_err(|e| anyhow!("sun position at {}: {e}", g.time))?;
+    match predicted_sky(&p.light, &sun) {
+        Ok(sky) => Ok((sky, false)),
+        Err(_) if !estimated.is_empty() => {
+            let from_model: Vec<&EstimatedLight> = estimated
+                .iter()
+                .map(|(_, e)| e)
+                .filter(|e| e.scale != ScaleSource::FittedSky)
+                .collect();
+            Ok((
+                predicted_estimated_light(&from_model, sun.direction(), &Atmosphere::clear()),
+                true,
+            ))
+        }
+        Err(e) => Err(anyhow!(e).context(format!("predicting the light of {}", g.key)).into()),
+    }
+}
+
+/// A zoom photograph's high-resolution pseudo-albedos (eq. 5.16) from the
+/// grid's, and its view re-rendered with them (and with the grid's alone)
+/// at its own time, against the photograph.
+fn zoom_view(
+    p: &Processed,
+    scene: &Scene,
+    refl: &Reflectance,
+    g: &MergedGroup,
+    estimated: &[(String, EstimatedLight)],
+) -> Result<ZoomView> {
+    let (sky, light_from) = light_at(p, g, estimated)?;
+    let light = Illumination {
+        time: g.time,
+        sky: &sky,
+    };
+    let photo = photo_of(p, g, g.time);
+    let albedo = zoom_albedo(scene, refl, &photo, &light, &ZoomSettings::default())
+        .map_err(|e| anyhow!("zoom photograph {}: {e}", g.key))?;
+    let settings = RerenderSettings::default();
+    let rendered = rerender_zoom(scene, refl, &albedo, &light, &settings);
+    let (grid_only, _) = rerender(scene, refl, &photo.rig, &light, &settings);
+    let valid = photo.mask.as_deref();
+    let mask: Vec<bool> = target_mask(scene, refl, &photo.rig)
+        .into_iter()
+        .enumerate()
+        .map(|(i, t)| t && valid.is_none_or(|v| v[i]))
+        .collect();
+    let (rmse_block, blocks) = block_rmse(&rendered, &photo.image, &mask, 4).unwrap_or((f64::NAN, 0));
+    Ok(ZoomView {
+        label: g.key.clone(),
+        light: light_from,
+        rmse_block,
+        blocks,
+        rmse_block_grid: block_rmse(&grid_only, &photo.image, &mask, 4).map_or(f64::NAN, |(r, _)| r),
+        rmse_pixel: relative_rmse(&rendered, &photo.image, &mask).unwrap_or(f64::NAN),
+        rmse_pixel_grid: relative_rmse(&grid_only, &photo.image, &mask).unwrap_or(f64::NAN),
+        albedo,
+        rendered,
     })
 }
 

@@ -204,6 +204,7 @@ impl SessionInputs {
                     filter_transmittance,
                     codes,
                     linear: e.format.is_raw() || e.format == FrameFormat::Fits,
+                    focal_px: e.meta.focal_px,
                 })
             })
             .collect();
