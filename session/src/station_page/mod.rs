@@ -39,7 +39,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
 
-use crate::{Error, Result};
+use crate::Result;
 
 /// How the page is served.
 #[derive(Debug, Clone)]
@@ -69,7 +69,7 @@ impl PageServer {
         let (snapshot, watcher) = store_watch::watch_store(options.store.clone(), options.poll).await;
         let listener = tokio::net::TcpListener::bind(options.listen)
             .await
-            .map_err(|e| Error::input(format!("--listen {}: cannot listen there: {e}", options.listen)))?;
+            .map_err(|e| anyhow::anyhow!("--listen {}: cannot listen there: {e}", options.listen))?;
         let state = Arc::new(routes::PageState::new(options.store, options.token, snapshot));
         Ok(PageServer {
             listener,
