@@ -15,6 +15,7 @@
 //!   the station calls after each scan, and the sky series' one;
 //! - [`station_run`]: the unattended station's run, simulated or real;
 //! - [`station_status`]: the station's heartbeat read back;
+//! - [`station_page`]: the station's live web page and JSON API;
 //! - [`igi`]: inverse global illumination on a scene file and its products;
 //! - [`outdoor_files`]: outdoor reflectance on plain files (recover, render);
 //! - [`env_files`]: environment regions on plain files (fit, predict);
@@ -72,6 +73,7 @@ pub mod site;
 pub mod sky_camera_files;
 pub mod sky_files;
 pub mod sky_series;
+pub mod station_page;
 pub mod station_run;
 pub mod station_status;
 pub mod sun_files;

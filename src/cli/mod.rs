@@ -90,7 +90,7 @@ pub enum Command {
         action: outdoor::OutdoorCommand,
     },
     Capture(capture::CaptureArgs),
-    /// The unattended station: run a plan day after day (`station run`), read its heartbeat (`station status`).
+    /// The unattended station: run a plan day after day (`station run`), read its heartbeat (`station status`), serve its live page (`station serve`).
     Station {
         #[command(subcommand)]
         action: station::StationCommand,

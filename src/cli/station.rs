@@ -1,5 +1,6 @@
-//! `campanile station run|status|calibrate-mount`: the unattended station,
-//! its heartbeat, and its head's mount calibrated from targets.
+//! `campanile station run|status|serve|calibrate-mount`: the unattended
+//! station, its heartbeat, its live page, and its head's mount calibrated
+//! from targets.
 
 use std::path::PathBuf;
 use std::time::Duration;
@@ -13,13 +14,14 @@ use clap::{Args, Subcommand};
 use super::{EXIT_FAILURE, EXIT_OK};
 use campanile_session::capture_inputs::Inputs;
 use campanile_session::station_run::{StationRun, TimedOutage, run_station};
-use campanile_session::station_status;
+use campanile_session::{station_page, station_status};
 
 #[derive(Debug, Subcommand)]
 pub enum StationCommand {
     // The variants take their help from their arguments' doc comments.
     Run(RunArgs),
     Status(StatusArgs),
+    Serve(ServeArgs),
     CalibrateMount(CalibrateMountArgs),
 }
 
@@ -240,6 +242,55 @@ pub struct StatusArgs {
     max_age: f64,
 }
 
+/// Serve a live web page of a running station (read-only).
+///
+/// The page shows the heartbeat (state, devices, free disk, frames today,
+/// last frame), the latest sky frame, today's keogram as it builds up,
+/// the sky series plots (sun irradiance, the Langley plot of the
+/// extinction, sky parameters, and the sky-condition columns when the
+/// series has them), and the day's outages and missed shots. Updates are
+/// pushed to the browser (server-sent events): no reload. The same data
+/// is a JSON API: /api/state, /api/days, /api/day/YYYY-MM-DD, and
+/// /day/YYYY-MM-DD/keogram.png and latest.png; /events is the event
+/// stream.
+///
+/// Only the files the station writes are read (polled every --poll-ms),
+/// so any number of browsers cannot slow the station.
+///
+/// It listens on loopback (127.0.0.1:8080) unless --listen says
+/// otherwise; on any other address a token is required (--token or
+/// --token-file, 16 or more printable characters), and every request
+/// must carry it (open the page as /?token=TOKEN, or send
+/// `Authorization: Bearer TOKEN`); others get 401.
+///
+/// Runs until SIGINT or SIGTERM (exit 0); exit 2 for bad input (no such
+/// store, a network address without a token), 1 when the address cannot
+/// be used.
+///
+/// Examples:
+///   campanile station serve sky
+///   campanile station serve sky --listen 0.0.0.0:8080 --token-file /etc/campanile/page-token
+#[derive(Debug, Args)]
+#[command(verbatim_doc_comment)]
+pub struct ServeArgs {
+    /// The store directory (`station run --store DIR`).
+    #[arg(value_name = "DIR")]
+    store: PathBuf,
+    /// Address and port to listen on.
+    #[arg(long, value_name = "ADDR:PORT", default_value = "127.0.0.1:8080")]
+    listen: std::net::SocketAddr,
+    /// The token requests must carry (needed off loopback). Visible to
+    /// other users in the process list: prefer --token-file.
+    #[arg(long, value_name = "TOKEN", conflicts_with = "token_file")]
+    token: Option<String>,
+    /// A file whose first line is the token.
+    #[arg(long, value_name = "FILE")]
+    token_file: Option<PathBuf>,
+    /// How often the store's files are looked at, in milliseconds.
+    #[arg(long, value_name = "MS", default_value_t = 500)]
+    poll_ms: u64,
+}
+
 pub fn run(command: StationCommand) -> Result<u8> {
     let out = &mut std::io::stdout();
     let ok = match command {
@@ -268,6 +319,20 @@ pub fn run(command: StationCommand) -> Result<u8> {
             run_station(&run, &inputs, response, out, &mut std::io::stderr())?
         }
         StationCommand::Status(args) => station_status::status(&args.store, args.max_age, out)?,
+        StationCommand::Serve(args) => {
+            let token = match (args.token, &args.token_file) {
+                (_, Some(file)) => Some(station_page::access::token_from_file(file)?),
+                (token, None) => token,
+            };
+            let options = station_page::ServeOptions {
+                store: args.store,
+                listen: args.listen,
+                token,
+                poll: Duration::from_millis(args.poll_ms),
+            };
+            station_page::serve(options, out)?;
+            true
+        }
         StationCommand::CalibrateMount(args) => {
             let limits = campanile_process::registration::mount::MountLimits::default();
             let cal = match (&args.session, &args.targets, &args.poses, &args.readings, &args.station) {
