@@ -249,10 +249,11 @@ fn series_rows(store: &Path, day: &str) -> usize {
     text.lines().filter(|l| !l.starts_with('#')).count() - 1
 }
 
-/// Writes the screenshot under `target/`, and the guide's one into
+/// Writes the screenshot under cargo's temporary directory for tests
+/// (`CARGO_TARGET_TMPDIR`, wherever the target directory is), and the guide's one into
 /// `docs/guide/` too when `CAMPANILE_SCREENSHOTS` is set.
 fn keep_screenshot(name: &str, png: &[u8], in_guide: bool) {
-    let target = root().join("target").join(name);
+    let target = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
     std::fs::write(&target, png).unwrap();
     if in_guide && std::env::var_os("CAMPANILE_SCREENSHOTS").is_some() {
         std::fs::write(root().join("docs/guide").join(name), png).unwrap();
