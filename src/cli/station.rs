@@ -133,9 +133,10 @@ pub struct CalibrateMountArgs {
 ///   campanile station run examples/sky-station.ron --station examples/sky-sim-station.ron --store sky --budget 50MB
 ///
 /// Example with sky conditions and an alert (simulated broken clouds):
-///   campanile station run examples/sky-station.ron --station examples/sky-sim-station.ron --store sky \
-///     --days 1 --process --response response.csv --sim-broken-clouds 7 \
-///     --on-condition-change 'echo "$(date) sky $2 -> $1, cover $5" >> conditions.log'
+///   campanile station run examples/sky-station.ron \
+///     --station examples/sky-sim-station.ron --store sky --days 1 \
+///     --process --response response.csv --sim-broken-clouds 7 \
+///     --on-condition-change 'echo "sky $2 -> $1 at $3" >> conditions.log'
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct RunArgs {

@@ -64,8 +64,11 @@ pub struct BrokenClouds {
     pub overcast_zenith: [f64; 3],
     /// The cover drawn for each hour's stretch, in order from `start`.
     pub hourly_cover: Vec<f64>,
-    /// The patches.
+    /// The patches, sorted by their centre along the wind (what
+    /// [`BrokenClouds::opacity`] searches).
     pub patches: Vec<CloudPatch>,
+    /// The largest patch radius, layer heights.
+    pub max_radius: f64,
 }
 
 impl BrokenClouds {
@@ -103,12 +106,14 @@ impl BrokenClouds {
                 });
             }
         }
+        patches.sort_by(|a, b| a.centre[0].total_cmp(&b.centre[0]));
         BrokenClouds {
             start,
             speed_per_hour,
             toward_rad,
             overcast_zenith: [6.0, 6.5, 7.0],
             hourly_cover,
+            max_radius: patches.iter().map(|p| p.radius).fold(0.0, f64::max),
             patches,
         }
     }
@@ -125,7 +130,12 @@ impl BrokenClouds {
         let along = px * s + py * c - self.speed_per_hour * hours;
         let across = -px * c + py * s;
         let mut o: f64 = 0.0;
-        for p in &self.patches {
+        let window = self.max_radius + EDGE_WIDTH;
+        let from = self.patches.partition_point(|p| p.centre[0] < along - window);
+        for p in self.patches[from..]
+            .iter()
+            .take_while(|p| p.centre[0] <= along + window)
+        {
             let (dx, dy) = (along - p.centre[0], across - p.centre[1]);
             let reach = p.radius + EDGE_WIDTH;
             if dx.abs() > reach || dy.abs() > reach {
@@ -390,6 +400,10 @@ mod tests {
         "2026-08-28T06:00:00Z".parse().unwrap()
     }
 
+    fn later_by(minutes: i32) -> DateTime<Utc> {
+        start() + chrono::TimeDelta::minutes(i64::from(minutes) * 3)
+    }
+
     #[test]
     fn the_layer_is_seeded_drifts_and_blends_the_overcast_sky() {
         let a = BrokenClouds::seeded(7, start(), 12);
@@ -409,6 +423,15 @@ mod tests {
         let moved = ground(p.centre[0] + a.speed_per_hour, p.centre[1]);
         assert!((a.opacity(moved, later) - 1.0).abs() < 1e-12);
         assert_eq!(a.opacity([0.0, 0.0, -1.0], start()), 0.0);
+        // The search along the wind finds what a look at every patch finds.
+        let every = BrokenClouds {
+            max_radius: 1e9,
+            ..a.clone()
+        };
+        for k in 0..200 {
+            let d = direction(f64::from(k) * 0.0041, f64::from(k) * 0.37);
+            assert_eq!(a.opacity(d, later_by(k)), every.opacity(d, later_by(k)));
+        }
         // The sky: clear where the opacity is 0, the overcast sky where it is 1.
         let sun = direction(40f64.to_radians(), 2.0);
         let day = Daylight::clear(sun, &Atmosphere::clear());
@@ -436,6 +459,7 @@ mod tests {
                 centre: [0.0, 0.0],
                 radius: 100.0,
             }],
+            max_radius: 100.0,
         };
         let sun = direction(30f64.to_radians(), 1.0);
         let t = clouds.truth(start(), sun);
