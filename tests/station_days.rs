@@ -145,6 +145,7 @@ fn process_each_scan(
         response: response.to_path_buf(),
         thresholds,
         camera_calibration: None,
+        on_condition_change: None,
     };
     move |dir: &Path, occurrence: &Occurrence| {
         let why = match processor.process(dir, &occurrence.key) {

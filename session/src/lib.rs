@@ -50,6 +50,7 @@ macro_rules! bail {
 
 pub mod capture_inputs;
 pub mod capture_run;
+pub mod condition_hook;
 pub mod demo;
 pub mod device_checks;
 pub mod env_files;

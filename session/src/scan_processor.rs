@@ -15,6 +15,7 @@ use campanile_process::hdr::debevec::DebevecOptions;
 use campanile_process::quality::{Quality, QualityReport, Verdict};
 
 use crate::Result;
+use crate::condition_hook::ConditionHook;
 use crate::sky_series::{SkySeriesOptions, process_scan, recompute_day, series_quality};
 
 /// Processes one settled scan of a day session.
@@ -38,6 +39,9 @@ pub struct SkySeriesProcessor {
     /// A calibrated camera (`campanile sky calibrate`'s file) the scans
     /// are processed with instead of the station's camera and mount.
     pub camera_calibration: Option<PathBuf>,
+    /// The command run when a scan changes the sky condition
+    /// (`--on-condition-change`, see [`crate::condition_hook`]).
+    pub on_condition_change: Option<ConditionHook>,
 }
 
 impl ScanProcessor for SkySeriesProcessor {
@@ -51,6 +55,9 @@ impl ScanProcessor for SkySeriesProcessor {
         };
         process_scan(session_dir, occurrence, &opts)?;
         let series = recompute_day(&opts.out)?;
+        if let Some(hook) = &self.on_condition_change {
+            hook.on_scan(&series, occurrence);
+        }
         // The day's verdicts beside its products.
         let day = series_quality(series.scans.iter(), &self.thresholds);
         crate::verdicts::write(&day, &opts.out.join("quality.json"))?;

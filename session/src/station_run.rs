@@ -21,9 +21,11 @@ use campanile_capture::unattended::{
 use campanile_process::quality::Quality;
 use campanile_sim::faults::{Device, FaultPlan, Outage};
 use campanile_sim::station::{SimOptions, SimStation};
+use campanile_sim::world::broken_clouds::BrokenClouds;
 use chrono::{DateTime, TimeDelta, Utc};
 
 use crate::capture_inputs::{Inputs, SimulatedWorld, simulated_world};
+use crate::condition_hook::ConditionHook;
 use crate::scan_processor::{SkySeriesProcessor, StationHook};
 use crate::{Error, Result};
 
@@ -51,10 +53,28 @@ pub struct StationRun {
     pub bounces: u32,
     /// Simulated stations: device outages.
     pub outages: Vec<TimedOutage>,
+    /// Simulated stations: a seeded drifting broken-cloud layer over the
+    /// clear sky (`sim::world::broken_clouds`), from an hour before the
+    /// plan's first occurrence.
+    pub broken_clouds: Option<u64>,
+    /// A command run when a processed scan changes the sky condition
+    /// (see [`crate::condition_hook`]).
+    pub on_condition_change: Option<String>,
 }
 
 /// How the station's run ended: its report, or the failure that stopped it.
 pub type StationResult = std::result::Result<StationReport, unattended::StationFailure>;
+
+/// The seeded broken-cloud layer `--sim-broken-clouds SEED` puts over
+/// the plan of `inputs`: from an hour before its first occurrence to an
+/// hour after its last (`None` without occurrences).
+pub fn broken_clouds_for(inputs: &Inputs, seed: u64) -> Option<BrokenClouds> {
+    let first = inputs.timeline.occurrences.first()?;
+    let last = inputs.timeline.occurrences.last()?;
+    let start = first.start - TimeDelta::hours(1);
+    let hours = ((last.start - start).num_hours() + 2).max(1) as usize;
+    Some(BrokenClouds::seeded(seed, start, hours))
+}
 
 /// The station time of the last line journaled in any day session of `store`.
 fn last_journaled(store: &Path) -> Result<Option<DateTime<Utc>>> {
@@ -86,7 +106,14 @@ pub fn run_simulated(
         Some(t) => t + TimeDelta::seconds(1),
         None => first.start - TimeDelta::seconds(60),
     };
-    let SimulatedWorld { world, home, seed: _ } = simulated_world(inputs, run.samples, run.bounces)?;
+    let SimulatedWorld {
+        mut world,
+        home,
+        seed: _,
+    } = simulated_world(inputs, run.samples, run.bounces)?;
+    if let Some(seed) = run.broken_clouds {
+        std::sync::Arc::make_mut(&mut world).broken_clouds = broken_clouds_for(inputs, seed);
+    }
     let outages = run
         .outages
         .iter()
@@ -214,6 +241,7 @@ pub fn run_station(
             response: response.to_path_buf(),
             thresholds,
             camera_calibration: None,
+            on_condition_change: run.on_condition_change.clone().map(ConditionHook::new),
         })),
         None => Box::new(NoProcessing),
     };

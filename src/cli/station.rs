@@ -133,6 +133,12 @@ pub struct CalibrateMountArgs {
 ///
 /// Example:
 ///   campanile station run examples/sky-station.ron --station examples/sky-sim-station.ron --store sky --budget 50MB
+///
+/// Example with sky conditions and an alert (simulated broken clouds):
+///   campanile station run examples/sky-station.ron \
+///     --station examples/sky-sim-station.ron --store sky --days 1 \
+///     --process --response response.csv --sim-broken-clouds 7 \
+///     --on-condition-change 'echo "sky $2 -> $1 at $3" >> conditions.log'
 #[derive(Debug, Args)]
 #[command(verbatim_doc_comment)]
 pub struct RunArgs {
@@ -173,6 +179,24 @@ pub struct RunArgs {
     /// restarted run keeps them.
     #[arg(long, value_name = "DEVICE:START:DURATION")]
     sim_outage: Vec<StationOutageArg>,
+    /// Simulation: a broken-cloud day, seeded: cloud patches drifting over
+    /// the clear sky (clear spells, scattered, broken and near-overcast
+    /// hours), for the sky-condition index.
+    #[arg(long, value_name = "SEED")]
+    sim_broken_clouds: Option<u64>,
+    /// With --process: run CMD (through `sh -c`) when a scan's sky
+    /// condition differs from the previous scan's of the day. Arguments
+    /// $1..$8 (and environment variables): the new condition
+    /// (CAMPANILE_SKY_CONDITION: clear, partly-cloudy, cloudy, overcast),
+    /// the previous one or `unknown` (CAMPANILE_PREVIOUS_SKY_CONDITION),
+    /// the scan time UTC (CAMPANILE_SCAN_TIME_UTC), the occurrence
+    /// (CAMPANILE_OCCURRENCE), cloud cover 0-1 (CAMPANILE_CLOUD_COVER),
+    /// the clear-sky index (CAMPANILE_CLEAR_SKY_INDEX), the direct one
+    /// (CAMPANILE_DIRECT_CLEAR_SKY_INDEX), clouds near the sun 1/0
+    /// (CAMPANILE_CLOUDS_NEAR_SUN_REGION). A failing or hanging command
+    /// (killed after 30 s) is logged; the station goes on.
+    #[arg(long, value_name = "CMD", requires = "process")]
+    on_condition_change: Option<String>,
 }
 
 /// `--sim-outage DEVICE:START:DURATION`.
@@ -314,6 +338,8 @@ pub fn run(command: StationCommand) -> Result<u8> {
                         duration: o.duration,
                     })
                     .collect(),
+                broken_clouds: args.sim_broken_clouds,
+                on_condition_change: args.on_condition_change.clone(),
             };
             let response = args.response.as_deref().filter(|_| args.process);
             run_station(&run, &inputs, response, out, &mut std::io::stderr())?

@@ -23,6 +23,7 @@
 //! it. The sun's irradiance is measured in the same units.
 
 mod estimated_light;
+pub(crate) use estimated_light::median;
 mod frames;
 mod illumination;
 mod measured_sky;

@@ -6,6 +6,7 @@
 
 use std::collections::BTreeMap;
 
+use super::condition::{SkyCondition, day_conditions};
 use super::scan::ScanProducts;
 use crate::sun::{Extinction, fit_extinction};
 
@@ -29,6 +30,8 @@ pub struct SkySeries {
     pub scans: Vec<ScanProducts>,
     /// One entry per day, in date order.
     pub days: Vec<DayExtinction>,
+    /// The sky condition of each scan, in the order of [`SkySeries::scans`].
+    pub conditions: Vec<SkyCondition>,
 }
 
 /// The day of an occurrence: the date after its `@` (`sky@2026-08-28#3`),
@@ -49,9 +52,10 @@ impl SkySeries {
         for s in &scans {
             by_day.entry(day_of(s)).or_default().push(s);
         }
-        let days = by_day
-            .into_iter()
+        let days: Vec<DayExtinction> = by_day
+            .iter()
             .map(|(date, day)| {
+                let date = date.clone();
                 let used: Vec<&ScanProducts> = day
                     .iter()
                     .copied()
@@ -77,6 +81,21 @@ impl SkySeries {
                 }
             })
             .collect();
-        SkySeries { scans, days }
+        // Each day's conditions, then in the scans' order.
+        let mut by_occurrence: BTreeMap<&str, SkyCondition> = BTreeMap::new();
+        for (ext, (_, day)) in days.iter().zip(&by_day) {
+            for (s, c) in day.iter().zip(day_conditions(day, ext)) {
+                by_occurrence.insert(s.occurrence.as_str(), c);
+            }
+        }
+        let conditions = scans
+            .iter()
+            .map(|s| by_occurrence.remove(s.occurrence.as_str()).unwrap_or_default())
+            .collect();
+        SkySeries {
+            scans,
+            days,
+            conditions,
+        }
     }
 }

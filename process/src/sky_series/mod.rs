@@ -9,25 +9,36 @@
 //! a stable hash of the occurrence id, and shard outputs merge by the union
 //! of their `scans/` directories ([`store`]).
 
+mod condition;
 mod day;
 mod keogram;
 mod plots;
 mod profile;
 mod quality;
+mod regions;
 mod report;
 mod scan;
 mod series_csv;
 mod series_parquet;
 mod shard;
+mod sky_pixels;
 pub mod store;
 
 use std::path::PathBuf;
 
+pub use condition::{
+    CLEAR_SCAN_COVER, CLEAR_SCAN_RMS, CLOUDY_DEPARTURE, ClearReference, Condition, MIN_MEASURED_SHARE, SkyCondition,
+    day_conditions,
+};
 pub use day::{DayExtinction, SkySeries, day_of};
 pub use keogram::{keogram_png, keogram_residual_png};
-pub use plots::{irradiance_svg, langley_svg, shape_parameters_svg, zenith_scale_svg};
+pub use plots::{conditions_svg, irradiance_svg, langley_svg, shape_parameters_svg, zenith_scale_svg};
 pub use profile::{MeridianProfile, PROFILE_BIN_DEG, PROFILE_BINS, meridian_profile, plane_direction};
 pub use quality::{HIGH_MASKED_FRACTION, POOR_FIT_RMS, QualityFlags};
+pub use regions::{
+    BAND_EDGES_DEG, MIN_REGION_PIXELS, NEAR_SUN_DEG, REGION_COUNT, RegionSums, SECTORS, SkyRegions,
+    in_sun_neighbourhood, region_grid, region_of, region_solid_angle, sun_neighbourhood_grid,
+};
 pub use report::sky_series_sections;
 pub use scan::{ScanProducts, SunRecord, scan_file_stem, scan_products};
 pub use series_csv::{EXTINCTION_COLUMNS, SERIES_COLUMNS, extinction_csv, series_csv, series_width};

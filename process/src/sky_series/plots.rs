@@ -93,6 +93,39 @@ pub fn irradiance_svg(series: &SkySeries) -> Result<String, ReportError> {
     line_plot_svg("direct normal solar irradiance", "hours UTC", "W·m⁻²", &lines)
 }
 
+/// The sky conditions against time: the sky's and the sun's clear-sky
+/// index and the cloud cover (scans whose figure could not be computed
+/// have no point).
+pub fn conditions_svg(series: &SkySeries) -> Result<String, ReportError> {
+    let t = hours(series);
+    type Figure = fn(&super::condition::SkyCondition) -> Option<f64>;
+    let figures: [(&str, Figure, (u8, u8, u8)); 3] = [
+        ("clear-sky index (sky)", |c| c.clear_sky_index, (40, 70, 200)),
+        ("clear-sky index (sun)", |c| c.direct_clear_sky_index, (230, 140, 0)),
+        ("cloud cover", |c| c.cloud_cover, (90, 90, 90)),
+    ];
+    let lines: Vec<Series> = figures
+        .iter()
+        .map(|(label, f, colour)| Series {
+            label: (*label).to_owned(),
+            points: series
+                .conditions
+                .iter()
+                .zip(&t)
+                .filter_map(|(c, &h)| f(c).filter(|v| v.is_finite()).map(|v| (h, v)))
+                .collect(),
+            colour: *colour,
+            markers: true,
+        })
+        .collect();
+    line_plot_svg(
+        "sky conditions: clear-sky indices and cloud cover",
+        "hours UTC",
+        "ratio / fraction",
+        &lines,
+    )
+}
+
 /// ln E against air mass for every day, with each channel's fitted line.
 pub fn langley_svg(series: &SkySeries) -> Result<String, ReportError> {
     let mut lines = Vec::new();

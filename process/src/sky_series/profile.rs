@@ -5,7 +5,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::pipeline::{MergedGroup, Purpose, SUN_MARGIN_RAD, StationOptics};
+use super::sky_pixels::for_each_sky_pixel;
+use crate::pipeline::{MergedGroup, SUN_MARGIN_RAD, StationOptics};
 use crate::sky::{SkyModel, angle_between, direction};
 use crate::sun::SunPosition;
 
@@ -51,46 +52,29 @@ pub fn meridian_profile(
     models: Option<&[SkyModel; 3]>,
     stride: usize,
 ) -> MeridianProfile {
-    let stride = stride.max(1);
     let az = sun.azimuth_rad;
     let (u, n) = ([az.sin(), az.cos(), 0.0], [az.cos(), -az.sin(), 0.0]);
     let sun_dir = sun.direction();
     let max_off = PROFILE_HALF_WIDTH_DEG.to_radians().sin();
     let mut sum = vec![[0.0f64; 3]; PROFILE_BINS];
     let mut count = vec![0usize; PROFILE_BINS];
-    for g in merged
-        .iter()
-        .filter(|g| g.occurrence == occurrence && g.purpose == Purpose::Sky)
-    {
-        for y in (0..g.map.height).step_by(stride) {
-            for x in (0..g.map.width).step_by(stride) {
-                let p = y * g.map.width + x;
-                if g.map.mask[p] != 0 {
-                    continue;
-                }
-                let Some(d) = g.pinhole.unproject(x as f64 + 0.5, y as f64 + 0.5) else {
-                    continue;
-                };
-                let d = g.mount(&optics.mount).to_world(g.head, d);
-                let off = d[0] * n[0] + d[1] * n[1];
-                if d[2] <= 0.0 || off.abs() > max_off || angle_between(d, sun_dir) < SUN_MARGIN_RAD {
-                    continue;
-                }
-                let along = d[0] * u[0] + d[1] * u[1];
-                let s = along.atan2(d[2]).to_degrees();
-                let bin = ((s + 90.0) / PROFILE_BIN_DEG).floor();
-                if !(0.0..PROFILE_BINS as f64).contains(&bin) {
-                    continue;
-                }
-                let rgb = [0, 1, 2].map(|c| f64::from(g.map.rgb[3 * p + c]));
-                if rgb.iter().all(|v| v.is_finite()) {
-                    let b = bin as usize;
-                    (0..3).for_each(|c| sum[b][c] += rgb[c]);
-                    count[b] += 1;
-                }
-            }
+    for_each_sky_pixel(merged, optics, occurrence, stride, |d, rgb| {
+        let off = d[0] * n[0] + d[1] * n[1];
+        if d[2] <= 0.0 || off.abs() > max_off || angle_between(d, sun_dir) < SUN_MARGIN_RAD {
+            return;
         }
-    }
+        let along = d[0] * u[0] + d[1] * u[1];
+        let s = along.atan2(d[2]).to_degrees();
+        let bin = ((s + 90.0) / PROFILE_BIN_DEG).floor();
+        if !(0.0..PROFILE_BINS as f64).contains(&bin) {
+            return;
+        }
+        if rgb.iter().all(|v| v.is_finite()) {
+            let b = bin as usize;
+            (0..3).for_each(|c| sum[b][c] += rgb[c]);
+            count[b] += 1;
+        }
+    });
     let centres: Vec<f64> = (0..PROFILE_BINS)
         .map(|i| -90.0 + PROFILE_BIN_DEG * (i as f64 + 0.5))
         .collect();

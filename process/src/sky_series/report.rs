@@ -2,7 +2,7 @@
 
 use super::day::SkySeries;
 use super::keogram::{RESIDUAL_RANGE, keogram_png, keogram_residual_png};
-use super::plots::{irradiance_svg, langley_svg, shape_parameters_svg, zenith_scale_svg};
+use super::plots::{conditions_svg, irradiance_svg, langley_svg, shape_parameters_svg, zenith_scale_svg};
 use crate::report::{ColourScale, Figure, ReportError, Section, Table};
 
 fn opt(v: Option<f64>, scale: f64, digits: usize) -> String {
@@ -15,7 +15,8 @@ pub fn sky_series_sections(series: &SkySeries) -> Result<Vec<Section>, ReportErr
     let rows: Vec<Vec<String>> = series
         .scans
         .iter()
-        .map(|s| {
+        .zip(&series.conditions)
+        .map(|(s, cond)| {
             let sun = s.sun.as_ref();
             let sky = s.sky.as_ref().filter(|k| k.len() == 3);
             vec![
@@ -34,6 +35,16 @@ pub fn sky_series_sections(series: &SkySeries) -> Result<Vec<Section>, ReportErr
                 opt(s.quality.worst_rms_relative, 100.0, 2),
                 opt(s.quality.masked_fraction, 100.0, 1),
                 s.quality.names(),
+                cond.condition
+                    .map_or_else(|| format!("– ({})", cond.note), |c| c.as_str().to_owned()),
+                opt(cond.cloud_cover, 100.0, 0),
+                format!(
+                    "{} / {}",
+                    opt(cond.clear_sky_index, 1.0, 2),
+                    opt(cond.direct_clear_sky_index, 1.0, 2)
+                ),
+                cond.clouds_near_sun_region
+                    .map_or("–".into(), |b| if b { "yes" } else { "no" }.to_owned()),
             ]
         })
         .collect();
@@ -42,7 +53,10 @@ pub fn sky_series_sections(series: &SkySeries) -> Result<Vec<Section>, ReportErr
         paragraphs: vec![format!(
             "{} scans. Per scan: the sun's direct normal irradiance (mean of its filtered frames, §5.3.1), \
              the sky per channel fitted to eq. (5.9) with the model chosen by BIC (§5.3.2), and the quality \
-             flags. The full record of each scan is in scans/*.ron; every column is in sky-series.csv.",
+             flags; the sky condition: the cloud cover over 24 regions of the dome, each compared with the \
+             day's clear sky at that sun position (a region departing by more than 0.2 in |ln ratio| is cloudy), \
+             the clear-sky indices of the sky and of the sun (over the day's Langley fit) and clouds in the sun's \
+             neighbourhood by the sky image. The full record of each scan is in scans/*.ron; every column is in sky-series.csv.",
             series.scans.len()
         )],
         tables: vec![Table {
@@ -58,6 +72,10 @@ pub fn sky_series_sections(series: &SkySeries) -> Result<Vec<Section>, ReportErr
                 "worst fit RMS %",
                 "masked %",
                 "flags",
+                "sky condition",
+                "cloud cover %",
+                "clear-sky index sky / sun",
+                "clouds near the sun (image)",
             ]
             .map(String::from)
             .to_vec(),
@@ -82,7 +100,14 @@ pub fn sky_series_sections(series: &SkySeries) -> Result<Vec<Section>, ReportErr
         }
         if measured {
             plots.push((irradiance_svg(series)?, "direct normal solar irradiance against time"));
-        } else {
+        }
+        if series.conditions.iter().any(|c| c.cloud_cover.is_some()) {
+            plots.push((
+                conditions_svg(series)?,
+                "sky conditions: clear-sky index of the sky and of the sun, cloud cover",
+            ));
+        }
+        if !measured {
             paragraphs
                 .push("No scan's sun could be measured (see the notes in scans/*.ron): no irradiance plot.".to_owned());
         }

@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::profile::{MeridianProfile, meridian_profile};
 use super::quality::QualityFlags;
+use super::regions::{SkyRegions, sky_regions};
 use crate::pipeline::{MergedGroup, PipelineError, Purpose, StationOptics, illumination};
 use crate::sky::{ChannelSky, SkyModel};
 use crate::sun::air_mass;
@@ -54,6 +55,10 @@ pub struct ScanProducts {
     pub sky: Option<Vec<ChannelSky>>,
     /// Measured and fitted radiance in the sun's vertical plane.
     pub profile: MeridianProfile,
+    /// The measured sky by region, for the sky-condition index (empty in
+    /// products written before it was kept).
+    #[serde(default)]
+    pub regions: SkyRegions,
     /// Quality flags.
     pub quality: QualityFlags,
     /// What could not be done, in words.
@@ -117,6 +122,7 @@ pub fn scan_products(
         .filter(|s| s.len() == 3)
         .map(|s| [s[0].model, s[1].model, s[2].model]);
     let profile = meridian_profile(&own, optics, occurrence, &l.sun, models.as_ref(), stride);
+    let regions = sky_regions(&own, optics, occurrence, l.sun.direction(), stride);
     let sun = match &l.sun_irradiance {
         Some(m) => {
             let at = crate::sun::sun_position(m.time, &optics.observer, optics.delta_t_s).map_err(|e| {
@@ -149,6 +155,7 @@ pub fn scan_products(
         sun,
         sky,
         profile,
+        regions,
         quality,
         notes: l.notes,
     })

@@ -4,6 +4,7 @@
 
 use std::fmt::Write as _;
 
+use super::condition::SkyCondition;
 use super::day::SkySeries;
 use super::scan::ScanProducts;
 
@@ -60,6 +61,30 @@ pub const SERIES_COLUMNS: &[(&str, &str)] = &[
     (
         "flags",
         "text: raised quality flags, ;-separated (clouds_near_sun, poor_fit, high_masked_fraction)",
+    ),
+    (
+        "clear_sky_index",
+        "ratio: measured sky radiance over the day's clear sky at this sun position, solid-angle-weighted mean over the regions (channels summed; empty: not computed, see condition_note)",
+    ),
+    (
+        "direct_clear_sky_index",
+        "ratio: measured direct normal irradiance over the day's Langley fit E₀ exp(−β m) at the scan's air mass (channels summed)",
+    ),
+    (
+        "cloud_cover",
+        "fraction 0–1: solid-angle-weighted share of sky regions (3 zenith bands to 80° × 8 azimuth sectors, the sun's 15° left out) departing from the clear sky by more than 0.2 in |ln ratio| in a channel",
+    ),
+    (
+        "clouds_near_sun_region",
+        "0 or 1: the sky image's sun neighbourhood (3°–15° from the sun) departs from the clear sky (separate from the triplet flag clouds_near_sun)",
+    ),
+    (
+        "sky_condition",
+        "text: clear, partly-cloudy, cloudy or overcast (cloud_cover below 1.5, 4.5, 7.5 oktas, else overcast)",
+    ),
+    (
+        "condition_note",
+        "text: why a condition figure is missing (empty when all are there)",
     ),
 ];
 
@@ -140,8 +165,8 @@ fn text_cell(s: &str) -> String {
     }
 }
 
-/// A scan's row, in [`SERIES_COLUMNS`]' order (expanded).
-pub(crate) fn cells(s: &ScanProducts) -> Vec<Cell> {
+/// A scan's row with its condition, in [`SERIES_COLUMNS`]' order (expanded).
+pub(crate) fn cells(s: &ScanProducts, cond: &SkyCondition) -> Vec<Cell> {
     let mut r = vec![
         Cell::Text(Some(s.occurrence.clone())),
         Cell::Time(s.time_utc),
@@ -175,6 +200,12 @@ pub(crate) fn cells(s: &ScanProducts) -> Vec<Cell> {
         r.push(Cell::Number(prms.map(|p| p[c])));
     }
     r.push(Cell::Text(Some(s.quality.names())));
+    r.push(Cell::Number(cond.clear_sky_index));
+    r.push(Cell::Number(cond.direct_clear_sky_index));
+    r.push(Cell::Number(cond.cloud_cover));
+    r.push(Cell::Number(cond.clouds_near_sun_region.map(f64::from)));
+    r.push(Cell::Text(cond.condition.map(|c| c.as_str().to_owned())));
+    r.push(Cell::Text(Some(cond.note.clone())));
     r
 }
 
@@ -186,8 +217,8 @@ pub fn series_csv(series: &SkySeries) -> String {
         "Campanile sky time series: one row per scan; columns, units and meaning:",
         &expand(SERIES_COLUMNS),
     );
-    for s in &series.scans {
-        let row: Vec<String> = cells(s).iter().map(Cell::csv).collect();
+    for (s, c) in series.scans.iter().zip(&series.conditions) {
+        let row: Vec<String> = cells(s, c).iter().map(Cell::csv).collect();
         let _ = writeln!(text, "{}", row.join(","));
     }
     text
@@ -245,8 +276,8 @@ mod tests {
         let header = text.lines().find(|l| !l.starts_with('#')).unwrap();
         let names: Vec<&str> = header.split(',').collect();
         assert_eq!(names.len(), series_width());
-        // 5 + 3 + 3 + 10 × 3 + 3 + 1 = 45 columns, each with a comment line.
-        assert_eq!(names.len(), 45);
+        // 5 + 3 + 3 + 10 × 3 + 3 + 1 + 6 = 51 columns, each with a comment line.
+        assert_eq!(names.len(), 51);
         for n in &names {
             assert!(text.contains(&format!("# {n}: ")), "{n} undocumented");
         }

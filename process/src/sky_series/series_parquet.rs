@@ -90,7 +90,12 @@ pub fn series_parquet(series: &SkySeries) -> Result<Vec<u8>, ParquetError> {
         .set_key_value_metadata(Some(metadata))
         .set_created_by(format!("campanile {}", env!("CARGO_PKG_VERSION")))
         .build();
-    let rows: Vec<Vec<Cell>> = series.scans.iter().map(cells).collect();
+    let rows: Vec<Vec<Cell>> = series
+        .scans
+        .iter()
+        .zip(&series.conditions)
+        .map(|(s, c)| cells(s, c))
+        .collect();
     let kinds = kinds();
     let mut writer = SerializedFileWriter::new(Vec::new(), Arc::new(schema(&kinds)?), Arc::new(props))?;
     let mut group = writer.next_row_group()?;
@@ -160,7 +165,7 @@ mod tests {
             .collect();
         let expected: Vec<String> = expand(SERIES_COLUMNS).into_iter().map(|(n, _)| n).collect();
         assert_eq!(names, expected);
-        assert_eq!(names.len(), 45);
+        assert_eq!(names.len(), 51);
         let kv = meta.key_value_metadata().unwrap();
         let get = |k: &str| kv.iter().find(|e| e.key == k).and_then(|e| e.value.clone());
         assert_eq!(get("campanile.format").as_deref(), Some(PARQUET_FORMAT));

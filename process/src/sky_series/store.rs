@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 use super::SkySeriesError;
 use super::day::SkySeries;
 use super::keogram::{keogram_png, keogram_residual_png};
-use super::plots::{irradiance_svg, langley_svg, shape_parameters_svg, zenith_scale_svg};
+use super::plots::{conditions_svg, irradiance_svg, langley_svg, shape_parameters_svg, zenith_scale_svg};
 use super::scan::{ScanProducts, scan_file_stem};
 use super::series_csv::{extinction_csv, series_csv};
 use super::series_parquet::series_parquet;
@@ -151,6 +151,7 @@ pub fn write_day(out: &Path) -> Result<SkySeries, SkySeriesError> {
             ("sky-scale.svg", zenith_scale_svg(&series)),
             ("sky-shape.svg", shape_parameters_svg(&series)),
             ("irradiance.svg", irradiance_svg(&series)),
+            ("conditions.svg", conditions_svg(&series)),
         ] {
             // A plot with no finite point (no sky fitted all day) is left out.
             if let Ok(svg) = svg {

@@ -93,14 +93,7 @@ pub fn fit_extinction(measurements: &[(f64, f64)]) -> Result<Extinction, Extinct
         });
     }
     let n = pts.len() as f64;
-    let (mx, my) = (
-        pts.iter().map(|p| p.0).sum::<f64>() / n,
-        pts.iter().map(|p| p.1).sum::<f64>() / n,
-    );
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    let slope = sxy / sxx;
-    let intercept = my - slope * mx;
+    let (slope, intercept) = line_fit(&pts);
     let rms_log = (pts.iter().map(|p| (p.1 - intercept - slope * p.0).powi(2)).sum::<f64>() / n).sqrt();
     Ok(Extinction {
         e0: intercept.exp(),
@@ -108,6 +101,20 @@ pub fn fit_extinction(measurements: &[(f64, f64)]) -> Result<Extinction, Extinct
         rms_log,
         air_mass_span: hi - lo,
     })
+}
+
+/// The least-squares line `y = slope x + intercept` through `pts`
+/// (`(x, y)`; non-finite when the x are all equal or there are none).
+pub(crate) fn line_fit(pts: &[(f64, f64)]) -> (f64, f64) {
+    let n = pts.len() as f64;
+    let (mx, my) = (
+        pts.iter().map(|p| p.0).sum::<f64>() / n,
+        pts.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let slope = sxy / sxx;
+    (slope, my - slope * mx)
 }
 
 #[cfg(test)]

@@ -21,6 +21,7 @@ mod table;
 
 pub use disc::{SunDisc, SunDiscError, SunFrame, measure_sun};
 pub use events::{SolarDay, solar_day};
+pub(crate) use extinction::line_fit;
 pub use extinction::{Extinction, ExtinctionError, MIN_AIR_MASS_SPAN, air_mass, fit_extinction};
 pub use position::{Ephemeris, Observer, SunError, SunPosition, delta_t_estimate, sun_position};
 pub use table::{SunAnswer, SunRequest, SunTableError, sun_positions, sun_table};

@@ -6,6 +6,7 @@
 //! (CIE clear sky per channel, extinction, reddening, optional clouds).
 //! Everything the solvers should recover is exposed here as ground truth.
 
+pub mod broken_clouds;
 pub mod campanile_day;
 pub mod cube_room;
 pub mod igi_photograph;
@@ -105,6 +106,9 @@ pub struct World {
     pub atmosphere: Atmosphere,
     /// Cloud cover: fraction of sunlight blocked and the overcast zenith radiance per channel.
     pub clouds: Option<(f64, [f64; 3])>,
+    /// A drifting broken-cloud layer over the clear sky (issue 29's truth);
+    /// when set, it replaces [`World::clouds`] in rendering.
+    pub broken_clouds: Option<broken_clouds::BrokenClouds>,
     /// The station's camera, as it truly is (the simulation's `true_camera`
     /// lens where one is given).
     pub camera: campanile_config::Camera,
@@ -159,6 +163,7 @@ impl World {
             delta_t_s: s.delta_t_s,
             atmosphere: Atmosphere::clear(),
             clouds: None,
+            broken_clouds: None,
             camera: station.camera.clone(),
             mount: rig::mount(&station.head.mount),
             lamps,
@@ -217,8 +222,18 @@ impl World {
         light_levels: &[f64],
         f: impl FnOnce(&Lighting) -> R,
     ) -> Result<R, WorldError> {
-        let daylight = self.daylight(time)?;
         let bulbs = self.bulbs(light_levels);
+        if let Some(layer) = self.broken_clouds.as_ref().filter(|_| self.setting == Setting::Outdoor) {
+            let clear = Daylight::clear(self.sun(time)?.direction(), &self.atmosphere);
+            let sky = layer.sky(clear, time);
+            let lighting = Lighting {
+                sky: Some(&sky as &dyn render::Sky),
+                points: &[],
+                spheres: &bulbs,
+            };
+            return Ok(f(&lighting));
+        }
+        let daylight = self.daylight(time)?;
         let lighting = Lighting {
             sky: daylight.as_ref().map(|d| d as &dyn render::Sky),
             points: &[],
