@@ -78,16 +78,7 @@ fn check_room_except(room: &str, out: &Path, bounds: [f64; 4], except: &[(&str, 
         let bounds = own.unwrap_or(bounds);
         let mut unused = [0.0f64; 4];
         let worst = if own.is_some() { &mut unused } else { &mut worst };
-        for c in 0..3 {
-            let e = (num(&s["rho_d"][c]) / num(&t["rho_d"][c]) - 1.0).abs();
-            assert!(
-                e < bounds[0],
-                "{room} {name} ρd[{c}] {} vs {}: {e}",
-                s["rho_d"][c],
-                t["rho_d"][c]
-            );
-            worst[0] = worst[0].max(e);
-        }
+        worst[0] = worst[0].max(channel_error(room, name, s, t, "rho_d", bounds[0]));
         if num(&t["rho_s"][0]) == 0.0 {
             assert_eq!(s["model"], "diffuse", "{room} {name}: {s}");
             continue;
@@ -110,20 +101,27 @@ fn check_room_except(room: &str, out: &Path, bounds: [f64; 4], except: &[(&str, 
     worst
 }
 
+/// The relative error of a result `s`'s per-channel `key` (`rho_d`,
+/// `rho_s`) against the truth `t`, worst channel, each asserted under `bound`.
+fn channel_error(room: &str, name: &str, s: &Value, t: &Value, key: &str, bound: f64) -> f64 {
+    (0..3)
+        .map(|c| {
+            let e = (num(&s[key][c]) / num(&t[key][c]) - 1.0).abs();
+            assert!(
+                e < bound,
+                "{room} {name} {key}[{c}] {} vs {}: {e}",
+                s[key][c],
+                t[key][c]
+            );
+            e
+        })
+        .fold(0.0, f64::max)
+}
+
 /// The relative errors of a result `s`'s ρs (worst channel) and α (worst
 /// axis) against the truth `t`, each asserted under its bound.
 fn lobe_errors(room: &str, name: &str, s: &Value, t: &Value, bounds: [f64; 2]) -> [f64; 2] {
-    let mut worst = [0.0f64; 2];
-    for c in 0..3 {
-        let e = (num(&s["rho_s"][c]) / num(&t["rho_s"][c]) - 1.0).abs();
-        assert!(
-            e < bounds[0],
-            "{room} {name} ρs[{c}] {} vs {}: {e}",
-            s["rho_s"][c],
-            t["rho_s"][c]
-        );
-        worst[0] = worst[0].max(e);
-    }
+    let mut worst = [channel_error(room, name, s, t, "rho_s", bounds[0]), 0.0];
     for a in ["alpha_x", "alpha_y"] {
         let e = (num(&s[a]) / num(&t[a]) - 1.0).abs();
         assert!(e < bounds[1], "{room} {name} {a} {} vs {}: {e}", s[a], t[a]);

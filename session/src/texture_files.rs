@@ -268,6 +268,15 @@ fn file_name(p: &Path) -> String {
         .unwrap_or_default()
 }
 
+/// The atlas pages' file names (EXR, PNG preview) as a manifest lists them.
+fn page_names(exported: &Exported) -> Vec<(String, String)> {
+    exported
+        .pages
+        .iter()
+        .map(|(e, p)| (file_name(e), file_name(p)))
+        .collect()
+}
+
 /// Each patch's record: its surface, atlas rectangle (gutter included)
 /// and texel counts.
 fn patch_records(scene: &Scene, ps: &[Patch], atlas: &Atlas, per_patch: &[(usize, usize)]) -> Vec<PatchRecord> {
@@ -350,11 +359,7 @@ pub fn texture_files(request: &TextureRequest, bar: &indicatif::ProgressBar) -> 
     let manifest = TextureManifest {
         texel_m: request.texel_m,
         obj: file_name(&exported.obj),
-        pages: exported
-            .pages
-            .iter()
-            .map(|(e, p)| (file_name(e), file_name(p)))
-            .collect(),
+        pages: page_names(&exported),
         preview_scale: exported.preview_scale,
         photos: photos
             .iter()
@@ -570,11 +575,7 @@ pub fn albedo_texture_files(
         spacing_m: refl.grid.spacing_m,
         texel_m,
         obj: file_name(&exported.obj),
-        pages: exported
-            .pages
-            .iter()
-            .map(|(e, p)| (file_name(e), file_name(p)))
-            .collect(),
+        pages: page_names(&exported),
         sun_pages: sun_pages.iter().map(|p| file_name(p)).collect(),
         patches: patch_records(&scene, &ps, &atlas, &r.per_patch),
         products,
@@ -957,11 +958,7 @@ pub fn igi_albedo_texture_files(
         maps_texel_m: index.texel_m,
         texel_m,
         obj: file_name(&exported.obj),
-        pages: exported
-            .pages
-            .iter()
-            .map(|(e, p)| (file_name(e), file_name(p)))
-            .collect(),
+        pages: page_names(&exported),
         patches: patch_records(&scene, &ps, &atlas, &r.per_patch),
         maps: used
             .iter()

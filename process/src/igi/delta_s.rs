@@ -203,7 +203,6 @@ mod tests {
 
     use super::*;
     use crate::brdf::WardVariant;
-    use crate::render::shapes;
 
     /// Under a uniform field (every surface Lambertian sending B, no
     /// lamps), ΔS per unit ρs at a pixel is B times the lobe's directional
@@ -212,12 +211,7 @@ mod tests {
     /// unshared one does; a wrong weight or ray count would not.
     #[test]
     fn shared_rays_estimate_the_lobes_integral_as_unshared_rays_do() {
-        let input = IgiInput {
-            triangles: shapes::cuboid(Vector3::zeros(), Vector3::repeat(1.0), true, [0; 6], [0, 1, 2, 3, 4, 5]),
-            surfaces: (0..6).map(|i| format!("s{i}")).collect(),
-            lights: Vec::new(),
-            views: Vec::new(),
-        };
+        let input = crate::igi::input::unit_cube();
         let geometry = Geometry::new(&input.triangles, &input.surfaces, 2).unwrap();
         let side = geometry.triangles().iter().map(|t| t.normal).collect();
         let mut field = RadiosityField::new(&geometry, &input, side);

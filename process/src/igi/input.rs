@@ -244,11 +244,28 @@ impl IgiInput {
     }
 }
 
+/// The empty unit-cube room of the unit tests: six faces (`s0` … `s5`),
+/// no lights, no views.
+#[cfg(test)]
+pub(crate) fn unit_cube() -> IgiInput {
+    IgiInput {
+        triangles: crate::render::shapes::cuboid(
+            Vector3::zeros(),
+            Vector3::repeat(1.0),
+            true,
+            [0; 6],
+            [0, 1, 2, 3, 4, 5],
+        ),
+        surfaces: (0..6).map(|i| format!("s{i}")).collect(),
+        lights: Vec::new(),
+        views: Vec::new(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::igi::recover;
-    use crate::render::shapes;
 
     fn input() -> IgiInput {
         let camera = ViewCamera {
@@ -260,8 +277,6 @@ mod tests {
             height: 3,
         };
         IgiInput {
-            triangles: shapes::cuboid(Vector3::zeros(), Vector3::repeat(1.0), true, [0; 6], [0, 1, 2, 3, 4, 5]),
-            surfaces: (0..6).map(|i| format!("s{i}")).collect(),
             lights: vec![IgiLight {
                 position: Vector3::new(0.5, 0.5, 0.8),
                 radius: 0.0,
@@ -277,6 +292,7 @@ mod tests {
                 },
                 mask: None,
             }],
+            ..super::unit_cube()
         }
     }
 

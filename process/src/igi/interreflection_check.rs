@@ -32,6 +32,7 @@
 //! [`TIE_MARGIN`] the images cannot tell.
 
 use super::observation::Observation;
+use super::ward_fit::TwoTermSums;
 
 /// Observations whose estimated specular share exceeds this are left out.
 pub const MAX_SPECULAR_SHARE: f64 = 0.1;
@@ -85,16 +86,18 @@ pub(crate) fn check(surfaces: &[SurfaceSamples], assumed: bool) -> Interreflecti
         if samples.len() < 8 {
             continue;
         }
-        let (mut dd, mut di, mut ii, mut dl, mut il, mut ll) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        let mut sums = TwoTermSums::default();
         for &(d, i, l) in samples {
-            let w = 1.0 / (l * l).max(1e-300);
-            dd += w * d * d;
-            di += w * d * i;
-            ii += w * i * i;
-            dl += w * d * l;
-            il += w * i * l;
-            ll += w * l * l;
+            sums.add(1.0 / (l * l).max(1e-300), d, i, l);
         }
+        let TwoTermSums {
+            xx: dd,
+            xy: di,
+            yy: ii,
+            xl: dl,
+            yl: il,
+            ll,
+        } = sums;
         // One ρ per hypothesis: x = d, or x = d + i.
         let one = |xx: f64, xl: f64| if xx > 0.0 { ll - xl * xl / xx } else { ll };
         r_direct += one(dd, dl).max(0.0);

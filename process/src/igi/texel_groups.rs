@@ -252,15 +252,7 @@ mod tests {
 
     #[test]
     fn a_face_s_two_triangles_share_one_grid_on_the_scene_axes() {
-        use crate::render::shapes;
-
-        use super::super::input::IgiInput;
-        let input = IgiInput {
-            triangles: shapes::cuboid(Vector3::zeros(), Vector3::repeat(1.0), true, [0; 6], [0, 1, 2, 3, 4, 5]),
-            surfaces: (0..6).map(|i| format!("s{i}")).collect(),
-            lights: Vec::new(),
-            views: Vec::new(),
-        };
+        let input = crate::igi::input::unit_cube();
         let geometry = Geometry::new(&input.triangles, &input.surfaces, 2).unwrap();
         // The floor (z = 0): a point on each of its two triangles, 1 cm apart
         // across the diagonal, and one 10 cm away.

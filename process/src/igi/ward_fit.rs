@@ -132,6 +132,31 @@ pub(crate) fn diffuse_radiance(samples: &[FitSample], material: Option<&WardMate
         .collect()
 }
 
+/// The weighted sums of products of two regressors `x`, `y` and the data
+/// `l`: the normal equations of `l ≈ a x + b y` by weighted least squares
+/// (App. A's linear step), with `Σ w l²` for the residual.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct TwoTermSums {
+    pub xx: f64,
+    pub xy: f64,
+    pub yy: f64,
+    pub xl: f64,
+    pub yl: f64,
+    pub ll: f64,
+}
+
+impl TwoTermSums {
+    /// Adds the sample `(x, y, l)` with weight `w`.
+    pub(crate) fn add(&mut self, w: f64, x: f64, y: f64, l: f64) {
+        self.xx += w * x * x;
+        self.xy += w * x * y;
+        self.yy += w * y * y;
+        self.xl += w * x * l;
+        self.yl += w * y * l;
+        self.ll += w * l * l;
+    }
+}
+
 /// ρd and ρs per channel minimizing the weighted residual (eq. A.3) for a
 /// fixed lobe shape, both constrained to be ≥ 0; `lobe = None` fits ρd alone.
 /// With [`Albedo::PerGroup`] ρd is one unknown per group (see
@@ -145,16 +170,18 @@ pub(crate) fn linear_fit(samples: &[FitSample], lobe: Option<&WardLobe>, albedo:
     let mut rho_s = [0.0; 3];
     let mut error = 0.0;
     for c in 0..3 {
-        let (mut dd, mut ds, mut ss, mut dl, mut sl, mut ll) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        let mut sums = TwoTermSums::default();
         for (s, k) in samples.iter().zip(&spec) {
-            let (d, k, l, w) = (s.diffuse[c], k[c], s.radiance[c], s.weight);
-            dd += w * d * d;
-            ds += w * d * k;
-            ss += w * k * k;
-            dl += w * d * l;
-            sl += w * k * l;
-            ll += w * l * l;
+            sums.add(s.weight, s.diffuse[c], k[c], s.radiance[c]);
         }
+        let TwoTermSums {
+            xx: dd,
+            xy: ds,
+            yy: ss,
+            xl: dl,
+            yl: sl,
+            ll,
+        } = sums;
         let det = dd * ss - ds * ds;
         let (mut a, mut b) = if lobe.is_some() && det > 1e-12 * dd * ss && det > 0.0 {
             ((dl * ss - sl * ds) / det, (sl * dd - dl * ds) / det)
@@ -199,20 +226,23 @@ fn within_groups(samples: &[FitSample], spec: &[[f64; 3]], lobe: bool, groups: u
     let mut acc = vec![[0.0f64; 3]; groups];
     for c in 0..3 {
         acc.fill([0.0; 3]);
-        let (mut dd, mut ds, mut dl, mut ss, mut sl, mut ll) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        let mut sums = TwoTermSums::default();
         for (s, k) in samples.iter().zip(spec) {
             let (d, k, l, w) = (s.diffuse[c], k[c], s.radiance[c], s.weight);
             let g = &mut acc[s.group];
             g[0] += w * d * d;
             g[1] += w * d * k;
             g[2] += w * d * l;
-            dd += w * d * d;
-            ds += w * d * k;
-            dl += w * d * l;
-            ss += w * k * k;
-            sl += w * k * l;
-            ll += w * l * l;
+            sums.add(w, d, k, l);
         }
+        let TwoTermSums {
+            xx: dd,
+            xy: ds,
+            yy: ss,
+            xl: dl,
+            yl: sl,
+            ll,
+        } = sums;
         let (mut pkk, mut pkl, mut pll) = (ss, sl, ll);
         for g in &acc {
             if g[0] > 0.0 {

@@ -16,8 +16,8 @@ use crate::Result;
 use anyhow::{Context, anyhow};
 use campanile_config::scene::MaterialModel;
 use campanile_process::camera::image::RadianceImage;
-use campanile_process::outdoor::novel_view::{block_rmse, compare_view, render_view};
-use campanile_process::outdoor::rerender::{Reference, relative_rmse, target_mask};
+use campanile_process::outdoor::novel_view::{NovelView, compare_view, render_view};
+use campanile_process::outdoor::rerender::{Reference, relative_rmse};
 use campanile_process::outdoor::texture_transfer::texture_sources;
 use campanile_process::outdoor::zoom_albedo::ZoomAlbedo;
 use campanile_process::outdoor::{
@@ -390,23 +390,22 @@ fn zoom_view(
     let settings = RerenderSettings::default();
     let rendered = rerender_zoom(scene, refl, &albedo, &light, &settings);
     let (grid_only, _) = rerender(scene, refl, &photo.rig, &light, &settings);
-    let valid = photo.mask.as_deref();
-    let mask: Vec<bool> = target_mask(scene, refl, &photo.rig)
-        .into_iter()
-        .enumerate()
-        .map(|(i, t)| t && valid.is_none_or(|v| v[i]))
-        .collect();
-    let (rmse_block, blocks) = block_rmse(&rendered, &photo.image, &mask, 4).unwrap_or((f64::NAN, 0));
+    let view = NovelView {
+        grid_only,
+        rendered,
+        references: 0,
+    };
+    let c = compare_view(scene, refl, &photo.rig, &view, &photo.image, photo.mask.as_deref());
     Ok(ZoomView {
         label: g.key.clone(),
         light: light_from,
-        rmse_block,
-        blocks,
-        rmse_block_grid: block_rmse(&grid_only, &photo.image, &mask, 4).map_or(f64::NAN, |(r, _)| r),
-        rmse_pixel: relative_rmse(&rendered, &photo.image, &mask).unwrap_or(f64::NAN),
-        rmse_pixel_grid: relative_rmse(&grid_only, &photo.image, &mask).unwrap_or(f64::NAN),
+        rmse_block: c.rmse_block,
+        blocks: c.blocks,
+        rmse_block_grid: c.rmse_block_grid,
+        rmse_pixel: c.rmse_pixel,
+        rmse_pixel_grid: relative_rmse(&view.grid_only, &photo.image, &c.mask).unwrap_or(f64::NAN),
         albedo,
-        rendered,
+        rendered: view.rendered,
     })
 }
 
