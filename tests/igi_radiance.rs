@@ -47,6 +47,16 @@ fn num(v: &Value) -> f64 {
     v.as_f64().unwrap_or(f64::NAN)
 }
 
+/// The entry of `surfaces` (a materials or truth file) named `name`.
+fn surface<'a>(file: &'a Value, room: &str, name: &str) -> &'a Value {
+    file["surfaces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["name"] == name)
+        .unwrap_or_else(|| panic!("{room}: no surface {name}"))
+}
+
 /// The issue's bounds: ρd, ρs, α (relative) and γ (degrees).
 const ISSUE_BOUNDS: [f64; 4] = [0.01, 0.02, 0.02, 0.5];
 
@@ -68,12 +78,7 @@ fn check_room_except(room: &str, out: &Path, bounds: [f64; 4], except: &[(&str, 
         if t.get("texture").is_some() {
             continue;
         }
-        let s = got["surfaces"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|s| s["name"] == name)
-            .unwrap_or_else(|| panic!("{room}: no surface {name}"));
+        let s = surface(&got, room, name);
         let own = except.iter().find(|(n, _)| *n == name).map(|(_, b)| *b);
         let bounds = own.unwrap_or(bounds);
         let mut unused = [0.0f64; 4];
@@ -136,19 +141,9 @@ fn lobe_errors(room: &str, name: &str, s: &Value, t: &Value, bounds: [f64; 2]) -
 fn check_textured_lobe(room: &str, out: &Path, name: &str, bounds: [f64; 2]) -> [f64; 2] {
     let got = json(&out.join("materials.json"));
     let truth = json(&fixture(room).join("truth.json"));
-    let t = truth["surfaces"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|t| t["name"] == name)
-        .unwrap();
+    let t = surface(&truth, room, name);
     assert!(t.get("texture").is_some(), "{room} {name} is not textured in the truth");
-    let s = got["surfaces"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|s| s["name"] == name)
-        .unwrap();
+    let s = surface(&got, room, name);
     let reason = s["reason"].as_str().unwrap();
     assert!(
         reason.contains("textured, ρd fitted per texel group"),

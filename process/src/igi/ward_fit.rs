@@ -235,15 +235,7 @@ fn within_groups(samples: &[FitSample], spec: &[[f64; 3]], lobe: bool, groups: u
             g[2] += w * d * l;
             sums.add(w, d, k, l);
         }
-        let TwoTermSums {
-            xx: dd,
-            xy: ds,
-            yy: ss,
-            xl: dl,
-            yl: sl,
-            ll,
-        } = sums;
-        let (mut pkk, mut pkl, mut pll) = (ss, sl, ll);
+        let (mut pkk, mut pkl, mut pll) = (sums.yy, sums.yl, sums.ll);
         for g in &acc {
             if g[0] > 0.0 {
                 pkk -= g[1] * g[1] / g[0];
@@ -251,14 +243,18 @@ fn within_groups(samples: &[FitSample], spec: &[[f64; 3]], lobe: bool, groups: u
                 pll -= g[2] * g[2] / g[0];
             }
         }
-        let b = if lobe && pkk > 1e-12 * ss && pkk > 0.0 {
+        let b = if lobe && pkk > 1e-12 * sums.yy && pkk > 0.0 {
             (pkl / pkk).max(0.0)
         } else {
             0.0
         };
         error += (pll - 2.0 * b * pkl + b * b * pkk).max(0.0);
         rho_s[c] = b;
-        rho_d[c] = if dd > 0.0 { ((dl - b * ds) / dd).max(0.0) } else { 0.0 };
+        rho_d[c] = if sums.xx > 0.0 {
+            ((sums.xl - b * sums.xy) / sums.xx).max(0.0)
+        } else {
+            0.0
+        };
     }
     LinearFit { rho_d, rho_s, error }
 }
