@@ -7,6 +7,8 @@
 //! - [`cloud`]: the scan as data, one scanner's points in the scene frame,
 //!   with their normals, intensity and colour when the file has them, and the
 //!   scanner's rows and columns when the scan is organised (a range image).
+//! - [`segmentation`]: every point's surface group (the segmenter's answer,
+//!   or the simulator's truth).
 //!
 //! The crate is separate from `campanile-process` because nothing in the
 //! reflectance and light solvers needs it and it needs none of them: it is
@@ -17,3 +19,4 @@
 //! metres (`DESIGN.md`, "World frame").
 
 pub mod cloud;
+pub mod segmentation;
