@@ -253,6 +253,19 @@ mod tests {
     }
 
     #[test]
+    fn libe57formats_zero_point_files_are_an_empty_scan_and_a_clear_refusal() {
+        // recordCount="0", Cartesian single floats: one empty scan.
+        let scans = read(&validation_file("ZeroPoints.e57")).unwrap();
+        assert_eq!(scans.len(), 1);
+        assert!(scans[0].is_empty());
+        // recordCount="0" at fileOffset="0" (no section there): refused,
+        // naming the file.
+        let e = read(&validation_file("ZeroPointsInvalid.e57")).unwrap_err();
+        assert!(matches!(e, ReadError::Format { format: "E57", .. }), "{e}");
+        assert!(e.to_string().contains("ZeroPointsInvalid.e57"), "{e}");
+    }
+
+    #[test]
     fn a_file_that_is_not_e57_is_a_format_error() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("fake.e57");

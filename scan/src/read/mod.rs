@@ -195,15 +195,16 @@ pub(crate) fn grid_from_indices(
         .max()
         .unwrap_or(0)
         .max(min_cols);
-    // A grid far larger than its points is a corrupt index, not a scan.
-    const MAX_CELLS: usize = 1 << 31;
-    let cells = rows.checked_mul(cols).filter(|&c| c <= MAX_CELLS).ok_or_else(|| {
+    // A grid far larger than its points is a corrupt index, not a scan:
+    // at most 64 cells a point (a scan of mostly sky), plus 2²⁰.
+    let max_cells = indices.len().saturating_mul(64).saturating_add(1 << 20).min(1 << 31);
+    let cells = rows.checked_mul(cols).filter(|&c| c <= max_cells).ok_or_else(|| {
         ReadError::malformed(
             path,
             element,
             "row/column",
-            format!("a {rows}×{cols} grid"),
-            format!("at most {MAX_CELLS} cells"),
+            format!("a {rows}×{cols} grid for {} points", indices.len()),
+            format!("at most {max_cells} cells (64 a point, plus 2^20)"),
         )
     })?;
     let mut grid = crate::cloud::RangeGrid {
@@ -276,5 +277,24 @@ mod tests {
 
         let e = read_scan(&dir.path().join("missing.e57")).unwrap_err();
         assert!(matches!(e, ReadError::Io { .. }), "{e}");
+    }
+
+    #[test]
+    fn truncations_of_a_binary_ply_and_an_e57_are_errors() {
+        // Every 7th length of the PLY (header and payload), every 509th of
+        // the E57 (its pages), then the whole file.
+        let dir = tempfile::tempdir().unwrap();
+        let whole = dir.path().join("whole.ply");
+        crate::write::ply::write(&whole, &crate::write::test_scan()).unwrap();
+        let e57 = std::fs::read(validation_file("tiny_spherical.e57")).unwrap();
+        for (bytes, name, step) in [(std::fs::read(&whole).unwrap(), "cut.ply", 7), (e57, "cut.e57", 509)] {
+            let cut = dir.path().join(name);
+            for len in (0..bytes.len()).step_by(step) {
+                std::fs::write(&cut, &bytes[..len]).unwrap();
+                assert!(read_scan(&cut).is_err(), "{name}: {len} of {} bytes read", bytes.len());
+            }
+            std::fs::write(&cut, &bytes).unwrap();
+            assert!(read_scan(&cut).is_ok());
+        }
     }
 }

@@ -449,6 +449,29 @@ mod tests {
             matches!(&e, ReadError::Malformed { field, expected, .. } if field == "property x" && expected == "a scalar"),
             "{e}"
         );
+        // A face list whose count is declared float, before the vertices
+        // (ply-rs refuses it while skipping the faces).
+        let path = ply_file(
+            &dir,
+            "float-count.ply",
+            "ply\nformat binary_little_endian 1.0\nelement face 1\nproperty list float int vertex_indices\n\
+             element vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n\0\0\x40\x40\0\0\0\0",
+        );
+        let e = read(&path).unwrap_err();
+        assert!(matches!(e, ReadError::Format { .. }), "{e}");
+        // A grid index far beyond the points: refused, not allocated.
+        let path = ply_file(
+            &dir,
+            "huge-grid.ply",
+            &format!(
+                "{header}property float x\nproperty float y\nproperty float z\nproperty int row\nproperty int col\nend_header\n0 0 0 0 0\n1 1 1 2000000000 2000000000\n"
+            ),
+        );
+        let e = read(&path).unwrap_err();
+        assert!(
+            matches!(&e, ReadError::Malformed { field, .. } if field == "row/column"),
+            "{e}"
+        );
         // A float grid index.
         let path = ply_file(
             &dir,
