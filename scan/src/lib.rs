@@ -11,7 +11,7 @@
 //!   or the simulator's truth).
 //! - [`read`]: scans from PLY, E57 and LAS/LAZ files, and several registered
 //!   scans streamed one at a time ([`read::stream`]).
-//! - [`write`]: scans to PLY and E57 files (the simulator's, the tests').
+//! - [`write`](mod@write): scans to PLY and E57 files (the simulator's, the tests').
 //!
 //! The crate is separate from `campanile-process` because nothing in the
 //! reflectance and light solvers needs it and it needs none of them: it is
