@@ -16,12 +16,14 @@
 //! ([`crate::write::ply`]), gives the scan its [`ScannerPose`].
 
 use std::fs::File;
-use std::io::BufReader;
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use ply_rs_bw::parser::{Parser, Reader};
-use ply_rs_bw::ply::{ElementDef, Header, Property, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType};
+use ply_rs_bw::ply::{
+    ElementDef, Encoding, Header, Property, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType,
+};
 
 use super::{ReadError, checked, grid_from_indices, stem};
 use crate::cloud::{Scan, ScannerPose};
@@ -32,6 +34,9 @@ pub(crate) const POSE_COMMENT: &str = "campanile scanner_pose";
 /// The comment that carries an organised scan's grid size (rows, columns)
 /// in our PLY files, so that empty last rows and columns survive.
 pub(crate) const GRID_COMMENT: &str = "campanile grid";
+
+/// What a truncated file's error says it found.
+const END: &str = "the end of the file";
 
 /// Names a PLY file may give the intensity, compared case-insensitively.
 const INTENSITY_NAMES: [&str; 4] = ["intensity", "scalar_intensity", "reflectance", "scalar_reflectance"];
@@ -308,32 +313,61 @@ pub fn read(path: &Path) -> Result<Scan, ReadError> {
     let pose = pose_from_comments(path, &header)?;
     // Elements come in header order: get past any before `vertex`.
     let skip_parser = Parser::<Skipped>::new();
-    let mut vertices = Vec::new();
     for (name, def) in &header.elements {
         if name == "vertex" {
-            vertices = vertex_parser
-                .read_payload_for_element(&mut reader, def, &header)
-                .map_err(|e| format_error(&e))?;
             break;
         }
         skip_parser
             .read_payload_for_element(&mut reader, def, &header)
             .map_err(|e| format_error(&e))?;
     }
-    let mut scan = Scan::from_positions(stem(path), vertices.iter().map(|v| Vector3::from(v.position)).collect());
-    scan.pose = pose;
-    if declared.normals {
-        scan.normals = Some(vertices.iter().map(|v| Vector3::from(v.normal)).collect());
-    }
-    if declared.intensity {
-        scan.intensity = Some(vertices.iter().map(|v| v.intensity).collect());
-    }
-    if declared.colour {
-        scan.colour = Some(vertices.iter().map(|v| v.colour).collect());
-    }
-    if declared.grid {
-        let mut indices = Vec::with_capacity(vertices.len());
-        for (i, v) in vertices.iter().enumerate() {
+    // The vertices one at a time, straight into the scan's columns (no
+    // intermediate vector of vertices: a 10⁷-point file needs only its scan).
+    let count = vertex_def.count;
+    let capacity = count.min(1 << 24);
+    let mut positions = Vec::with_capacity(capacity);
+    let mut normals = Vec::with_capacity(if declared.normals { capacity } else { 0 });
+    let mut intensity = Vec::with_capacity(if declared.intensity { capacity } else { 0 });
+    let mut colour = Vec::with_capacity(if declared.colour { capacity } else { 0 });
+    let mut indices = Vec::with_capacity(if declared.grid { capacity } else { 0 });
+    let mut line = String::new();
+    for i in 0..count {
+        let bad = |found: String| {
+            ReadError::malformed(
+                path,
+                "element vertex",
+                format!("entry {i} of {count}"),
+                found,
+                "each of the header's properties",
+            )
+        };
+        let inner = reader.get_mut();
+        let v = match header.encoding {
+            Encoding::Ascii => {
+                line.clear();
+                if inner.read_line(&mut line).map_err(|e| ReadError::io(path, &e))? == 0 {
+                    return Err(bad(END.into()));
+                }
+                vertex_parser.read_ascii_element(&line, vertex_def)
+            }
+            Encoding::BinaryLittleEndian => vertex_parser.read_little_endian_element(inner, vertex_def),
+            Encoding::BinaryBigEndian => vertex_parser.read_big_endian_element(inner, vertex_def),
+        }
+        .map_err(|e| match e.kind() {
+            std::io::ErrorKind::UnexpectedEof => bad(END.into()),
+            _ => bad(e.to_string()),
+        })?;
+        positions.push(Vector3::from(v.position));
+        if declared.normals {
+            normals.push(Vector3::from(v.normal));
+        }
+        if declared.intensity {
+            intensity.push(v.intensity);
+        }
+        if declared.colour {
+            colour.push(v.colour);
+        }
+        if declared.grid {
             let (Ok(r), Ok(c)) = (u32::try_from(v.row), u32::try_from(v.col)) else {
                 return Err(ReadError::malformed(
                     path,
@@ -345,6 +379,13 @@ pub fn read(path: &Path) -> Result<Scan, ReadError> {
             };
             indices.push((r, c));
         }
+    }
+    let mut scan = Scan::from_positions(stem(path), positions);
+    scan.pose = pose;
+    scan.normals = declared.normals.then_some(normals);
+    scan.intensity = declared.intensity.then_some(intensity);
+    scan.colour = declared.colour.then_some(colour);
+    if declared.grid {
         let (rows, cols) = grid_size_from_comments(&header);
         scan.grid = Some(grid_from_indices(path, "element vertex", &indices, rows, cols)?);
     }
@@ -530,7 +571,10 @@ mod tests {
             &format!("{header}property float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 nan 1\n"),
         );
         let e = read(&path).unwrap_err();
-        assert!(matches!(e, ReadError::Format { .. }), "{e}");
+        assert!(
+            matches!(&e, ReadError::Malformed { field, .. } if field == "entry 1 of 2"),
+            "{e}"
+        );
         let path = dir.path().join("nan-binary.ply");
         let mut bytes =
             b"ply\nformat binary_big_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
@@ -557,7 +601,10 @@ mod tests {
             &format!("{header}property float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n"),
         );
         let e = read(&path).unwrap_err();
-        assert!(matches!(e, ReadError::Format { .. }), "{e}");
+        assert!(
+            matches!(&e, ReadError::Malformed { field, found, .. } if field == "entry 1 of 2" && found == END),
+            "{e}"
+        );
         // A bad pose comment.
         let path = ply_file(
             &dir,
