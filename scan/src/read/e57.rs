@@ -15,7 +15,8 @@
 //!   `colorLimits`. A point whose intensity or colour is flagged invalid
 //!   gets 0.
 //! - The grid comes from `rowIndex`/`columnIndex`: rows and columns from
-//!   `indexBounds`' minimum (or the smallest index present) to the largest.
+//!   `indexBounds`' minimum (or the smallest index present, negative ones
+//!   too) to the largest; the grid's row 0 is that minimum.
 //! - E57 has no standard normals; none are read.
 
 use std::path::Path;
@@ -120,7 +121,7 @@ fn read_cloud<R: std::io::Read + std::io::Seek>(
     let mut intensity = Vec::new();
     let mut colour = Vec::new();
     let mut raw_indices = Vec::new();
-    for (i, p) in points.enumerate() {
+    for p in points {
         let p = p.map_err(|e| format_error(path, &e))?;
         let CartesianCoordinate::Valid { x, y, z } = p.cartesian else {
             continue;
@@ -133,15 +134,6 @@ fn read_cloud<R: std::io::Read + std::io::Seek>(
             colour.push(p.color.map_or([0.0; 3], |c| [c.red, c.green, c.blue]));
         }
         if has_grid {
-            if p.row < 0 || p.column < 0 {
-                return Err(ReadError::malformed(
-                    path,
-                    format!("{element} point {i}"),
-                    "rowIndex/columnIndex",
-                    format!("({}, {})", p.row, p.column),
-                    "indices from 0",
-                ));
-            }
             raw_indices.push((p.row, p.column));
         }
     }
@@ -158,25 +150,24 @@ fn read_cloud<R: std::io::Read + std::io::Seek>(
         let row_min = bounds
             .and_then(|b| b.row_min)
             .unwrap_or(i64::MAX)
-            .min(raw_indices.iter().map(|&(r, _)| r).min().unwrap_or(0))
-            .max(0);
+            .min(raw_indices.iter().map(|&(r, _)| r).min().unwrap_or(0));
         let col_min = bounds
             .and_then(|b| b.column_min)
             .unwrap_or(i64::MAX)
-            .min(raw_indices.iter().map(|&(_, c)| c).min().unwrap_or(0))
-            .max(0);
-        let span = |max: Option<i64>, min: i64| max.map_or(0, |m| usize::try_from(m - min + 1).unwrap_or(0));
+            .min(raw_indices.iter().map(|&(_, c)| c).min().unwrap_or(0));
+        let offset = |v: i64, min: i64| v.checked_sub(min).and_then(|d| u32::try_from(d).ok());
+        let span = |max: Option<i64>, min: i64| max.and_then(|m| offset(m, min)).map_or(0, |d| d as usize + 1);
         let rows = span(bounds.and_then(|b| b.row_max), row_min);
         let cols = span(bounds.and_then(|b| b.column_max), col_min);
         let mut indices = Vec::with_capacity(raw_indices.len());
         for (i, &(r, c)) in raw_indices.iter().enumerate() {
-            let (Ok(r), Ok(c)) = (u32::try_from(r - row_min), u32::try_from(c - col_min)) else {
+            let (Some(r), Some(c)) = (offset(r, row_min), offset(c, col_min)) else {
                 return Err(ReadError::malformed(
                     path,
                     format!("{element} point {i}"),
                     "rowIndex/columnIndex",
-                    format!("({r}, {c})"),
-                    "indices that fit 32 bits",
+                    format!("({r}, {c}) from the smallest ({row_min}, {col_min})"),
+                    "a span that fits 32 bits",
                 ));
             };
             indices.push((r, c));
@@ -263,6 +254,59 @@ mod tests {
         let e = read(&validation_file("ZeroPointsInvalid.e57")).unwrap_err();
         assert!(matches!(e, ReadError::Format { format: "E57", .. }), "{e}");
         assert!(e.to_string().contains("ZeroPointsInvalid.e57"), "{e}");
+    }
+
+    #[test]
+    fn a_grid_with_negative_indices_starts_at_its_smallest_and_invalid_points_leave_holes() {
+        use ::e57::{E57Writer, Record, RecordDataType, RecordName, RecordValue};
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("grid.e57");
+        let mut writer = E57Writer::from_file(&path, "grid-test").unwrap();
+        let index = |name| Record {
+            name,
+            data_type: RecordDataType::Integer { min: -2, max: 1 },
+        };
+        let prototype = vec![
+            Record::CARTESIAN_X_F64,
+            Record::CARTESIAN_Y_F64,
+            Record::CARTESIAN_Z_F64,
+            Record::CARTESIAN_INVALID_STATE,
+            index(RecordName::RowIndex),
+            index(RecordName::ColumnIndex),
+        ];
+        let mut cloud = writer.add_pointcloud("grid-cloud", prototype).unwrap();
+        // A 4 × 4 grid from (−2, −2); the cell (0, 0) has no return.
+        for r in -2..2i64 {
+            for c in -2..2i64 {
+                let invalid = i64::from((r, c) == (0, 0)) * 2;
+                cloud
+                    .add_point(vec![
+                        RecordValue::Double(r as f64),
+                        RecordValue::Double(c as f64),
+                        RecordValue::Double(1.0),
+                        RecordValue::Integer(invalid),
+                        RecordValue::Integer(r),
+                        RecordValue::Integer(c),
+                    ])
+                    .unwrap();
+            }
+        }
+        cloud.finalize().unwrap();
+        writer.finalize().unwrap();
+        let scan = read(&path).unwrap().remove(0);
+        assert_eq!(scan.len(), 15);
+        let grid = scan.grid.as_ref().unwrap();
+        assert_eq!((grid.rows, grid.cols), (4, 4));
+        // File cell (−2, −2) is grid cell (0, 0); file (0, 0) is (2, 2).
+        assert_eq!(
+            scan.positions[grid.point_at(0, 0).unwrap()],
+            Vector3::new(-2.0, -2.0, 1.0)
+        );
+        assert_eq!(grid.point_at(2, 2), None);
+        assert_eq!(
+            scan.positions[grid.point_at(3, 1).unwrap()],
+            Vector3::new(1.0, -1.0, 1.0)
+        );
     }
 
     #[test]
