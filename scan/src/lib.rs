@@ -9,6 +9,9 @@
 //!   scanner's rows and columns when the scan is organised (a range image).
 //! - [`segmentation`]: every point's surface group (the segmenter's answer,
 //!   or the simulator's truth).
+//! - [`read`]: scans from PLY, E57 and LAS/LAZ files, and several registered
+//!   scans streamed one at a time ([`read::stream`]).
+//! - [`write`](mod@write): scans to PLY and E57 files (the simulator's, the tests').
 //!
 //! The crate is separate from `campanile-process` because nothing in the
 //! reflectance and light solvers needs it and it needs none of them: it is
@@ -19,4 +22,6 @@
 //! metres (`DESIGN.md`, "World frame").
 
 pub mod cloud;
+pub mod read;
 pub mod segmentation;
+pub mod write;

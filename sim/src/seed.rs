@@ -21,6 +21,9 @@ pub enum Purpose {
     LightsLink,
     /// The head's encoder noise.
     Encoder,
+    /// The simulated range scanner's noise, dropouts and mixed pixels
+    /// (one stream per scan, then per row).
+    RangeScan,
 }
 
 impl Purpose {
@@ -33,6 +36,7 @@ impl Purpose {
             Purpose::WheelLink => 5,
             Purpose::LightsLink => 6,
             Purpose::Encoder => 7,
+            Purpose::RangeScan => 8,
         }
     }
 }

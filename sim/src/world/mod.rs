@@ -10,6 +10,7 @@ pub mod broken_clouds;
 pub mod campanile_day;
 pub mod cube_room;
 pub mod igi_photograph;
+pub mod range_scanner;
 pub mod rig;
 pub mod room_igi;
 pub mod scene_file;
