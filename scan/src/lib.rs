@@ -9,6 +9,18 @@
 //!   scanner's rows and columns when the scan is organised (a range image).
 //! - [`segmentation`]: every point's surface group (the segmenter's answer,
 //!   or the simulator's truth).
+//! - [`mesh`]: a mesh per surface group (§2.4): planar polygons, scan-order
+//!   triangles, a height-field fallback; quadric-error simplification; the
+//!   Hausdorff distance to the true geometry.
+//! - [`obj_file`]: meshes as an OBJ with one group each, and back.
+//! - [`skeleton`]: the scene-file skeleton (`surfaces`, `groups`) that
+//!   `campanile igi`, `process` and `render` take.
+//! - [`segmentation_ply`]: the points coloured by group.
+//! - [`reconstruction`]: scans and segmentation to a scene directory (OBJ,
+//!   skeleton, PLY, report with a verdict): the one call behind
+//!   `campanile segment`.
+//! - [`edit`]: scene editing (§2.5.2): groups merged into objects, objects
+//!   moved, copied and deleted.
 //!
 //! The crate is separate from `campanile-process` because nothing in the
 //! reflectance and light solvers needs it and it needs none of them: it is
@@ -19,4 +31,12 @@
 //! metres (`DESIGN.md`, "World frame").
 
 pub mod cloud;
+pub mod edit;
+pub mod mesh;
+pub mod obj_file;
+pub mod reconstruction;
 pub mod segmentation;
+pub mod segmentation_ply;
+pub mod skeleton;
+#[cfg(test)]
+mod test_scenes;
