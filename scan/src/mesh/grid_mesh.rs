@@ -64,6 +64,47 @@ impl GridStep {
     }
 }
 
+/// The rows and columns (inclusive) a group's returns span in one grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GridWindow {
+    /// First and last row.
+    pub rows: (usize, usize),
+    /// First and last column.
+    pub cols: (usize, usize),
+}
+
+impl GridWindow {
+    /// The whole grid.
+    pub fn whole(grid: &RangeGrid) -> GridWindow {
+        GridWindow {
+            rows: (0, grid.rows.saturating_sub(1)),
+            cols: (0, grid.cols.saturating_sub(1)),
+        }
+    }
+
+    /// Each of `groups` groups' window in `grid` (`None` for a group with
+    /// no return there), in one pass over the grid.
+    pub fn of_groups(grid: &RangeGrid, labels: &[u32], groups: usize) -> Vec<Option<GridWindow>> {
+        let mut windows: Vec<Option<GridWindow>> = vec![None; groups];
+        for r in 0..grid.rows {
+            for c in 0..grid.cols {
+                let Some(g) = grid.point_at(r, c).and_then(|p| labels.get(p)) else {
+                    continue;
+                };
+                if let Some(w) = windows.get_mut(*g as usize) {
+                    let n = w.get_or_insert(GridWindow {
+                        rows: (r, r),
+                        cols: (c, c),
+                    });
+                    n.rows = (n.rows.0.min(r), n.rows.1.max(r));
+                    n.cols = (n.cols.0.min(c), n.cols.1.max(c));
+                }
+            }
+        }
+        windows
+    }
+}
+
 /// Horizontal and vertical neighbour pairs of returns.
 fn neighbour_pairs(grid: &RangeGrid) -> impl Iterator<Item = (usize, usize)> + '_ {
     (0..grid.rows).flat_map(move |r| {
@@ -77,11 +118,13 @@ fn neighbour_pairs(grid: &RangeGrid) -> impl Iterator<Item = (usize, usize)> + '
 }
 
 /// The mesh of `group`'s returns in `scan` (`labels[point]` is a point's
-/// group), facing `viewpoint`; empty for an unorganised scan.
+/// group) within `window`, facing `viewpoint`; empty for an unorganised
+/// scan.
 pub fn grid_mesh(
     scan: &Scan,
     labels: &[u32],
     group: u32,
+    window: &GridWindow,
     step: &GridStep,
     depth_jump_factor: f64,
     viewpoint: &Vector3<f64>,
@@ -98,8 +141,8 @@ pub fn grid_mesh(
             triangles.push(t.map(|i| i as u32));
         }
     };
-    for r in 0..grid.rows.saturating_sub(1) {
-        for c in 0..grid.cols.saturating_sub(1) {
+    for r in window.rows.0..window.rows.1.min(grid.rows.saturating_sub(1)) {
+        for c in window.cols.0..window.cols.1.min(grid.cols.saturating_sub(1)) {
             let corners = [member(r, c), member(r, c + 1), member(r + 1, c), member(r + 1, c + 1)];
             match corners {
                 [Some(a), Some(b), Some(d), Some(e)] => {
@@ -120,11 +163,7 @@ pub fn grid_mesh(
             }
         }
     }
-    let mut mesh = TriangleMesh {
-        positions: scan.positions.clone(),
-        triangles,
-    }
-    .compacted();
+    let mut mesh = TriangleMesh::gathered(&scan.positions, &triangles);
     mesh.face_towards(viewpoint);
     mesh
 }
@@ -178,7 +217,8 @@ mod tests {
             step.step
         );
         let labels = vec![0; scan.len()];
-        let mesh = grid_mesh(&scan, &labels, 0, &step, 8.0, &Vector3::zeros());
+        let whole = GridWindow::whole(scan.grid.as_ref().unwrap());
+        let mesh = grid_mesh(&scan, &labels, 0, &whole, &step, 8.0, &Vector3::zeros());
         // 20 × 20 quads, less one triangle at the missing corner.
         assert_eq!(mesh.triangles.len(), 799);
         assert!((0..mesh.triangles.len()).all(|t| mesh.area_normal(t).x < 0.0));
@@ -186,7 +226,7 @@ mod tests {
         // The board in front, labelled with the wall (a segmentation that
         // missed it): no triangle joins board and wall across the 2 m jump.
         let scan = wall_and_board(|r, c| (-3..=3).contains(&r) && (-3..=3).contains(&c));
-        let mesh = grid_mesh(&scan, &labels, 0, &step, 8.0, &Vector3::zeros());
+        let mesh = grid_mesh(&scan, &labels, 0, &whole, &step, 8.0, &Vector3::zeros());
         for t in 0..mesh.triangles.len() {
             let xs = mesh.corners(t).map(|p| p.x);
             assert!(xs.iter().all(|&x| (x - 1.0).abs() < 1e-9) || xs.iter().all(|&x| (x - 3.0).abs() < 1e-9));
@@ -200,7 +240,16 @@ mod tests {
         let labels: Vec<u32> = (0..scan.len())
             .map(|i| u32::from((scan.positions[i].x - 1.0).abs() < 1e-9))
             .collect();
-        let wall = grid_mesh(&scan, &labels, 0, &step, 8.0, &Vector3::zeros());
+        let windows = GridWindow::of_groups(scan.grid.as_ref().unwrap(), &labels, 2);
+        // The board's returns: rows and columns −3..=3 of −10..=10.
+        let board = GridWindow {
+            rows: (7, 13),
+            cols: (7, 13),
+        };
+        assert_eq!(windows, vec![Some(whole), Some(board)]);
+        let wall = grid_mesh(&scan, &labels, 0, &whole, &step, 8.0, &Vector3::zeros());
+        let board_mesh = grid_mesh(&scan, &labels, 1, &board, &step, 8.0, &Vector3::zeros());
+        assert_eq!(board_mesh.triangles.len(), 72);
         assert_eq!(wall.triangles.len(), 2 * (400 - 64) - 1 + 4);
     }
 }

@@ -44,7 +44,7 @@ use crate::segmentation::{Segmentation, UNASSIGNED};
 pub use hausdorff::{Hausdorff, OneSided, Reference, hausdorff, one_sided};
 pub use triangle_mesh::TriangleMesh;
 
-use grid_mesh::{GridStep, grid_mesh};
+use grid_mesh::{GridStep, GridWindow, grid_mesh};
 use height_field::height_field;
 use planar_polygon::planar_polygon;
 use plane_fit::PlaneFit;
@@ -257,43 +257,98 @@ fn check_labels(scans: &[Scan], segmentation: &Segmentation) -> Result<(), MeshE
     Ok(())
 }
 
+/// Where each group's points are: per scan, per group, the point indices
+/// and (organised scans) the grid window, found in one pass per scan.
+struct Membership {
+    /// `points[scan][group]`: the group's point indices in that scan.
+    points: Vec<Vec<Vec<u32>>>,
+    /// `windows[scan][group]`: the group's grid window in that scan.
+    windows: Vec<Vec<Option<GridWindow>>>,
+}
+
+impl Membership {
+    fn of(scans: &[Scan], segmentation: &Segmentation) -> Membership {
+        let groups = segmentation.groups();
+        let mut points = Vec::with_capacity(scans.len());
+        let mut windows = Vec::with_capacity(scans.len());
+        for (scan, labels) in scans.iter().zip(&segmentation.labels) {
+            let mut members = vec![Vec::new(); groups];
+            for (i, &l) in labels.iter().enumerate() {
+                if let Some(m) = members.get_mut(l as usize) {
+                    m.push(i as u32);
+                }
+            }
+            points.push(members);
+            windows.push(match &scan.grid {
+                Some(grid) => GridWindow::of_groups(grid, labels, groups),
+                None => vec![None; groups],
+            });
+        }
+        Membership { points, windows }
+    }
+}
+
 /// Meshes every group of `segmentation` over `scans` (each group's points
-/// from every scan), in group order.
+/// from every scan), in group order; groups in parallel.
 pub fn mesh_groups(
     scans: &[Scan],
     segmentation: &Segmentation,
     options: &MeshOptions,
 ) -> Result<Vec<GroupMesh>, MeshError> {
+    use rayon::prelude::*;
     options.check()?;
     check_labels(scans, segmentation)?;
     let all_points = scans.iter().map(Scan::len).sum::<usize>().max(1);
     let cloud_centre = scans.iter().flat_map(|s| &s.positions).sum::<Vector3<f64>>() / all_points as f64;
-    let viewpoint = |scan: &Scan| scan.pose.map_or(cloud_centre, |p| p.origin);
+    let views: Vec<Vector3<f64>> = scans
+        .iter()
+        .map(|s| s.pose.map_or(cloud_centre, |p| p.origin))
+        .collect();
     let steps: Vec<Option<GridStep>> = scans.iter().map(GridStep::of).collect();
-    let mut meshes = Vec::with_capacity(segmentation.groups());
-    for (g, name) in segmentation.names.iter().enumerate() {
-        let group = g as u32;
+    let membership = Membership::of(scans, segmentation);
+    let context = Context {
+        scans,
+        segmentation,
+        options,
+        views: &views,
+        steps: &steps,
+        membership: &membership,
+    };
+    Ok((0..segmentation.groups())
+        .into_par_iter()
+        .map(|g| context.mesh_group(g as u32))
+        .collect())
+}
+
+/// What every group's meshing shares.
+struct Context<'a> {
+    scans: &'a [Scan],
+    segmentation: &'a Segmentation,
+    options: &'a MeshOptions,
+    /// Each scan's viewpoint: its scanner, or the cloud's centre.
+    views: &'a [Vector3<f64>],
+    steps: &'a [Option<GridStep>],
+    membership: &'a Membership,
+}
+
+impl Context<'_> {
+    fn mesh_group(&self, group: u32) -> GroupMesh {
+        let g = group as usize;
+        let options = self.options;
         let mut points = Vec::new();
         let mut view_sum = Vector3::zeros();
         let mut all_organised = true;
-        for (scan, labels) in scans.iter().zip(&segmentation.labels) {
-            let before = points.len();
-            points.extend(
-                labels
-                    .iter()
-                    .zip(&scan.positions)
-                    .filter(|(l, _)| **l == group)
-                    .map(|(_, p)| *p),
-            );
-            let n = points.len() - before;
-            if n > 0 {
-                view_sum += viewpoint(scan) * n as f64;
+        for (s, scan) in self.scans.iter().enumerate() {
+            let members = &self.membership.points[s][g];
+            points.extend(members.iter().map(|&i| scan.positions[i as usize]));
+            if !members.is_empty() {
+                view_sum += self.views[s] * members.len() as f64;
                 all_organised &= scan.grid.is_some();
             }
         }
         let mut out = GroupMesh {
             group,
-            name: name.clone(),
+            name: self.segmentation.names[g].clone(),
             points: points.len(),
             method: MeshMethod::TooFewPoints,
             plane_rms_m: None,
@@ -305,56 +360,57 @@ pub fn mesh_groups(
         let plane = (points.len() >= options.min_points.max(3))
             .then(|| PlaneFit::of(&points))
             .flatten();
-        if let Some(plane) = plane {
-            let plane = plane.facing(&(view_sum / points.len() as f64));
-            out.plane_rms_m = Some(plane.rms_m);
-            let curved = if plane.rms_m <= options.planar_rms_m {
-                out.method = MeshMethod::PlanarPolygon;
-                out.mesh = planar_polygon(
-                    &points,
-                    &plane,
-                    options.outline_alpha_factor,
-                    options.outline_tolerance_m,
-                )
-                .0;
-                None
-            } else if all_organised {
-                out.method = MeshMethod::ScanGrid;
-                let mut mesh = TriangleMesh::default();
-                for ((scan, labels), step) in scans.iter().zip(&segmentation.labels).zip(&steps) {
-                    if let Some(step) = step {
-                        mesh.append(&grid_mesh(
-                            scan,
-                            labels,
-                            group,
-                            step,
-                            options.depth_jump_factor,
-                            &viewpoint(scan),
-                        ));
-                    }
-                }
-                Some(mesh)
-            } else {
-                out.method = MeshMethod::HeightField;
-                let hf = height_field(&points, &plane, options.outline_alpha_factor);
-                out.folded = hf.folded;
-                Some(hf.mesh)
-            };
+        let Some(plane) = plane else {
+            return out;
+        };
+        let plane = plane.facing(&(view_sum / points.len() as f64));
+        out.plane_rms_m = Some(plane.rms_m);
+        let curved = if plane.rms_m <= options.planar_rms_m {
+            out.method = MeshMethod::PlanarPolygon;
+            out.mesh = planar_polygon(
+                &points,
+                &plane,
+                options.outline_alpha_factor,
+                options.outline_tolerance_m,
+            )
+            .0;
             out.triangles_before = out.mesh.triangles.len();
-            if let Some(mesh) = curved {
-                out.triangles_before = mesh.triangles.len();
-                out.mesh = if options.simplify_error_m > 0.0 {
-                    let s = simplify(&mesh, options.simplify_error_m);
-                    out.simplify_error_m = s.error_m;
-                    s.mesh
-                } else {
-                    mesh
-                };
+            return out;
+        } else if all_organised {
+            out.method = MeshMethod::ScanGrid;
+            let mut mesh = TriangleMesh::default();
+            for (s, scan) in self.scans.iter().enumerate() {
+                if let (Some(step), Some(window)) = (&self.steps[s], &self.membership.windows[s][g]) {
+                    let labels = &self.segmentation.labels[s];
+                    let view = &self.views[s];
+                    mesh.append(&grid_mesh(
+                        scan,
+                        labels,
+                        group,
+                        window,
+                        step,
+                        options.depth_jump_factor,
+                        view,
+                    ));
+                }
             }
-        }
-        meshes.push(out);
+            mesh
+        } else {
+            out.method = MeshMethod::HeightField;
+            let hf = height_field(&points, &plane, options.outline_alpha_factor);
+            out.folded = hf.folded;
+            hf.mesh
+        };
+        out.triangles_before = curved.triangles.len();
+        out.mesh = if options.simplify_error_m > 0.0 {
+            let s = simplify(&curved, options.simplify_error_m);
+            out.simplify_error_m = s.error_m;
+            s.mesh
+        } else {
+            curved
+        };
+        out
     }
-    Ok(meshes)
 }
 
 #[cfg(test)]

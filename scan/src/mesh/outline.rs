@@ -121,15 +121,26 @@ impl AlphaShape {
     }
 
     /// The shape as polygons with holes, each ring simplified by
-    /// Ramer–Douglas–Peucker within `tolerance` (rings that collapse below
-    /// three corners are dropped). Each hole goes to the smallest outline
+    /// Ramer–Douglas–Peucker within `tolerance` from its lowest-leftmost
+    /// corner (rings that collapse below three corners are dropped). Each hole goes to the smallest outline
     /// that holds its first corner.
     pub fn polygons(&self, points: &[[f64; 2]], tolerance: f64) -> Vec<Polygon<f64>> {
         use geo::Simplify;
         let mut outlines: Vec<(f64, LineString<f64>, Vec<LineString<f64>>)> = Vec::new();
         let mut holes = Vec::new();
         for ring in &self.rings {
-            let coords: Vec<[f64; 2]> = ring.iter().map(|&i| points[i as usize]).collect();
+            let mut coords: Vec<[f64; 2]> = ring.iter().map(|&i| points[i as usize]).collect();
+            // Start at the lowest-leftmost corner, a vertex of the ring's
+            // convex hull: Ramer–Douglas–Peucker keeps its first point, so a
+            // start mid-side would stay as a needless corner.
+            let first = (0..coords.len())
+                .min_by(|&a, &b| {
+                    coords[a][0]
+                        .total_cmp(&coords[b][0])
+                        .then(coords[a][1].total_cmp(&coords[b][1]))
+                })
+                .unwrap_or(0);
+            coords.rotate_left(first);
             let area2 = ring_area2(&coords);
             let mut line: LineString<f64> = coords.iter().map(|p| (p[0], p[1])).collect();
             line.close();

@@ -49,23 +49,30 @@ impl TriangleMesh {
     /// The mesh without the vertices no triangle uses (indices renumbered
     /// in their first-use order).
     pub fn compacted(&self) -> TriangleMesh {
-        let mut new_index = vec![u32::MAX; self.positions.len()];
-        let mut positions = Vec::new();
-        let triangles = self
-            .triangles
+        TriangleMesh::gathered(&self.positions, &self.triangles)
+    }
+
+    /// The mesh of `triangles` that index `positions`, holding only the
+    /// positions they use (renumbered in first-use order; the cost is the
+    /// triangles', not the positions').
+    pub fn gathered(positions: &[Vector3<f64>], triangles: &[[u32; 3]]) -> TriangleMesh {
+        let mut new_index = std::collections::HashMap::new();
+        let mut used = Vec::new();
+        let triangles = triangles
             .iter()
             .map(|t| {
                 t.map(|i| {
-                    let slot = &mut new_index[i as usize];
-                    if *slot == u32::MAX {
-                        *slot = positions.len() as u32;
-                        positions.push(self.positions[i as usize]);
-                    }
-                    *slot
+                    *new_index.entry(i).or_insert_with(|| {
+                        used.push(positions[i as usize]);
+                        used.len() as u32 - 1
+                    })
                 })
             })
             .collect();
-        TriangleMesh { positions, triangles }
+        TriangleMesh {
+            positions: used,
+            triangles,
+        }
     }
 
     /// The centre of the vertices' bounding box, if there is a vertex.
