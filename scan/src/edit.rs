@@ -422,7 +422,7 @@ mod tests {
     use super::*;
     use crate::mesh::MeshOptions;
     use crate::reconstruction::reconstruct;
-    use crate::test_scenes::{cabinet, room, scan_of};
+    use crate::synthetic_scan::{cabinet, room, scan_of};
 
     /// The room with its cabinet, scanned from its centre and meshed into `dir`.
     fn scanned_room(dir: &Path) -> PathBuf {

@@ -19,6 +19,9 @@
 //! - [`reconstruction`]: scans and segmentation to a scene directory (OBJ,
 //!   skeleton, PLY, report with a verdict): the one call behind
 //!   `campanile segment`.
+//! - [`synthetic_scan`]: an ideal organised scanner over axis-aligned
+//!   rectangles (a box room, a cabinet), with the true segmentation and
+//!   geometry, for tests and benchmarks.
 //! - [`edit`]: scene editing (§2.5.2): groups merged into objects, objects
 //!   moved, copied and deleted.
 //!
@@ -38,5 +41,4 @@ pub mod reconstruction;
 pub mod segmentation;
 pub mod segmentation_ply;
 pub mod skeleton;
-#[cfg(test)]
-mod test_scenes;
+pub mod synthetic_scan;

@@ -310,7 +310,7 @@ pub fn reconstruct(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_scenes::{cabinet, room, scan_of, truth};
+    use crate::synthetic_scan::{cabinet, room, scan_of, truth};
     use nalgebra::Vector3;
 
     #[test]

@@ -416,7 +416,7 @@ impl Context<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_scenes::{Rect, scan_of};
+    use crate::synthetic_scan::{Rect, scan_of};
 
     /// A 6 × 4 m wall at x = 3, scanned from the origin over ±30° in
     /// elevation every 0.5° (the scan's azimuths that miss it give no

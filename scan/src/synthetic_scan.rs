@@ -1,6 +1,8 @@
-//! Scenes built for tests: axis-aligned rectangles (a box room, a cabinet
-//! in it) scanned from a point by an organised scanner, with uniform range
-//! noise and every return labelled with the rectangle it hit.
+//! Scenes built for tests and benchmarks: axis-aligned rectangles (a box
+//! room, a cabinet in it) scanned from a point by an ideal organised
+//! scanner, with uniform range noise and every return labelled with the
+//! rectangle it hit. No mixed pixels, dropouts or intensity: the simulated
+//! range scanner (`campanile-sim`) is the realistic one.
 
 use nalgebra::{Rotation3, Vector3};
 
@@ -13,10 +15,15 @@ use crate::segmentation::Segmentation;
 /// (in x, y, z order) span `lo..hi`.
 #[derive(Debug, Clone)]
 pub struct Rect {
+    /// The surface's name (the segmentation's and the truth's).
     pub name: String,
+    /// The axis the rectangle is normal to: 0 x, 1 y, 2 z.
     pub axis: usize,
+    /// Its coordinate along that axis, metres.
     pub at: f64,
+    /// The low corner along the other two axes (in x, y, z order).
     pub lo: [f64; 2],
+    /// The high corner.
     pub hi: [f64; 2],
 }
 
