@@ -255,14 +255,25 @@ impl<'a> Nearest<'a> {
             };
             for x in range(0) {
                 for y in range(1) {
-                    for z in range(2) {
-                        let ring = x.abs_diff(c[0]).max(y.abs_diff(c[1])).max(z.abs_diff(c[2]));
-                        if ring != shell {
-                            continue;
-                        }
+                    // Inside the shell's x-y square only its two z faces
+                    // belong to it: O(shell²) cells a shell, not O(shell³).
+                    let side = x.abs_diff(c[0]).max(y.abs_diff(c[1])) == shell;
+                    let zs = range(2);
+                    let (z0, z1) = (*zs.start(), *zs.end());
+                    let faces = [c[2].checked_sub(shell), Some(c[2] + shell)];
+                    let mut visit = |z: usize| {
                         for &i in &self.cells[(x * self.dims[1] + y) * self.dims[2] + z] {
                             best = best.min(self.item_distance(i, p));
                         }
+                    };
+                    if side {
+                        (z0..=z1).for_each(&mut visit);
+                    } else {
+                        faces
+                            .into_iter()
+                            .flatten()
+                            .filter(|z| (z0..=z1).contains(z))
+                            .for_each(visit);
                     }
                 }
             }
@@ -309,6 +320,24 @@ mod tests {
         // The square's corners (1, 0), (1, 1), (0, 1) are farthest from both points.
         let far = (0.5f64 * 0.5 + 0.5 * 0.5 + 0.2 * 0.2).sqrt();
         assert!((h.mesh_to_reference_m - far).abs() < 1e-12, "{h:?}");
+    }
+
+    #[test]
+    fn the_grid_search_finds_the_nearest_of_many_points_as_brute_force_does() {
+        // 2000 points spread through a box, queried from inside and outside it.
+        let points: Vec<Vector3<f64>> = (0..2000u32)
+            .map(|i| {
+                let f = |k: u32| f64::from((i * k + 17) % 1000) / 1000.0;
+                Vector3::new(f(389), 0.3 * f(631), 2.0 * f(757))
+            })
+            .collect();
+        let index = Nearest::points(&points).unwrap();
+        for q in 0..200u32 {
+            let f = |k: u32| f64::from((q * k + 3) % 97) / 97.0;
+            let p = Vector3::new(3.0 * f(13) - 1.0, 2.0 * f(29) - 0.8, 4.0 * f(41) - 1.0);
+            let brute = points.iter().map(|x| (x - p).norm()).fold(f64::INFINITY, f64::min);
+            assert_eq!(index.distance(&p), brute, "query {q} at {p:?}");
+        }
     }
 
     #[test]
