@@ -130,12 +130,18 @@ pub enum EditError {
         /// The value.
         value: f64,
     },
-    /// The scene's OBJ.
-    #[error(transparent)]
-    Obj(#[from] ObjError),
-    /// The scene's skeleton.
-    #[error(transparent)]
-    Skeleton(#[from] SkeletonError),
+    /// The scene's OBJ could not be read.
+    #[error("reading the scene: {0}")]
+    SceneObj(ObjError),
+    /// The scene file could not be read.
+    #[error("reading the scene: {0}")]
+    SceneFile(SkeletonError),
+    /// The edited OBJ could not be written.
+    #[error("writing the edited scene: {0}")]
+    Obj(ObjError),
+    /// The edited scene file could not be written.
+    #[error("writing the edited scene: {0}")]
+    Skeleton(SkeletonError),
     /// The output directory.
     #[error("{}: {source}", path.display())]
     Io {
@@ -144,6 +150,22 @@ pub enum EditError {
         /// What went wrong.
         source: std::io::Error,
     },
+}
+
+impl EditError {
+    /// Whether the edit file or the scene is at fault (exit 2), rather than
+    /// writing the result (exit 1).
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            EditError::Io { .. } | EditError::Obj(_) | EditError::Skeleton(_) => false,
+            EditError::Parse { .. }
+            | EditError::Unknown { .. }
+            | EditError::Taken { .. }
+            | EditError::NotFinite { .. }
+            | EditError::SceneObj(_)
+            | EditError::SceneFile(_) => true,
+        }
+    }
 }
 
 /// An object of a scene being edited.
@@ -178,9 +200,9 @@ impl EditableScene {
     /// Reads the scene file at `path` (a skeleton or a full scene file) and
     /// its OBJ; OBJ groups no surface lists become objects of their own.
     pub fn read(path: &Path) -> Result<EditableScene, EditError> {
-        let skeleton = SceneSkeleton::read(path)?;
+        let skeleton = SceneSkeleton::read(path).map_err(EditError::SceneFile)?;
         let obj = path.parent().unwrap_or(Path::new(".")).join(&skeleton.geometry);
-        let meshes = read_obj(&obj)?;
+        let meshes = read_obj(&obj).map_err(EditError::SceneObj)?;
         let mut objects: Vec<SceneObject> = skeleton
             .surfaces
             .iter()
@@ -215,7 +237,7 @@ impl EditableScene {
             path: dir.to_path_buf(),
             source,
         })?;
-        write_obj(&dir.join("scene.obj"), &self.meshes, "campanile-scan: an edited scene")?;
+        write_obj(&dir.join("scene.obj"), &self.meshes, "campanile-scan: an edited scene").map_err(EditError::Obj)?;
         let used: Vec<&String> = self.objects.iter().map(|o| &o.material).collect();
         let skeleton = SceneSkeleton {
             name: self.name.clone(),
@@ -236,7 +258,7 @@ impl EditableScene {
                 })
                 .collect(),
         };
-        Ok(skeleton.write(&dir.join("scene.ron"))?)
+        skeleton.write(&dir.join("scene.ron")).map_err(EditError::Skeleton)
     }
 
     fn object_index(&self, place: &str, name: &str) -> Result<usize, EditError> {
@@ -544,6 +566,12 @@ mod tests {
         std::fs::write(&bad, "SceneEdit(operations: [Shrink(object: \"floor\")])").unwrap();
         let e = edit_scene(&dir.path().join("scanned/scene.ron"), &bad, dir.path()).unwrap_err();
         assert!(e.to_string().contains("bad.ron: 1:"), "{e}");
+        assert!(e.is_bad_input());
+        let nothing = dir.path().join("nothing.ron");
+        std::fs::write(&nothing, "SceneEdit()").unwrap();
+        let e = edit_scene(&dir.path().join("none.ron"), &nothing, dir.path()).unwrap_err();
+        assert!(e.to_string().starts_with("reading the scene: "), "{e}");
+        assert!(e.is_bad_input(), "{e}");
     }
 
     /// Thesis Fig. 2.6: the cabinet copied across the room and moved; the

@@ -115,7 +115,10 @@ pub enum ReconstructionError {
     /// Bad options, scans or segmentation.
     #[error(transparent)]
     Mesh(#[from] MeshError),
-    /// The OBJ could not be written, or the truth read.
+    /// The truth OBJ could not be read.
+    #[error("the truth: {0}")]
+    Truth(ObjError),
+    /// The OBJ could not be written.
     #[error(transparent)]
     Obj(#[from] ObjError),
     /// The skeleton could not be written.
@@ -132,6 +135,15 @@ pub enum ReconstructionError {
         /// What went wrong.
         message: String,
     },
+}
+
+impl ReconstructionError {
+    /// Whether the caller's input is at fault (options, scans, the
+    /// segmentation, the truth file: exit 2), rather than writing the
+    /// directory (exit 1).
+    pub fn is_bad_input(&self) -> bool {
+        matches!(self, ReconstructionError::Mesh(_) | ReconstructionError::Truth(_))
+    }
 }
 
 /// Unique, non-empty object names: the segmentation's, or the OBJ group's
@@ -159,7 +171,7 @@ pub fn reconstruct(
 ) -> Result<ReconstructionReport, ReconstructionError> {
     let meshes = mesh_groups(scans, segmentation, options)?;
     let truth = match &options.truth {
-        Some(path) => Some(read_obj(path)?),
+        Some(path) => Some(read_obj(path).map_err(ReconstructionError::Truth)?),
         None => None,
     };
     let all_truth = truth.as_ref().map(|t| {
@@ -415,5 +427,20 @@ mod tests {
         assert!(h2.mean_m * 3.0 < h1.mean_m, "{h1:?} {h2:?}");
         assert!(f2.area_m2 > f1.area_m2 + 0.2);
         assert_eq!(two.verdict, Verdict::Ok);
+    }
+
+    #[test]
+    fn a_missing_truth_is_bad_input_naming_the_file() {
+        let rects = room();
+        let (scan, seg) = scan_of(&rects, Vector3::new(2.0, 1.5, 1.25), 6.0, 84.0, 0.0);
+        let dir = tempfile::tempdir().unwrap();
+        let options = MeshOptions {
+            truth: Some(dir.path().join("truth.obj")),
+            ..MeshOptions::default()
+        };
+        let e = reconstruct(&[scan], &seg, &options, &dir.path().join("out")).unwrap_err();
+        assert!(e.is_bad_input());
+        assert!(e.to_string().starts_with("the truth: "), "{e}");
+        assert!(e.to_string().contains("truth.obj"), "{e}");
     }
 }

@@ -46,26 +46,28 @@ pub fn write_segmentation_ply(path: &Path, scans: &[Scan], segmentation: &Segmen
         source,
     };
     let points: usize = scans.iter().map(Scan::len).sum();
-    let mut bytes = format!(
+    let header = format!(
         "ply\nformat binary_little_endian 1.0\ncomment campanile segmentation: {} groups\n\
          element vertex {points}\nproperty double x\nproperty double y\nproperty double z\n\
          property uchar red\nproperty uchar green\nproperty uchar blue\nproperty int group\nend_header\n",
         segmentation.groups()
-    )
-    .into_bytes();
-    bytes.reserve(points * 31);
+    );
+    let file = std::fs::File::create(path).map_err(io)?;
+    let mut out = std::io::BufWriter::new(file);
+    out.write_all(header.as_bytes()).map_err(io)?;
+    let mut record = [0u8; 31];
     for (scan, labels) in scans.iter().zip(&segmentation.labels) {
         for (p, &label) in scan.positions.iter().zip(labels) {
-            for v in [p.x, p.y, p.z] {
-                bytes.extend_from_slice(&v.to_le_bytes());
+            for (k, v) in [p.x, p.y, p.z].into_iter().enumerate() {
+                record[8 * k..8 * k + 8].copy_from_slice(&v.to_le_bytes());
             }
-            bytes.extend_from_slice(&group_colour(label));
+            record[24..27].copy_from_slice(&group_colour(label));
             let group = if label == UNASSIGNED { -1 } else { label as i32 };
-            bytes.extend_from_slice(&group.to_le_bytes());
+            record[27..31].copy_from_slice(&group.to_le_bytes());
+            out.write_all(&record).map_err(io)?;
         }
     }
-    let mut file = std::fs::File::create(path).map_err(io)?;
-    file.write_all(&bytes).map_err(io)?;
+    let file = out.into_inner().map_err(|e| io(e.into_error()))?;
     file.sync_all().map_err(io)
 }
 
