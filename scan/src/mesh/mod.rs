@@ -22,9 +22,10 @@
 //!
 //! Normals face the scanner: the pose of each scan that saw the group, or,
 //! for scans without a pose, the centroid of all the scans' points (the
-//! inside of a room scanned from within). `campanile igi` shades either
-//! side of a triangle; the outdoor solver and the texture maps use the
-//! side the normal gives.
+//! inside of a room scanned from within). `campanile igi` and the outdoor
+//! solver find each triangle's visible side from their cameras; the
+//! texture maps group a face's triangles by their normal, so the triangles
+//! of one face must share an orientation, which facing the scanner gives.
 
 pub mod grid_mesh;
 pub mod hausdorff;
