@@ -25,7 +25,9 @@
 //!   `offset_m`, in new OBJ groups `GROUP_NAME`, sharing its material.
 //! - `Delete` removes the object and its meshes.
 //!
-//! Each merged object gets a material of its own name. Every error names
+//! A merged object keeps its members' material when they share one, and
+//! otherwise gets a new one of its own name (model `Auto`). A full scene
+//! file keeps its materials, camera poses and targets. Every error names
 //! the object or group that does not exist and lists those that do.
 
 use std::path::{Path, PathBuf};
@@ -34,7 +36,7 @@ use nalgebra::{Rotation3, Vector3};
 use serde::Deserialize;
 
 use crate::obj_file::{NamedMesh, ObjError, read_obj, write_obj};
-use crate::skeleton::{SceneSkeleton, SkeletonError, SkeletonMaterial, SkeletonSurface};
+use crate::skeleton::{SceneSkeleton, SkeletonError, SkeletonMaterial, SkeletonPose, SkeletonSurface};
 
 /// A merge: the members (OBJ groups or objects) become one object.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -188,8 +190,12 @@ pub struct EditableScene {
     pub meshes: Vec<NamedMesh>,
     /// Objects.
     pub objects: Vec<SceneObject>,
-    /// Material names.
-    pub materials: Vec<String>,
+    /// Material groups.
+    pub materials: Vec<SkeletonMaterial>,
+    /// The scene's camera poses, kept.
+    pub poses: Vec<SkeletonPose>,
+    /// The scene's targets file, as a path from where the scene was read.
+    pub targets: Option<PathBuf>,
 }
 
 fn listed<'a>(names: impl Iterator<Item = &'a str>) -> String {
@@ -201,7 +207,8 @@ impl EditableScene {
     /// its OBJ; OBJ groups no surface lists become objects of their own.
     pub fn read(path: &Path) -> Result<EditableScene, EditError> {
         let skeleton = SceneSkeleton::read(path).map_err(EditError::SceneFile)?;
-        let obj = path.parent().unwrap_or(Path::new(".")).join(&skeleton.geometry);
+        let scene_dir = path.parent().unwrap_or(Path::new("."));
+        let obj = scene_dir.join(&skeleton.geometry);
         let meshes = read_obj(&obj).map_err(EditError::SceneObj)?;
         let mut objects: Vec<SceneObject> = skeleton
             .surfaces
@@ -212,7 +219,7 @@ impl EditableScene {
                 material: s.material.clone(),
             })
             .collect();
-        let mut materials: Vec<String> = skeleton.materials.iter().map(|m| m.name.clone()).collect();
+        let mut materials = skeleton.materials.clone();
         for m in &meshes {
             if !objects.iter().any(|o| o.groups.contains(&m.group)) {
                 objects.push(SceneObject {
@@ -220,7 +227,7 @@ impl EditableScene {
                     groups: vec![m.group.clone()],
                     material: m.group.clone(),
                 });
-                materials.push(m.group.clone());
+                materials.push(SkeletonMaterial::named(&m.group));
             }
         }
         Ok(EditableScene {
@@ -228,6 +235,8 @@ impl EditableScene {
             meshes,
             objects,
             materials,
+            poses: skeleton.poses,
+            targets: skeleton.targets.map(|t| scene_dir.join(t)),
         })
     }
 
@@ -239,14 +248,23 @@ impl EditableScene {
         })?;
         write_obj(&dir.join("scene.obj"), &self.meshes, "campanile-scan: an edited scene").map_err(EditError::Obj)?;
         let used: Vec<&String> = self.objects.iter().map(|o| &o.material).collect();
+        // The targets file stays where it was: from the new directory, by
+        // its absolute path.
+        let targets = match &self.targets {
+            Some(t) => Some(std::path::absolute(t).map_err(|source| EditError::Io {
+                path: t.clone(),
+                source,
+            })?),
+            None => None,
+        };
         let skeleton = SceneSkeleton {
             name: self.name.clone(),
             geometry: PathBuf::from("scene.obj"),
             materials: self
                 .materials
                 .iter()
-                .filter(|m| used.contains(m))
-                .map(|m| SkeletonMaterial { name: m.clone() })
+                .filter(|m| used.contains(&&m.name))
+                .cloned()
                 .collect(),
             surfaces: self
                 .objects
@@ -257,6 +275,8 @@ impl EditableScene {
                     material: o.material.clone(),
                 })
                 .collect(),
+            poses: self.poses.clone(),
+            targets,
         };
         skeleton.write(&dir.join("scene.ron")).map_err(EditError::Skeleton)
     }
@@ -286,11 +306,16 @@ impl EditableScene {
     /// Merges `object`'s members into one object.
     fn merge(&mut self, place: &str, object: &Object) -> Result<(), EditError> {
         let mut groups = Vec::new();
+        let mut materials = Vec::new();
         for member in &object.members {
             if let Some(o) = self.objects.iter().find(|o| &o.name == member) {
                 groups.extend(o.groups.iter().cloned());
+                materials.push(o.material.clone());
             } else if self.meshes.iter().any(|m| &m.group == member) {
                 groups.push(member.clone());
+                if let Some(o) = self.objects.iter().find(|o| o.groups.contains(member)) {
+                    materials.push(o.material.clone());
+                }
             } else {
                 return Err(EditError::Unknown {
                     place: format!("{place} ({:?})", object.name),
@@ -312,14 +337,23 @@ impl EditableScene {
         self.check_new_name(place, &object.name)?;
         let mut seen = std::collections::HashSet::new();
         groups.retain(|g| seen.insert(g.clone()));
+        // One material among the members is kept; several give way to a
+        // new one of the object's name, to be fitted.
+        materials.dedup();
+        let material = match &materials[..] {
+            [one] => one.clone(),
+            _ => {
+                if !self.materials.iter().any(|m| m.name == object.name) {
+                    self.materials.push(SkeletonMaterial::named(&object.name));
+                }
+                object.name.clone()
+            }
+        };
         self.objects.push(SceneObject {
             name: object.name.clone(),
             groups,
-            material: object.name.clone(),
+            material,
         });
-        if !self.materials.contains(&object.name) {
-            self.materials.push(object.name.clone());
-        }
         Ok(())
     }
 
@@ -672,5 +706,47 @@ mod tests {
             assert!((got / want - 1.0).abs() < 0.03, "{surface}: {got} against {want}");
         }
         assert!(after.2 > 1.5 * before.2);
+    }
+
+    /// The repository's example room (a full scene file: material models,
+    /// camera poses) edited as in Fig. 2.6: its table copied and turned, a
+    /// sphere deleted. What it had is kept, and `campanile_config` accepts
+    /// the result.
+    #[test]
+    fn the_example_room_edited_keeps_its_poses_and_materials() {
+        let room = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/room-scene.ron");
+        let dir = tempfile::tempdir().unwrap();
+        let edit = dir.path().join("edit.ron");
+        std::fs::write(
+            &edit,
+            r#"SceneEdit(operations: [
+                Copy(object: "table", name: "table_2", offset_m: (0.0, 1.5, 0.0)),
+                Move(object: "table_2", rotate_z_deg: 90.0),
+                Delete(object: "sphere-metal"),
+            ])"#,
+        )
+        .unwrap();
+        let out = dir.path().join("edited");
+        let edited = edit_scene(&room, &edit, &out).unwrap();
+        let before = campanile_config::load_scene(&room).unwrap().value;
+        let after = campanile_config::load_scene(&out.join("scene.ron")).unwrap().value;
+        assert_eq!(after.poses, before.poses);
+        let table_2 = after.surface("table_2").unwrap();
+        assert_eq!(table_2.material, "wood");
+        assert_eq!(table_2.groups.len(), 6);
+        assert!(after.surface("sphere-metal").is_none());
+        // The metal material went with its only sphere; wood keeps its model.
+        assert!(!after.materials.iter().any(|m| m.name == "metal"));
+        let wood = after.materials.iter().find(|m| m.name == "wood").unwrap();
+        assert_eq!(wood.model, campanile_config::scene::MaterialModel::WardIsotropic);
+        assert_eq!(edited.objects.len(), before.surfaces.len());
+        // The copy's top is the table's, 1.5 m north, turned a quarter about
+        // its own centre: same area, same height.
+        let top = |s: &EditableScene, g: &str| s.meshes.iter().find(|m| m.group == g).unwrap().mesh.clone();
+        let original = EditableScene::read(&room).unwrap();
+        let (a, b) = (top(&original, "table-top"), top(&edited, "table-top_table_2"));
+        assert!((a.area() - b.area()).abs() < 1e-9);
+        let (ca, cb) = (a.bounding_box_centre().unwrap(), b.bounding_box_centre().unwrap());
+        assert!((cb - ca - Vector3::new(0.0, 1.5, 0.0)).norm() < 1e-6, "{ca:?} {cb:?}");
     }
 }

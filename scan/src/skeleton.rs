@@ -5,12 +5,35 @@
 //! fitter's `Auto` model) until the user groups materials (thesis §4.4).
 //!
 //! The structs mirror the config crate's public fields (this crate does
-//! not depend on it); a test reads the skeleton back through
+//! not depend on it), so that an edited full scene file keeps its
+//! materials' models and albedos, its camera poses and its targets; tests
+//! read skeletons and edited scenes back through
 //! `campanile_config::load_scene`.
 
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
+
+/// The reflectance model of a material group
+/// (`campanile_config::scene::MaterialModel`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum SkeletonModel {
+    /// The fitter chooses.
+    #[default]
+    Auto,
+    /// Lambertian only.
+    Diffuse,
+    /// Isotropic Ward.
+    WardIsotropic,
+    /// Anisotropic Ward.
+    WardAnisotropic,
+    /// Outdoor pseudo-BRDFs.
+    PseudoBrdf,
+}
+
+fn is_auto(m: &SkeletonModel) -> bool {
+    *m == SkeletonModel::Auto
+}
 
 /// A material group of the skeleton (`campanile_config::scene::MaterialGroup`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -18,6 +41,44 @@ use serde::{Deserialize, Serialize};
 pub struct SkeletonMaterial {
     /// Name.
     pub name: String,
+    /// Model to fit.
+    #[serde(default, skip_serializing_if = "is_auto")]
+    pub model: SkeletonModel,
+    /// A known diffuse albedo (r, g, b).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub albedo: Option<(f64, f64, f64)>,
+}
+
+impl SkeletonMaterial {
+    /// A material to be fitted (`Auto`), with no known albedo.
+    pub fn named(name: &str) -> SkeletonMaterial {
+        SkeletonMaterial {
+            name: name.to_string(),
+            model: SkeletonModel::Auto,
+            albedo: None,
+        }
+    }
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+/// A named camera pose (`campanile_config::scene::CameraPose`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename = "CameraPose")]
+pub struct SkeletonPose {
+    /// Name.
+    pub name: String,
+    /// Position, scene frame, metres.
+    pub position_m: (f64, f64, f64),
+    /// Azimuth of the optical axis, degrees from north through east.
+    pub azimuth_deg: f64,
+    /// Elevation of the optical axis, degrees.
+    pub elevation_deg: f64,
+    /// Roll about the optical axis, degrees.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub roll_deg: f64,
 }
 
 /// An object: a named surface made of OBJ groups
@@ -33,7 +94,8 @@ pub struct SkeletonSurface {
     pub material: String,
 }
 
-/// A scene file without camera poses or targets (`campanile_config::Scene`).
+/// A scene file (`campanile_config::Scene`); a meshed scan's has no poses
+/// or targets.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename = "Scene")]
 pub struct SceneSkeleton {
@@ -45,6 +107,12 @@ pub struct SceneSkeleton {
     pub materials: Vec<SkeletonMaterial>,
     /// Objects.
     pub surfaces: Vec<SkeletonSurface>,
+    /// Named camera poses.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub poses: Vec<SkeletonPose>,
+    /// The surveyed targets file, relative to the scene file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub targets: Option<PathBuf>,
 }
 
 /// Why a skeleton could not be written or read.
@@ -74,10 +142,7 @@ impl SceneSkeleton {
         SceneSkeleton {
             name: name.to_string(),
             geometry: geometry.to_path_buf(),
-            materials: objects
-                .iter()
-                .map(|(name, _)| SkeletonMaterial { name: name.clone() })
-                .collect(),
+            materials: objects.iter().map(|(name, _)| SkeletonMaterial::named(name)).collect(),
             surfaces: objects
                 .iter()
                 .map(|(name, groups)| SkeletonSurface {
@@ -86,6 +151,8 @@ impl SceneSkeleton {
                     material: name.clone(),
                 })
                 .collect(),
+            poses: Vec::new(),
+            targets: None,
         }
     }
 
@@ -102,8 +169,7 @@ impl SceneSkeleton {
         })
     }
 
-    /// Reads a skeleton, or a full scene file's `name`, `geometry`,
-    /// `materials` (their names) and `surfaces`: other fields are ignored.
+    /// Reads a skeleton or a full scene file.
     pub fn read(path: &Path) -> Result<SceneSkeleton, SkeletonError> {
         let text = std::fs::read_to_string(path).map_err(|source| SkeletonError::Io {
             path: path.to_path_buf(),
