@@ -14,9 +14,8 @@
 //!
 //! Verdicts, per group then overall (the worst): **failed** when a group
 //! with enough points gives no triangle, or its mesh strays farther than
-//! `hausdorff_failed_m` from the truth; **poor** beyond `hausdorff_poor_m`,
-//! or for a height field with more than 1 % folded triangles; **ok**
-//! otherwise. Groups under `min_points` are left out and counted, not
+//! `hausdorff_failed_m` from the truth; **poor** beyond `hausdorff_poor_m`;
+//! **ok** otherwise. Groups under `min_points` are left out and counted, not
 //! judged. With a truth OBJ, a group whose name is a true surface's is
 //! measured both ways (the symmetric Hausdorff distance, reported), any
 //! other group against the union of the true surfaces; the gate is on how
@@ -64,7 +63,8 @@ pub struct GroupReport {
     pub method: MeshMethod,
     /// The least-squares plane's RMS residual, metres.
     pub plane_rms_m: Option<f64>,
-    /// Height field only: triangles more than 80° from the plane.
+    /// Curved unorganised groups: the height field's triangles more than
+    /// 80° from the plane (over 1 %: ball pivoting instead).
     pub folded: usize,
     /// Triangles before simplification.
     pub triangles_before: usize,
@@ -95,6 +95,8 @@ pub struct ReconstructionReport {
     pub scan_grid: usize,
     /// See `planar`.
     pub height_field: usize,
+    /// Groups meshed by ball pivoting.
+    pub ball_pivoting: usize,
     /// Groups left out for having too few points.
     pub skipped: usize,
     /// Triangles before simplification, all groups.
@@ -226,16 +228,6 @@ pub fn reconstruct(
         if m.mesh.is_empty() {
             judge(Verdict::Failed, "no triangle: the points span no area".into());
         }
-        if m.method == MeshMethod::HeightField && m.folded * 100 > m.mesh.triangles.len() {
-            judge(
-                Verdict::Poor,
-                format!(
-                    "{} of {} triangles fold over the plane: not a height field, needs a surface reconstruction",
-                    m.folded,
-                    m.mesh.triangles.len()
-                ),
-            );
-        }
         if let (Some(truth), Some(all)) = (&truth, &all_truth) {
             let spacing = options.hausdorff_spacing_m;
             let distance = match truth.iter().find(|t| t.group == m.name) {
@@ -280,6 +272,7 @@ pub fn reconstruct(
         planar: count(MeshMethod::PlanarPolygon),
         scan_grid: count(MeshMethod::ScanGrid),
         height_field: count(MeshMethod::HeightField),
+        ball_pivoting: count(MeshMethod::BallPivoting),
         skipped: count(MeshMethod::TooFewPoints),
         triangles_before: groups.iter().map(|g| g.triangles_before).sum(),
         triangles_after: groups.iter().map(|g| g.triangles_after).sum(),

@@ -1,7 +1,8 @@
 //! Scenes built for tests and benchmarks: axis-aligned rectangles (a box
 //! room, a cabinet in it) scanned from a point by an ideal organised
 //! scanner, with uniform range noise and every return labelled with the
-//! rectangle it hit. No mixed pixels, dropouts or intensity: the simulated
+//! rectangle it hit; and a sphere seen from six sides as unorganised
+//! clouds. No mixed pixels, dropouts or intensity: the simulated
 //! range scanner (`campanile-sim`) is the realistic one.
 
 use nalgebra::{Rotation3, Vector3};
@@ -173,4 +174,56 @@ pub fn truth(rects: &[Rect]) -> Vec<NamedMesh> {
             mesh: r.mesh(),
         })
         .collect()
+}
+
+/// `n` points on a sphere of radius `r` about the origin (a Fibonacci
+/// lattice: near-uniform).
+pub fn fibonacci_sphere(n: usize, r: f64) -> Vec<Vector3<f64>> {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+            let s = (1.0 - z * z).sqrt();
+            let a = golden * i as f64;
+            r * Vector3::new(s * a.cos(), s * a.sin(), z)
+        })
+        .collect()
+}
+
+/// A sphere of `n` points and radius `r` about `centre` seen by six
+/// scanners 3 m from it along ±x, ±y, ±z: each point in the unorganised
+/// scan (no normals) of the scanner it faces most, all in one group
+/// "sphere".
+pub fn sphere_scans(n: usize, r: f64, centre: Vector3<f64>) -> (Vec<Scan>, Segmentation) {
+    let axes = [
+        Vector3::x(),
+        -Vector3::x(),
+        Vector3::y(),
+        -Vector3::y(),
+        Vector3::z(),
+        -Vector3::z(),
+    ];
+    let mut scans: Vec<Scan> = axes
+        .iter()
+        .enumerate()
+        .map(|(k, axis)| {
+            let mut scan = Scan::from_positions(format!("sphere scan {k}"), Vec::new());
+            scan.pose = Some(ScannerPose {
+                origin: centre + 3.0 * axis,
+                rotation: Rotation3::identity(),
+            });
+            scan
+        })
+        .collect();
+    for p in fibonacci_sphere(n, r) {
+        let k = (0..6)
+            .max_by(|&a, &b| p.dot(&axes[a]).total_cmp(&p.dot(&axes[b])))
+            .unwrap_or(0);
+        scans[k].positions.push(p + centre);
+    }
+    let segmentation = Segmentation {
+        labels: scans.iter().map(|s| vec![0; s.len()]).collect(),
+        names: vec!["sphere".into()],
+    };
+    (scans, segmentation)
 }

@@ -5,10 +5,8 @@
 //! It is right for a surface that the plane sees once, such as a curtain,
 //! a gently curved wall or a vault, and wrong for one that folds over
 //! itself (a sphere, a chair): there some triangles turn edge-on or over.
-//! Those are counted ([`HeightField::folded`]) and a group with more than
-//! 1 % of them is judged poor (it needs a true surface reconstruction,
-//! Poisson or the crust the thesis used; no maintained Rust crate fits
-//! the workspace's nalgebra yet).
+//! Those are counted ([`HeightField::folded`]); a group with more than 1 %
+//! of them is meshed by ball pivoting instead ([`super::ball_pivoting`]).
 
 use nalgebra::Vector3;
 
