@@ -10,8 +10,8 @@
 //! - [`segmentation`]: every point's surface group (the segmenter's answer,
 //!   or the simulator's truth).
 //! - [`mesh`]: a mesh per surface group (§2.4): planar polygons, scan-order
-//!   triangles, a height-field fallback; quadric-error simplification; the
-//!   Hausdorff distance to the true geometry.
+//!   triangles, height fields and ball pivoting; quadric-error
+//!   simplification; the Hausdorff distance to the true geometry.
 //! - [`obj_file`]: meshes as an OBJ with one group each, and back.
 //! - [`skeleton`]: the scene-file skeleton (`surfaces`, `groups`) that
 //!   `campanile igi`, `process` and `render` take.

@@ -171,11 +171,13 @@ pub fn reconstruct(
     options: &MeshOptions,
     out: &Path,
 ) -> Result<ReconstructionReport, ReconstructionError> {
-    let meshes = mesh_groups(scans, segmentation, options)?;
+    options.check()?;
+    // The truth is read first: a bad path is found before the meshing.
     let truth = match &options.truth {
         Some(path) => Some(read_obj(path).map_err(ReconstructionError::Truth)?),
         None => None,
     };
+    let meshes = mesh_groups(scans, segmentation, options)?;
     let all_truth = truth.as_ref().map(|t| {
         let mut all = TriangleMesh::default();
         t.iter().for_each(|m| all.append(&m.mesh));
