@@ -12,6 +12,21 @@
 //! - [`read`]: scans from PLY, E57 and LAS/LAZ files, and several registered
 //!   scans streamed one at a time ([`read::stream`]).
 //! - [`write`](mod@write): scans to PLY and E57 files (the simulator's, the tests').
+//! - [`mesh`]: a mesh per surface group (§2.4): planar polygons, scan-order
+//!   triangles, height fields and ball pivoting; quadric-error
+//!   simplification; the Hausdorff distance to the true geometry.
+//! - [`obj_file`]: meshes as an OBJ with one group each, and back.
+//! - [`skeleton`]: the scene-file skeleton (`surfaces`, `groups`) that
+//!   `campanile igi`, `process` and `render` take.
+//! - [`segmentation_ply`]: the points coloured by group.
+//! - [`reconstruction`]: scans and segmentation to a scene directory (OBJ,
+//!   skeleton, PLY, report with a verdict): the one call behind
+//!   `campanile segment`.
+//! - [`synthetic_scan`]: an ideal organised scanner over axis-aligned
+//!   rectangles (a box room, a cabinet), with the true segmentation and
+//!   geometry, for tests and benchmarks.
+//! - [`edit`]: scene editing (§2.5.2): groups merged into objects, objects
+//!   moved, copied and deleted.
 //!
 //! The crate is separate from `campanile-process` because nothing in the
 //! reflectance and light solvers needs it and it needs none of them: it is
@@ -22,6 +37,13 @@
 //! metres (`DESIGN.md`, "World frame").
 
 pub mod cloud;
+pub mod edit;
+pub mod mesh;
+pub mod obj_file;
 pub mod read;
+pub mod reconstruction;
 pub mod segmentation;
+pub mod segmentation_ply;
+pub mod skeleton;
+pub mod synthetic_scan;
 pub mod write;
