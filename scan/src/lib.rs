@@ -9,6 +9,9 @@
 //!   scanner's rows and columns when the scan is organised (a range image).
 //! - [`segmentation`]: every point's surface group (the segmenter's answer,
 //!   or the simulator's truth).
+//! - [`segment`]: normalized-cut segmentation (§2.3): normals, the cluster
+//!   graph, recursive cuts, boundary voting, fine segmentation, targets,
+//!   and metrics against the truth.
 //!
 //! The crate is separate from `campanile-process` because nothing in the
 //! reflectance and light solvers needs it and it needs none of them: it is
@@ -19,4 +22,5 @@
 //! metres (`DESIGN.md`, "World frame").
 
 pub mod cloud;
+pub mod segment;
 pub mod segmentation;
