@@ -39,6 +39,13 @@ use super::graph::{Graph, Pass};
 /// Edges lighter than this count as absent when finding components.
 const NO_EDGE: f64 = 1e-12;
 
+/// Regions from this size multiply in parallel.
+const PARALLEL_FROM: usize = 16_384;
+
+/// The eigensolver's residual tolerance (the operator's norm is at most 2):
+/// the split needs the eigenvector's order, not its last digits.
+const TOLERANCE: f64 = 1e-6;
+
 /// Regions up to this size use the dense eigensolver.
 const DENSE_UP_TO: usize = 300;
 
@@ -155,16 +162,29 @@ impl LinOp<f64> for DeflatedOperator<'_> {
     }
 
     fn apply(&self, mut out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, _par: Par, _stack: &mut MemStack) {
+        use rayon::prelude::*;
         let n = self.nrows();
         for k in 0..rhs.ncols() {
-            let ux: f64 = (0..n).map(|i| self.trivial[i] * rhs[(i, k)]).sum();
-            for i in 0..n {
-                let mut s = 0.0;
-                for e in self.offsets[i]..self.offsets[i + 1] {
-                    let j = self.targets[e] as usize;
-                    s += self.weights[e] * self.inv_sqrt_degree[j] * rhs[(j, k)];
-                }
-                out[(i, k)] = rhs[(i, k)] + self.inv_sqrt_degree[i] * s - 2.0 * self.trivial[i] * ux;
+            let x: Vec<f64> = (0..n).map(|i| rhs[(i, k)]).collect();
+            let ux: f64 = self.trivial.iter().zip(&x).map(|(u, x)| u * x).sum();
+            let row = |i: usize| {
+                let s: f64 = (self.offsets[i]..self.offsets[i + 1])
+                    .map(|e| {
+                        let j = self.targets[e] as usize;
+                        self.weights[e] * self.inv_sqrt_degree[j] * x[j]
+                    })
+                    .sum();
+                x[i] + self.inv_sqrt_degree[i] * s - 2.0 * self.trivial[i] * ux
+            };
+            // Large regions' products in parallel (they are the sequential
+            // top of the recursion).
+            let y: Vec<f64> = if n >= PARALLEL_FROM {
+                (0..n).into_par_iter().with_min_len(4096).map(row).collect()
+            } else {
+                (0..n).map(row).collect()
+            };
+            for (i, v) in y.into_iter().enumerate() {
+                out[(i, k)] = v;
             }
         }
     }
@@ -229,7 +249,7 @@ fn fiedler(region: &Region) -> Option<Vec<f64>> {
             &mut values,
             &op,
             v0.as_ref(),
-            1e-8,
+            TOLERANCE,
             Par::Seq,
             MemStack::new(&mut memory),
             params,
