@@ -603,7 +603,7 @@ mod tests {
             ..small_room()
         });
         let (_, _, m) = run(std::slice::from_ref(&scan), &truth);
-        // Measured: 98.88 % right, 9 groups, the curtain whole.
+        // Measured: 98.94 % right, boundary 0.27 cm, 8 groups, the curtain whole.
         assert!(m.right_fraction >= 0.97, "{m:?}");
         for name in ["curtain", "wall_y3", "floor"] {
             assert!(!m.merged.contains(&name.to_string()), "{name}: {m:?}");
@@ -616,9 +616,13 @@ mod tests {
         scan.grid = None;
         scan.pose = None;
         let (_, report, m) = run(std::slice::from_ref(&scan), &truth);
-        // Measured: 97.28 % right but 24 groups: without the grid, the
-        // ceiling and two walls come in pieces (boundary error 44 cm).
-        assert!(m.right_fraction >= 0.97, "{m:?}");
+        // Measured: 96.82 % right but 23 groups: without the grid, the
+        // ceiling and three walls come in pieces (boundary error 43 cm).
+        // Bound lowered from 0.97 (97.28 % measured) when edges under
+        // w = 1e-3 began to be cut at once (criterion::NO_EDGE), which took
+        // the 2 cm-noise room below from 17 groups to 7 and 0.96 M points
+        // from 52.7 to 37.2 CPU-s.
+        assert!(m.right_fraction >= 0.96, "{m:?}");
         assert_ne!(report.verdict, Verdict::Failed);
     }
 
@@ -629,8 +633,12 @@ mod tests {
             ..small_room()
         });
         let (_, _, m) = run(std::slice::from_ref(&noisy), &truth);
-        // Measured: 98.45 %, but the floor and a wall split (17 groups).
-        assert!(m.right_fraction >= 0.95, "2 cm noise: {m:?}");
+        // Measured: 98.78 % right, boundary 1.0 cm, 7 groups.
+        assert!(m.right_fraction >= 0.97, "2 cm noise: {m:?}");
+        assert!(m.boundary_mean_m.unwrap() <= 0.03, "2 cm noise: {m:?}");
+        for name in main_surfaces() {
+            assert!(!m.split.contains(&name.to_string()), "2 cm noise, {name}: {m:?}");
+        }
         let (sparse, truth) = scan_room(&RoomScan {
             cols: 80,
             rows: 32,
