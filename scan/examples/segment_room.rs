@@ -5,7 +5,8 @@
 //! cargo run --release -p campanile-scan --example segment_room -- 1200 450 0.005
 //! ```
 //! Arguments: azimuth steps, elevation steps, range noise in m; then any of
-//! `curtain`, `target`, `nofine`, `novote`.
+//! `curtain`, `target`, `nofine`, `novote`, `unorganised` (no grid, no
+//! pose), `verbose`.
 
 use std::time::Instant;
 
@@ -26,7 +27,11 @@ fn main() {
         target: flag("target"),
         ..RoomScan::default()
     };
-    let (scan, truth) = scan_room(&spec);
+    let (mut scan, truth) = scan_room(&spec);
+    if flag("unorganised") {
+        scan.grid = None;
+        scan.pose = None;
+    }
     let overrides = Overrides {
         fine: flag("nofine").then_some(false),
         boundary_voting: flag("novote").then_some(false),

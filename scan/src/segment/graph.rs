@@ -46,9 +46,11 @@ pub fn anisotropic_distance(pu: &Vector3<f64>, nu: &Vector3<f64>, pv: &Vector3<f
     one(nu).max(one(nv))
 }
 
-/// The angle between two unit normals, radians.
+/// The angle between two unit normals' lines, radians (0 to π/2): a scan
+/// without a pose can only orient its normals by propagation, which may
+/// flip a patch, so the sign is not trusted.
 pub fn normal_angle(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
-    a.dot(b).clamp(-1.0, 1.0).acos()
+    a.dot(b).abs().min(1.0).acos()
 }
 
 /// One cluster: its sums (the node's attributes are their means).
@@ -157,7 +159,7 @@ impl Clusterer {
             if d2 > r2 || best.is_some_and(|(b, _)| b <= d2) {
                 continue;
             }
-            if node.normal().dot(n) < self.cos_normal || (node.intensity() - intensity).abs() > self.intensity {
+            if node.normal().dot(n).abs() < self.cos_normal || (node.intensity() - intensity).abs() > self.intensity {
                 continue;
             }
             best = Some((d2, k));
@@ -166,7 +168,12 @@ impl Clusterer {
             Some((_, k)) => {
                 let node = &mut self.nodes[k as usize];
                 node.sum_position += p;
-                node.sum_normal += n;
+                // Normals of either sign (see `normal_angle`) add aligned.
+                if node.sum_normal.dot(n) < 0.0 {
+                    node.sum_normal -= n;
+                } else {
+                    node.sum_normal += n;
+                }
                 node.sum_intensity += intensity;
                 node.points += 1;
                 k
