@@ -690,6 +690,19 @@ mod tests {
         };
         let error = segment(std::slice::from_ref(&scan), &overrides, &|_| {}).unwrap_err();
         assert!(error.to_string().contains("anisotropy = 0.5"), "{error}");
+        // Two points fit no plane and make no group: a failed verdict that
+        // says so, not a panic.
+        let two = Scan::from_positions("two", vec![Vector3::zeros(), Vector3::x()]);
+        let (found, report) = segment(&[two], &Overrides::default(), &|_| {}).unwrap();
+        assert_eq!(
+            (found.groups(), report.unassigned, report.verdict),
+            (0, 2, Verdict::Failed)
+        );
+        assert!(
+            report.verdict_reason.contains("100.00 % of points unassigned"),
+            "{}",
+            report.verdict_reason
+        );
         let mut bad = scan.clone();
         bad.positions[3].x = f64::NAN;
         let error = segment(&[bad], &Overrides::default(), &|_| {}).unwrap_err();
