@@ -128,8 +128,10 @@ impl Parameters {
         let radius = pick(
             "cluster_radius_m",
             overrides.cluster_radius_m,
-            (4.0 * s).max(6.0 * noise),
-            format!("4 × spacing {s:.4} m (at least 6 × noise {noise:.4} m): about 50 points a cluster"),
+            (4.0 * s).max(12.0 * noise),
+            format!(
+                "4 × spacing {s:.4} m (at least 12 × noise {noise:.4} m, so that a cluster's mean normal is steady on dense, noisy scans): about 50 points a cluster"
+            ),
         );
         let nn = figures.normal_noise_deg;
         let cluster_normal = pick(
