@@ -27,6 +27,9 @@
 //!   geometry, for tests and benchmarks.
 //! - [`edit`]: scene editing (§2.5.2): groups merged into objects, objects
 //!   moved, copied and deleted.
+//! - [`segment`]: normalized-cut segmentation (§2.3): normals, the cluster
+//!   graph, recursive cuts, boundary voting, fine segmentation, targets,
+//!   and metrics against the truth.
 //!
 //! The crate is separate from `campanile-process` because nothing in the
 //! reflectance and light solvers needs it and it needs none of them: it is
@@ -42,6 +45,7 @@ pub mod mesh;
 pub mod obj_file;
 pub mod read;
 pub mod reconstruction;
+pub mod segment;
 pub mod segmentation;
 pub mod segmentation_ply;
 pub mod skeleton;
