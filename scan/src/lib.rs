@@ -18,10 +18,13 @@
 //! - [`obj_file`]: meshes as an OBJ with one group each, and back.
 //! - [`skeleton`]: the scene-file skeleton (`surfaces`, `groups`) that
 //!   `campanile igi`, `process` and `render` take.
-//! - [`segmentation_ply`]: the points coloured by group.
+//! - [`segmentation_ply`]: the points coloured by group; [`group_view`]: a
+//!   picture of them for the report page.
 //! - [`reconstruction`]: scans and segmentation to a scene directory (OBJ,
 //!   skeleton, PLY, report with a verdict): the one call behind
 //!   `campanile segment`.
+//! - [`scene_from_scans`]: the whole of `campanile segment`: read, segment,
+//!   mesh, write the scene directory and its report page.
 //! - [`synthetic_scan`]: an ideal organised scanner over axis-aligned
 //!   rectangles (a box room, a cabinet), with the true segmentation and
 //!   geometry, for tests and benchmarks.
@@ -41,10 +44,12 @@
 
 pub mod cloud;
 pub mod edit;
+pub mod group_view;
 pub mod mesh;
 pub mod obj_file;
 pub mod read;
 pub mod reconstruction;
+pub mod scene_from_scans;
 pub mod segment;
 pub mod segmentation;
 pub mod segmentation_ply;

@@ -13,7 +13,8 @@
 //! - `mesh-report.json`: this module's [`ReconstructionReport`].
 //!
 //! Verdicts, per group then overall (the worst): **failed** when a group
-//! with enough points gives no triangle, or its mesh strays farther than
+//! with enough points gives no triangle (**poor** when it holds under
+//! [`SPECK_SHARE`] of the points: a line of edge pixels), or its mesh strays farther than
 //! `hausdorff_failed_m` from the truth; **poor** beyond `hausdorff_poor_m`;
 //! **ok** otherwise. Groups under `min_points` are left out and counted, not
 //! judged. With a truth OBJ, a group whose name is a true surface's is
@@ -36,17 +37,11 @@ use crate::segmentation::Segmentation;
 use crate::segmentation_ply::{PlyError, write_segmentation_ply};
 use crate::skeleton::{SceneSkeleton, SkeletonError};
 
-/// A product's quality.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Verdict {
-    /// Within its bounds.
-    Ok,
-    /// Usable with care.
-    Poor,
-    /// Not usable.
-    Failed,
-}
+pub use crate::segment::Verdict;
+
+/// A group that gives no triangle is poor, not failed, when it holds
+/// under this share of the scans' points (a line of edge pixels).
+pub const SPECK_SHARE: f64 = 0.01;
 
 /// One group's line of the report.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -187,6 +182,7 @@ pub fn reconstruct(
         path: out.to_path_buf(),
         message: e.to_string(),
     })?;
+    let total_points = scans.iter().map(Scan::len).sum::<usize>().max(1);
     let names = object_names(&segmentation.names);
     let mut groups = Vec::with_capacity(meshes.len());
     let mut written = Vec::new();
@@ -203,7 +199,7 @@ pub fn reconstruct(
             triangles_before: m.triangles_before,
             triangles_after: m.mesh.triangles.len(),
             simplify_error_m: m.simplify_error_m,
-            area_m2: m.mesh.area(),
+            area_m2: m.mesh.area() + 0.0, // no "-0.00" for an empty mesh
             hausdorff: None,
             to_truth: None,
             verdict: Verdict::Ok,
@@ -228,7 +224,21 @@ pub fn reconstruct(
             continue;
         }
         if m.mesh.is_empty() {
-            judge(Verdict::Failed, "no triangle: the points span no area".into());
+            // A speck or a line of points (edge pixels a group of their own)
+            // loses little; a real share of the scan lost is a failure.
+            let share = m.points as f64 / total_points as f64;
+            let verdict = if share < SPECK_SHARE {
+                Verdict::Poor
+            } else {
+                Verdict::Failed
+            };
+            judge(
+                verdict,
+                format!(
+                    "no triangle: its points ({:.2} % of the scans') span no area",
+                    100.0 * share
+                ),
+            );
         }
         if let (Some(truth), Some(all)) = (&truth, &all_truth) {
             let spacing = options.hausdorff_spacing_m;

@@ -6,6 +6,7 @@ mod capture;
 mod config_check;
 mod demo;
 mod devices;
+mod edit;
 mod env;
 pub mod exit;
 mod hdr;
@@ -17,6 +18,7 @@ mod process;
 mod register;
 mod render;
 mod ron_output;
+mod segment;
 mod session;
 mod sky;
 mod station;
@@ -105,6 +107,8 @@ pub enum Command {
     Render(render::RenderArgs),
     Register(register::RegisterArgs),
     Texture(texture::TextureArgs),
+    Segment(segment::SegmentArgs),
+    Edit(edit::EditArgs),
     /// Plans: simulate one forward without devices (timeline, frames, durations, what it will not cover).
     Plan {
         #[command(subcommand)]
@@ -157,6 +161,8 @@ pub fn run() -> ExitCode {
         Command::Render(args) => report(render::run(args)),
         Command::Register(args) => finish(register::run(args)),
         Command::Texture(args) => finish(texture::run(args)),
+        Command::Segment(args) => finish(segment::run(args)),
+        Command::Edit(args) => finish(edit::run(args)),
         Command::Igi(args) => report(igi::run(args)),
         Command::Outdoor { action } => report(outdoor::run(action)),
     };

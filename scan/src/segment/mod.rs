@@ -61,8 +61,9 @@ pub struct Progress {
     pub total: usize,
 }
 
-/// A product's quality.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+/// A product's quality (the segmentation's and the meshes'), ordered from
+/// best to worst.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Verdict {
     /// Usable as it is.
