@@ -1,7 +1,7 @@
 """Open3D's plane segmentation on the simulated range scans, scored against
 their true surfaces (issue 28, "Peers").
 
-    python open3d_segment.py SCANDIR SET [--methods ransac,patches] [--threads N]
+    python open3d_segment.py SCANDIR SET [--methods ransac,patches] [--check-metrics] [--header]
 
 SCANDIR holds the scans and truth written by
 `cargo run -p campanile-sim --example range_scans -- SCANDIR --truth`
@@ -251,6 +251,35 @@ def metrics(xyz, truth, found, surfaces):
                 under_names=name(under), over_names=name(over), missed_names=name(missed))
 
 
+def check_metrics(xyz, truth, surfaces):
+    """The metrics' known answers on this cloud: the truth itself as the
+    segmentation (all right, nothing under, over or missed, every boundary
+    at 0 cm), one segment for everything (right = the largest surface's
+    share, every other counted surface under-segmented), and nothing
+    assigned (0 right, every counted surface missed). Exits 1 on a miss."""
+    sizes = np.bincount(truth[truth >= 0], minlength=len(surfaces))
+    counted = int((sizes >= MIN_SURFACE).sum())
+    cases = [
+        ("truth", truth, dict(right=1.0, under=0, over=0, missed=0), (1.0, 0.0, 0.0)),
+        ("one segment", np.zeros_like(truth), dict(right=sizes.max() / sizes.sum(), under=counted - 1, over=0,
+                                                   missed=0), None),
+        ("nothing", np.full_like(truth, UNASSIGNED), dict(right=0.0, under=0, over=0, missed=counted), None),
+    ]
+    bad = 0
+    for name, found, expected, boundary in cases:
+        m = metrics(xyz, truth, found, surfaces)
+        for key, value in expected.items():
+            if abs(m[key] - value) > 1e-12:
+                print(f"check {name}: {key} = {m[key]}, expected {value}", file=sys.stderr)
+                bad += 1
+        if boundary != m["boundary"]:
+            print(f"check {name}: boundary = {m['boundary']}, expected {boundary}", file=sys.stderr)
+            bad += 1
+    print(f"# metrics check on {len(truth)} points: {'ok' if bad == 0 else f'{bad} misses'}", file=sys.stderr)
+    if bad:
+        sys.exit(1)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                  epilog="example: python open3d_segment.py /tmp/scans room --methods ransac")
@@ -258,8 +287,12 @@ def main():
     ap.add_argument("set", choices=sorted(PARAMETERS))
     ap.add_argument("--methods", default="ransac,patches")
     ap.add_argument("--header", action="store_true", help="print the table's header first")
+    ap.add_argument("--check-metrics", action="store_true",
+                    help="check the metrics on known answers (the truth, one segment, nothing) first")
     args = ap.parse_args()
     xyz, truth, surfaces = read_set(args.scandir, args.set)
+    if args.check_metrics:
+        check_metrics(xyz, truth, surfaces)
     p = PARAMETERS[args.set]
     spacing, _ = cKDTree(xyz).query(xyz[:: max(1, len(xyz) // 20000)], k=2, workers=-1)
     p["voxel"] = float(np.percentile(spacing[:, 1], 99))

@@ -34,6 +34,6 @@ fi
 echo "# $(nproc) cores, $(awk '/MemTotal/ {printf "%.0f GB", $2 / 1048576}' /proc/meminfo); $(date -u +%Y-%m-%d)" >&2
 header=--header
 for set in ${sets//,/ }; do
-    "$venv/bin/python" "$repo/bench/segment/open3d_segment.py" "$scans" "$set" $header
+    "$venv/bin/python" "$repo/bench/segment/open3d_segment.py" "$scans" "$set" --check-metrics $header
     header=
 done
