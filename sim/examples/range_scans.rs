@@ -6,16 +6,20 @@
 //! ```text
 //! cargo run --release -p campanile-sim --example range_scans -- /tmp/scans
 //! cargo run --release -p campanile-sim --example range_scans -- /tmp/scans --format e57 --rows 360 --columns 720 --seed 7
+//! cargo run --release -p campanile-sim --example range_scans -- /tmp/scans --truth
 //! ```
 //!
 //! Arguments: the directory to write, then optionally `--format ply|e57`
 //! (PLY: one file per scan, `room-sw.ply` …; E57: `room.e57` and
 //! `building.e57`), `--rows N` and `--columns N` (default 180 × 360: 1°
-//! steps in azimuth, 0.78° in elevation from −60° to 80°) and `--seed N`.
+//! steps in azimuth, 0.78° in elevation from −60° to 80°), `--seed N`, and
+//! `--truth`: also write every point's true surface beside the scans
+//! (`room.truth.json`, `room-sw.truth` …; the format is
+//! `sim::world::range_truth`'s), which the scan files do not hold.
 //! Prints one line per scan: beams, returns, misses, grazing losses,
 //! dropouts, depth-edge beams and mixed pixels; then the verdict: `ok`
-//! when every file reads back with the points written, `failed` (exit 3)
-//! otherwise.
+//! when every file (and the truth) reads back with the points written,
+//! `failed` (exit 3) otherwise.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -23,9 +27,11 @@ use std::process::ExitCode;
 use campanile_sim::world::range_scanner::{
     ScanFileFormat, ScannerSettings, building_poses, building_scene, room_poses, room_scene, scan_scene, write_scans,
 };
+use campanile_sim::world::range_truth::{read_truth, write_truth};
 
-const USAGE: &str = "usage: range_scans DIR [--format ply|e57] [--rows N] [--columns N] [--seed N]\n\
-example: cargo run --release -p campanile-sim --example range_scans -- /tmp/scans --format e57";
+const USAGE: &str = "usage: range_scans DIR [--format ply|e57] [--rows N] [--columns N] [--seed N] [--truth]\n\
+example: cargo run --release -p campanile-sim --example range_scans -- /tmp/scans --format e57\n\
+example: cargo run --release -p campanile-sim --example range_scans -- /tmp/scans --truth   (true surfaces beside the scans)";
 
 fn main() -> ExitCode {
     match run() {
@@ -44,6 +50,7 @@ fn run() -> Result<bool, String> {
     let mut dir = None;
     let mut format = ScanFileFormat::Ply;
     let mut settings = ScannerSettings::new(180, 360);
+    let mut truth = false;
     let mut it = args.iter();
     while let Some(arg) = it.next() {
         let mut value = |name: &str| {
@@ -70,6 +77,7 @@ fn run() -> Result<bool, String> {
             "--rows" => settings.rows = number("--rows", value("--rows")?)? as usize,
             "--columns" => settings.columns = number("--columns", value("--columns")?)? as usize,
             "--seed" => settings.seed = number("--seed", value("--seed")?)?,
+            "--truth" => truth = true,
             other if dir.is_none() && !other.starts_with('-') => dir = Some(PathBuf::from(other)),
             other => return Err(usage(&format!("unexpected argument {other:?}"))),
         }
@@ -110,6 +118,18 @@ fn run() -> Result<bool, String> {
             dir.display()
         );
         ok &= read == written;
+        if truth {
+            let index = write_truth(&dir, set, &scans, format).map_err(|e| e.to_string())?;
+            let (_, back) = read_truth(&index).map_err(|e| e.to_string())?;
+            let same = back == scans.truth;
+            println!(
+                "{set}: truth of {} surfaces in {} ({})",
+                back.names.len(),
+                index.display(),
+                if same { "reads back" } else { "DIFFERS on reading back" }
+            );
+            ok &= same;
+        }
     }
     println!("verdict: {}", if ok { "ok" } else { "failed" });
     Ok(ok)

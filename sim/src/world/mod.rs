@@ -11,6 +11,7 @@ pub mod campanile_day;
 pub mod cube_room;
 pub mod igi_photograph;
 pub mod range_scanner;
+pub mod range_truth;
 pub mod rig;
 pub mod room_igi;
 pub mod scene_file;
