@@ -164,6 +164,11 @@ fn test_a_new_pan_tilt_head() {
 }
 
 #[test]
+fn from_range_scans_to_a_scene() {
+    run_chapter("range-scans.md");
+}
+
+#[test]
 fn process_a_year_of_archive_on_a_cluster() {
     run_chapter("archive-on-a-cluster.md");
 }
