@@ -92,10 +92,6 @@ impl SceneError {
     }
 }
 
-/// A stage of the run, for a progress bar: reading file `done` of
-/// `total`, or one of the segmenter's stages.
-pub type Stage = Progress;
-
 fn io(path: &Path, e: impl std::fmt::Display) -> SceneError {
     SceneError::Io {
         path: path.to_path_buf(),
@@ -103,8 +99,9 @@ fn io(path: &Path, e: impl std::fmt::Display) -> SceneError {
     }
 }
 
-/// Reads, segments and meshes `request.scans` into `request.out`.
-pub fn scene_from_scans(request: &SceneRequest, progress: &(dyn Fn(Stage) + Sync)) -> Result<SceneRun, SceneError> {
+/// Reads, segments and meshes `request.scans` into `request.out`;
+/// `progress` hears of each file read and each of the segmenter's stages.
+pub fn scene_from_scans(request: &SceneRequest, progress: &(dyn Fn(Progress) + Sync)) -> Result<SceneRun, SceneError> {
     if request.scans.is_empty() {
         return Err(SceneError::NoScans);
     }
@@ -134,7 +131,7 @@ pub fn scene_from_scans(request: &SceneRequest, progress: &(dyn Fn(Stage) + Sync
     files.extend(views.iter().cloned());
 
     let verdict = meshes.verdict.max(report.verdict);
-    let run = SceneRun {
+    let mut run = SceneRun {
         segmentation: report,
         meshes,
         verdict,
@@ -143,7 +140,6 @@ pub fn scene_from_scans(request: &SceneRequest, progress: &(dyn Fn(Stage) + Sync
     };
     let page = request.out.join("report.html");
     std::fs::write(&page, report_page(&run, &request.scans, &views)).map_err(|e| io(&page, e))?;
-    let mut run = run;
     run.files.push(page);
     Ok(run)
 }
