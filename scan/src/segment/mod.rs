@@ -153,8 +153,10 @@ fn scan_order(scan: &Scan) -> Vec<usize> {
     }
 }
 
-fn intensity_of(scan: &Scan, i: usize) -> f64 {
-    scan.intensity.as_ref().map_or(0.0, |v| f64::from(v[i]))
+/// Point `i`'s intensity as the segmentation compares it
+/// ([`normals::corrected_intensity`]), 0 without intensity.
+fn intensity_of(intensity: &Option<Vec<f32>>, i: usize) -> f64 {
+    intensity.as_ref().map_or(0.0, |v| f64::from(v[i]))
 }
 
 /// Point-weighted figures over scans.
@@ -172,6 +174,8 @@ fn combined_figures(surfaces: &[LocalSurface]) -> ScanFigures {
         noise_m: weighted(&|f| Some(f.noise_m)).unwrap_or(0.0),
         normal_noise_deg: weighted(&|f| Some(f.normal_noise_deg)).unwrap_or(0.0),
         intensity_noise: weighted(&|f| f.intensity_noise),
+        corrected_intensity_noise: weighted(&|f| f.corrected_intensity_noise),
+        incidence_slope: weighted(&|f| f.incidence_slope),
         points: total,
     }
 }
@@ -181,6 +185,7 @@ fn combined_figures(surfaces: &[LocalSurface]) -> ScanFigures {
 fn cluster(
     scans: &[Scan],
     surfaces: &[LocalSurface],
+    intensities: &[Option<Vec<f32>>],
     params: &Parameters,
     tag: &dyn Fn(usize, usize) -> u32,
 ) -> (Vec<Node>, Vec<Vec<u32>>) {
@@ -190,14 +195,14 @@ fn cluster(
         params.cluster_intensity,
     );
     let mut node_of = Vec::with_capacity(scans.len());
-    for (s, (scan, surface)) in scans.iter().zip(surfaces).enumerate() {
+    for (s, ((scan, surface), intensity)) in scans.iter().zip(surfaces).zip(intensities).enumerate() {
         let mut nodes = vec![u32::MAX; scan.len()];
         for i in scan_order(scan) {
             let t = tag(s, i);
             if t == UNASSIGNED - 1 {
                 continue;
             }
-            nodes[i] = clusterer.add(&scan.positions[i], &surface.normals[i], intensity_of(scan, i), t);
+            nodes[i] = clusterer.add(&scan.positions[i], &surface.normals[i], intensity_of(intensity, i), t);
         }
         node_of.push(nodes);
     }
@@ -286,6 +291,13 @@ pub fn segment(
     }
     let figures = combined_figures(&surfaces);
     let (params, choices) = Parameters::choose(&figures, overrides)?;
+    let intensities: Vec<Option<Vec<f32>>> = scans
+        .iter()
+        .zip(&surfaces)
+        .map(|(scan, surface)| {
+            normals::corrected_intensity(scan, surface.incidence_cos.as_deref(), params.correct_incidence)
+        })
+        .collect();
     lap("normals", &mut stages);
 
     progress(Progress {
@@ -293,7 +305,7 @@ pub fn segment(
         done: 0,
         total: points,
     });
-    let (coarse_nodes, coarse_node_of) = cluster(scans, &surfaces, &params, &|_, _| u32::MAX);
+    let (coarse_nodes, coarse_node_of) = cluster(scans, &surfaces, &intensities, &params, &|_, _| u32::MAX);
     lap("clustering", &mut stages);
     progress(Progress {
         stage: "graph",
@@ -331,7 +343,7 @@ pub fn segment(
                 coarse_group[node as usize]
             }
         };
-        let (nodes, node_of) = cluster(scans, &surfaces, &fine_params, &tag);
+        let (nodes, node_of) = cluster(scans, &surfaces, &intensities, &fine_params, &tag);
         let mut graph = Graph::build(&nodes, &fine_params);
         adapt(&mut graph, &mut fine_params, overrides, "fine", &mut choices);
         let (group, _) = segment_graph(&graph, &fine_params, intensity, &records);
@@ -373,7 +385,8 @@ pub fn segment(
         .iter()
         .zip(&surfaces)
         .zip(&final_node_of)
-        .map(|((scan, surface), node_of)| {
+        .zip(&intensities)
+        .map(|(((scan, surface), node_of), scan_intensity)| {
             (0..scan.len())
                 .into_par_iter()
                 .map(|i| {
@@ -392,7 +405,10 @@ pub fn segment(
                         let mut w = proximity(d, final_params.sigma_c_m)
                             * similarity(normal_angle(n, &node.normal), sigma_normal);
                         if intensity {
-                            w *= similarity(intensity_of(scan, i) - node.intensity, final_params.sigma_w_intensity);
+                            w *= similarity(
+                                intensity_of(scan_intensity, i) - node.intensity,
+                                final_params.sigma_w_intensity,
+                            );
                         }
                         if w > best.0 {
                             best = (w, g);

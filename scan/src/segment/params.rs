@@ -38,6 +38,9 @@ pub struct Overrides {
     pub random_edges: Option<usize>,
     /// Seed for the random edges.
     pub seed: Option<u64>,
+    /// Divide intensities by the cosine of the beam's incidence
+    /// ([`crate::segment::normals::corrected_intensity`]).
+    pub correct_incidence: Option<bool>,
 }
 
 /// The parameters in force.
@@ -74,10 +77,16 @@ pub struct Parameters {
     pub min_group_points: usize,
     /// Seed for the random edges.
     pub seed: u64,
+    /// Intensities are divided by the cosine of the beam's incidence.
+    pub correct_incidence: bool,
 }
 
 /// The range of σ_w for normals, degrees.
 const SIGMA_W_NORMAL_DEG: (f64, f64) = (4.0, 25.0);
+/// The exponent of cos incidence the returns must follow, at least, for
+/// the intensities to be divided by it: halfway between a scanner that
+/// corrects its returns (0) and one that does not (1).
+const INCIDENCE_SLOPE: f64 = 0.5;
 /// The least σ_w for intensity.
 const SIGMA_W_INTENSITY_MIN: f64 = 0.02;
 
@@ -140,7 +149,24 @@ impl Parameters {
             (3.5 * nn).clamp(10.0, 30.0),
             format!("3.5 × normal noise {nn:.2}° (a point's normal is within it 99 % of the time), within 10°–30°"),
         );
-        let inoise = figures.intensity_noise.unwrap_or(0.0);
+        let slope = figures.incidence_slope;
+        let correct_incidence = pick(
+            "correct_incidence",
+            overrides.correct_incidence.map(|c| f64::from(u8::from(c))),
+            f64::from(u8::from(slope.is_some_and(|k| k >= INCIDENCE_SLOPE))),
+            match slope {
+                Some(k) => format!(
+                    "the returns follow cos incidence with exponent {k:.2} (ln intensity on ln cos between points on one plane; corrected from {INCIDENCE_SLOPE})"
+                ),
+                None => "no pose, no intensity or too few pairs to measure how returns follow the incidence".into(),
+            },
+        ) > 0.5;
+        let inoise = if correct_incidence {
+            figures.corrected_intensity_noise.or(figures.intensity_noise)
+        } else {
+            figures.intensity_noise
+        }
+        .unwrap_or(0.0);
         let cluster_intensity = pick(
             "cluster_intensity",
             None,
@@ -210,6 +236,7 @@ impl Parameters {
             fine: overrides.fine.unwrap_or(true),
             min_group_points: min_group_points as usize,
             seed: overrides.seed.unwrap_or(28),
+            correct_incidence,
         };
         parameters.check()?;
         Ok((parameters, choices))
