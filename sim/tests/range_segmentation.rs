@@ -36,28 +36,47 @@ fn run(
     (m, report)
 }
 
-/// Measured 92.68 % on the right surface (issue 28's goal: 98 %, not met).
-/// The six planes are found; the posters and boards, coplanar with the
-/// walls and differing only in reflectance, and the three spheres merge
-/// into larger groups (the intensity pass does not split them: the
-/// intensity's cos-incidence falloff across a wall sets σ_w high).
+/// Measured 95.87 % on the right surface (issue 28's goal: 98 %, not met;
+/// 92.68 % before the intensities were divided by the incidence cosine).
+/// The planes, the table and both boards are found. What is left: the
+/// posters (2.8 % of the points), whose paper reads 0.70–0.80 in red
+/// against the paint's 0.72 and stands 1 cm proud of the wall at 3 mm
+/// range noise, so that neither pass's similarity (normals, intensity)
+/// tells them from the wall; and the three spheres (0.5 %, 7.7 cm radius,
+/// under the 12.5 cm clusters), left unassigned.
 #[test]
 fn the_simulated_room_segments_into_its_planes() {
     let (m, report) = run("room", &room_scene().unwrap(), &room_poses());
-    assert!(m.right_fraction >= 0.92, "{:.4}", m.right_fraction);
+    assert!(m.right_fraction >= 0.955, "{:.4}", m.right_fraction);
     assert_eq!(report.verdict, Verdict::Ok);
-    for plane in ["floor", "ceiling"] {
-        assert!(!m.merged.iter().any(|s| s == plane), "{plane} merged: {:?}", m.merged);
+    for surface in ["floor", "ceiling", "table", "board-1", "board-2"] {
+        assert!(
+            !m.merged.iter().any(|s| s == surface),
+            "{surface} merged: {:?}",
+            m.merged
+        );
     }
+    let corrected = report
+        .parameters
+        .iter()
+        .find(|c| c.name == "correct_incidence")
+        .unwrap();
+    assert_eq!(corrected.value, 1.0, "{}", corrected.reason);
 }
 
-/// The tower from five poses on the ground: 87.3 % on the right surface,
-/// but 12.8 % of the points (the far, sparse ground) in no group, which the
-/// verdict must say rather than hand the scene on as ok.
+/// The tower from five poses on the ground, 30–40 m off: 99.04 % on the
+/// right surface, every face its own group. Before clusters grew with the
+/// points' spacing (`scan::segment::graph::scale_level`), the faces, a
+/// metre between points against a few centimetres on the ground nearby,
+/// fell apart into single points: 87.3 %, 12.8 % unassigned, failed. The
+/// verdict follows what is left unassigned.
 #[test]
 fn the_simulated_tower_is_judged_by_what_it_leaves_unassigned() {
     let (m, report) = run("tower", &building_scene().unwrap(), &building_poses());
-    assert!(m.right_fraction >= 0.87, "{:.4}", m.right_fraction);
+    assert!(m.right_fraction >= 0.985, "{:.4}", m.right_fraction);
+    for face in ["south-face", "east-face", "north-face", "west-face"] {
+        assert!(!m.merged.iter().any(|s| s == face), "{face} merged: {:?}", m.merged);
+    }
     let unassigned = report.unassigned as f64 / report.points as f64;
     let expected = if unassigned > 0.10 {
         Verdict::Failed

@@ -27,6 +27,12 @@ pub fn similarity(diff: f64, sigma_w: f64) -> f64 {
     (-diff * diff / (2.0 * sigma_w * sigma_w)).exp()
 }
 
+/// Eq. (2.3) on an intensity difference; 1 when it is NaN (an end without
+/// intensity: nothing to tell them apart by).
+pub fn intensity_similarity(diff: f64, sigma_w: f64) -> f64 {
+    if diff.is_nan() { 1.0 } else { similarity(diff, sigma_w) }
+}
+
 /// Eq. (2.4): P(u, v) = exp(−dist²(u, v) / 2σ_c²).
 pub fn proximity(dist: f64, sigma_c: f64) -> f64 {
     (-dist * dist / (2.0 * sigma_c * sigma_c)).exp()
@@ -60,12 +66,18 @@ pub struct Node {
     pub sum_position: Vector3<f64>,
     /// Σ normals.
     pub sum_normal: Vector3<f64>,
-    /// Σ intensities.
+    /// Σ intensities (of the points that carry one).
     pub sum_intensity: f64,
+    /// Points that carry an intensity (not NaN: see
+    /// [`crate::segment::normals::corrected_intensity`]).
+    pub intensity_points: u32,
     /// Points in the cluster.
     pub points: u32,
     /// The coarse group the cluster belongs to (fine stage), or `u32::MAX`.
     pub tag: u32,
+    /// Its scale level: the cluster's radius is the base radius × 2^level
+    /// ([`scale_level`]).
+    pub level: u8,
 }
 
 impl Node {
@@ -79,9 +91,13 @@ impl Node {
         self.sum_normal.try_normalize(1e-12).unwrap_or_else(Vector3::zeros)
     }
 
-    /// The mean intensity.
+    /// The mean intensity, NaN when no point carries one.
     pub fn intensity(&self) -> f64 {
-        self.sum_intensity / f64::from(self.points)
+        if self.intensity_points == 0 {
+            f64::NAN
+        } else {
+            self.sum_intensity / f64::from(self.intensity_points)
+        }
     }
 }
 
@@ -123,14 +139,41 @@ impl CellGrid {
     }
 }
 
-/// Incremental clustering (§2.3.2).
+/// The most scale levels: a cluster is at most 2^(LEVELS − 1) times the
+/// base radius.
+pub const LEVELS: usize = 7;
+
+/// The scale level of a point whose local spacing is `spacing` m, for
+/// clusters of `radius` m: 0 while a cluster of that radius still holds a
+/// dozen points (the spacing up to half the radius), then one more for each
+/// doubling of the spacing, up to `LEVELS − 1`.
+///
+/// A scanner's points thin out with range (their spacing is the range
+/// times the beam step) and at grazing incidence. With one radius for all
+/// (§2.3.2), a tower 30 m away from scans whose median spacing is a few
+/// centimetres on the ground nearby gets one point per cluster, no edge
+/// within the edge radius, and falls apart into single points. With its
+/// level, every cluster holds about as many points wherever it is.
+pub fn scale_level(spacing: f64, radius: f64) -> u8 {
+    if !(spacing.is_finite() && radius > 0.0) || spacing <= radius {
+        return 0;
+    }
+    ((spacing / radius).log2().ceil().max(0.0) as usize).min(LEVELS - 1) as u8
+}
+
+/// 2^level.
+pub fn level_scale(level: u8) -> f64 {
+    f64::from(1u32 << level)
+}
+
+/// Incremental clustering (§2.3.2), with one hash grid per scale level.
 #[derive(Debug, Clone)]
 pub struct Clusterer {
     radius: f64,
     cos_normal: f64,
     intensity: f64,
     nodes: Vec<Node>,
-    grid: CellGrid,
+    grids: Vec<CellGrid>,
 }
 
 impl Clusterer {
@@ -142,15 +185,20 @@ impl Clusterer {
             cos_normal: normal_deg.to_radians().cos(),
             intensity,
             nodes: Vec::new(),
-            grid: CellGrid::new(radius),
+            grids: (0..LEVELS)
+                .map(|l| CellGrid::new(radius * level_scale(l as u8)))
+                .collect(),
         }
     }
 
-    /// Adds one point; returns its node.
-    pub fn add(&mut self, p: &Vector3<f64>, n: &Vector3<f64>, intensity: f64, tag: u32) -> u32 {
-        let r2 = self.radius * self.radius;
+    /// Adds one point at scale `level` ([`scale_level`]); it joins a cluster
+    /// of its level; returns its node.
+    pub fn add(&mut self, p: &Vector3<f64>, n: &Vector3<f64>, intensity: f64, tag: u32, level: u8) -> u32 {
+        let level = level.min(LEVELS as u8 - 1);
+        let radius = self.radius * level_scale(level);
+        let r2 = radius * radius;
         let mut best: Option<(f64, u32)> = None;
-        for k in self.grid.around(p) {
+        for k in self.grids[usize::from(level)].around(p) {
             let node = &self.nodes[k as usize];
             if node.tag != tag {
                 continue;
@@ -159,6 +207,7 @@ impl Clusterer {
             if d2 > r2 || best.is_some_and(|(b, _)| b <= d2) {
                 continue;
             }
+            // NaN (no intensity on either side) never refuses.
             if node.normal().dot(n).abs() < self.cos_normal || (node.intensity() - intensity).abs() > self.intensity {
                 continue;
             }
@@ -174,7 +223,10 @@ impl Clusterer {
                 } else {
                     node.sum_normal += n;
                 }
-                node.sum_intensity += intensity;
+                if intensity.is_finite() {
+                    node.sum_intensity += intensity;
+                    node.intensity_points += 1;
+                }
                 node.points += 1;
                 k
             }
@@ -183,11 +235,13 @@ impl Clusterer {
                 self.nodes.push(Node {
                     sum_position: *p,
                     sum_normal: *n,
-                    sum_intensity: intensity,
+                    sum_intensity: if intensity.is_finite() { intensity } else { 0.0 },
+                    intensity_points: u32::from(intensity.is_finite()),
                     points: 1,
                     tag,
+                    level,
                 });
-                self.grid.insert(p, k);
+                self.grids[usize::from(level)].insert(p, k);
                 k
             }
         }
@@ -206,12 +260,17 @@ pub struct NodeAttributes {
     pub position: Vector3<f64>,
     /// Mean unit normal.
     pub normal: Vector3<f64>,
-    /// Mean intensity.
+    /// Mean intensity (NaN when none of its points carries one).
     pub intensity: f64,
     /// Points in the node.
     pub points: u32,
     /// Coarse group (fine stage) or `u32::MAX`.
     pub tag: u32,
+    /// 2^level ([`scale_level`]): the node's radius, edge radius and σ_c
+    /// are the parameters' times this.
+    pub scale: f64,
+    /// Points that carry an intensity.
+    pub intensity_points: u32,
 }
 
 /// Which similarity a pass uses (§2.3.4: normal continuity, then intensity).
@@ -240,14 +299,20 @@ pub struct Graph {
     pub normal_diff: Vec<f32>,
     /// The ends' intensity difference per edge.
     pub intensity_diff: Vec<f32>,
+    /// The variance of that difference from the ends' own noise,
+    /// σ²(1/n_u + 1/n_v) (σ one point's intensity noise).
+    pub intensity_var: Vec<f32>,
+    /// One point's intensity noise σ.
+    intensity_noise: f64,
     /// σ_w for normals, radians; σ_w for intensity; σ_c, m; E.
     sigmas: (f64, f64, f64, f64),
 }
 
 impl Graph {
     /// Builds the graph over `nodes`: an edge between nodes of the same tag
-    /// whose centroids are within `edge_radius_m`, plus `random_edges` a
-    /// node to a random node of the same tag within twice that.
+    /// whose centroids are within `edge_radius_m` (times the coarser node's
+    /// scale), plus `random_edges` a node to a random node of the same tag
+    /// within twice that.
     pub fn build(nodes: &[Node], params: &Parameters) -> Graph {
         let attributes: Vec<NodeAttributes> = nodes
             .iter()
@@ -257,33 +322,42 @@ impl Graph {
                 intensity: n.intensity(),
                 points: n.points,
                 tag: n.tag,
+                scale: level_scale(n.level),
+                intensity_points: n.intensity_points,
             })
             .collect();
-        let reach = 2.0 * params.edge_radius_m;
-        let mut grid = CellGrid::new(reach);
-        for (k, a) in attributes.iter().enumerate() {
-            grid.insert(&a.position, k as u32);
+        // One grid per level, of cubes twice that level's edge radius; a
+        // pair's reach is set by the larger of its two levels, so each node
+        // looks in its own level's grid and the coarser ones.
+        let mut grids: Vec<CellGrid> = (0..LEVELS)
+            .map(|l| CellGrid::new(2.0 * params.edge_radius_m * level_scale(l as u8)))
+            .collect();
+        for (k, n) in nodes.iter().enumerate() {
+            grids[usize::from(n.level.min(LEVELS as u8 - 1))].insert(&n.position(), k as u32);
         }
-        let r2 = params.edge_radius_m * params.edge_radius_m;
-        let reach2 = reach * reach;
         let mut pairs: Vec<(u32, u32)> = attributes
             .par_iter()
             .enumerate()
             .flat_map_iter(|(i, a)| {
                 let mut local = Vec::new();
                 let mut far = Vec::new();
-                for j in grid.around(&a.position) {
-                    let b = &attributes[j as usize];
-                    if j as usize == i || b.tag != a.tag {
-                        continue;
-                    }
-                    let d2 = (b.position - a.position).norm_squared();
-                    if d2 <= r2 {
-                        if (j as usize) > i {
-                            local.push((i as u32, j));
+                let own = usize::from(nodes[i].level.min(LEVELS as u8 - 1));
+                for (l, grid) in grids.iter().enumerate().skip(own) {
+                    let r = params.edge_radius_m * level_scale(l as u8);
+                    let (r2, reach2) = (r * r, 4.0 * r * r);
+                    for j in grid.around(&a.position) {
+                        let b = &attributes[j as usize];
+                        if j as usize == i || b.tag != a.tag {
+                            continue;
                         }
-                    } else if d2 <= reach2 {
-                        far.push(j);
+                        let d2 = (b.position - a.position).norm_squared();
+                        if d2 <= r2 {
+                            if l > own || (j as usize) > i {
+                                local.push((i.min(j as usize) as u32, i.max(j as usize) as u32));
+                            }
+                        } else if d2 <= reach2 {
+                            far.push(j);
+                        }
                     }
                 }
                 if !far.is_empty() {
@@ -330,9 +404,11 @@ impl Graph {
             proximity: Vec::new(),
             normal_diff: Vec::new(),
             intensity_diff: Vec::new(),
+            intensity_var: Vec::new(),
+            intensity_noise: params.intensity_noise,
             sigmas,
         };
-        let terms: Vec<(f64, f32, f32)> = (0..n)
+        let terms: Vec<(f64, f32, f32, f32)> = (0..n)
             .into_par_iter()
             .flat_map_iter(|i| {
                 let g = &graph;
@@ -342,6 +418,7 @@ impl Graph {
                         g.proximity_of(i, j),
                         normal_angle(&a.normal, &b.normal) as f32,
                         (a.intensity - b.intensity).abs() as f32,
+                        g.intensity_variance(i, j) as f32,
                     )
                 })
             })
@@ -349,6 +426,7 @@ impl Graph {
         graph.proximity = terms.iter().map(|t| t.0).collect();
         graph.normal_diff = terms.iter().map(|t| t.1).collect();
         graph.intensity_diff = terms.iter().map(|t| t.2).collect();
+        graph.intensity_var = terms.iter().map(|t| t.3).collect();
         graph
     }
 
@@ -357,23 +435,38 @@ impl Graph {
         (self.offsets[i]..self.offsets[i + 1]).map(|e| (self.targets[e] as usize, e))
     }
 
-    /// P (eq. 2.4) between any two nodes, with eq. 2.5's distance.
+    /// P (eq. 2.4) between any two nodes, with eq. 2.5's distance; σ_c is
+    /// scaled by the coarser node's level.
     pub fn proximity_of(&self, i: usize, j: usize) -> f64 {
         let (a, b) = (&self.nodes[i], &self.nodes[j]);
         let (_, _, sigma_c, e) = self.sigmas;
         proximity(
             anisotropic_distance(&a.position, &a.normal, &b.position, &b.normal, e),
-            sigma_c,
+            sigma_c * a.scale.max(b.scale),
         )
     }
 
-    /// S (eq. 2.3) between any two nodes for `pass`.
+    /// The variance of nodes `i` and `j`'s intensity difference from their
+    /// own noise, σ²(1/n_i + 1/n_j).
+    pub fn intensity_variance(&self, i: usize, j: usize) -> f64 {
+        let inverse = |n: u32| if n == 0 { 0.0 } else { 1.0 / f64::from(n) };
+        self.intensity_noise.powi(2)
+            * (inverse(self.nodes[i].intensity_points) + inverse(self.nodes[j].intensity_points))
+    }
+
+    /// S (eq. 2.3) between any two nodes for `pass`. For intensity, σ_w is
+    /// widened by the two means' own noise: σ² = σ_w² + σ²(1/n_i + 1/n_j),
+    /// so that a cluster of three grazing points is not cut off a wall for
+    /// reading 2σ_w off its mean.
     pub fn similarity_of(&self, i: usize, j: usize, pass: Pass) -> f64 {
         let (a, b) = (&self.nodes[i], &self.nodes[j]);
         let (sigma_normal, sigma_intensity, _, _) = self.sigmas;
         match pass {
             Pass::Normal => similarity(normal_angle(&a.normal, &b.normal), sigma_normal),
-            Pass::Intensity => similarity(a.intensity - b.intensity, sigma_intensity),
+            Pass::Intensity => intensity_similarity(
+                a.intensity - b.intensity,
+                (sigma_intensity.powi(2) + self.intensity_variance(i, j)).sqrt(),
+            ),
         }
     }
 
@@ -382,7 +475,10 @@ impl Graph {
         let (sigma_normal, sigma_intensity, _, _) = self.sigmas;
         match pass {
             Pass::Normal => similarity(f64::from(self.normal_diff[e]), sigma_normal),
-            Pass::Intensity => similarity(f64::from(self.intensity_diff[e]), sigma_intensity),
+            Pass::Intensity => intensity_similarity(
+                f64::from(self.intensity_diff[e]),
+                (sigma_intensity.powi(2) + f64::from(self.intensity_var[e])).sqrt(),
+            ),
         }
     }
 
@@ -394,7 +490,7 @@ impl Graph {
             let mut v: Vec<f32> = values
                 .iter()
                 .zip(&self.proximity)
-                .filter(|(_, p)| **p > 0.1)
+                .filter(|(d, p)| **p > 0.1 && d.is_finite())
                 .map(|(d, _)| *d)
                 .collect();
             if v.is_empty() {
@@ -417,6 +513,58 @@ impl Graph {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn scale_levels_double_with_the_spacing() {
+        // Clusters of 0.125 m: a dozen points each up to 0.125 m spacing.
+        assert_eq!(scale_level(0.03, 0.125), 0);
+        assert_eq!(scale_level(0.125, 0.125), 0);
+        assert_eq!(scale_level(0.2, 0.125), 1);
+        assert_eq!(scale_level(0.25, 0.125), 1);
+        assert_eq!(scale_level(0.26, 0.125), 2);
+        assert_eq!(scale_level(1.0, 0.125), 3);
+        assert_eq!(scale_level(1e6, 0.125), (LEVELS - 1) as u8);
+        assert_eq!(scale_level(f64::NAN, 0.125), 0);
+        assert_eq!(scale_level(f64::INFINITY, 0.125), 0);
+        assert_eq!(level_scale(3), 8.0);
+    }
+
+    #[test]
+    fn sparse_clusters_join_at_their_own_level_and_meet_the_dense_ones() {
+        // A line of points 0.02 m apart, then one 0.3 m apart: with one
+        // radius (0.1 m) every far point would be a node of its own.
+        let mut c = Clusterer::new(0.1, 20.0, 0.1);
+        let mut nodes = Vec::new();
+        for i in 0..50 {
+            nodes.push(c.add(
+                &Vector3::new(i as f64 * 0.02, 0.0, 0.0),
+                &Vector3::z(),
+                0.5,
+                u32::MAX,
+                0,
+            ));
+        }
+        let level = scale_level(0.3, 0.1);
+        assert_eq!(level, 2);
+        for i in 0..20 {
+            nodes.push(c.add(
+                &Vector3::new(1.0 + i as f64 * 0.3, 0.0, 0.0),
+                &Vector3::z(),
+                f64::NAN,
+                u32::MAX,
+                level,
+            ));
+        }
+        let dense: std::collections::BTreeSet<u32> = nodes[..50].iter().copied().collect();
+        let sparse: std::collections::BTreeSet<u32> = nodes[50..].iter().copied().collect();
+        // Radius 0.4 m at level 2: two points a node, not one.
+        assert_eq!(sparse.len(), 10, "{sparse:?}");
+        assert!(dense.is_disjoint(&sparse));
+        let all = c.into_nodes();
+        // A node of points without intensity has none, not 0 or NaN mixed in.
+        assert!(all[*sparse.first().unwrap() as usize].intensity().is_nan());
+        assert!((all[0].intensity() - 0.5).abs() < 1e-12);
+    }
 
     #[test]
     fn the_anisotropic_distance_magnifies_depth_and_shrinks_the_tangent() {
@@ -445,10 +593,22 @@ mod tests {
         // A 1 m strip of floor (normal z) along x, then a wall (normal x) at x = 1.
         let mut labels = Vec::new();
         for i in 0..50 {
-            labels.push(c.add(&Vector3::new(i as f64 * 0.02, 0.0, 0.0), &Vector3::z(), 0.5, u32::MAX));
+            labels.push(c.add(
+                &Vector3::new(i as f64 * 0.02, 0.0, 0.0),
+                &Vector3::z(),
+                0.5,
+                u32::MAX,
+                0,
+            ));
         }
         for i in 0..10 {
-            labels.push(c.add(&Vector3::new(1.0, 0.0, i as f64 * 0.02), &-Vector3::x(), 0.5, u32::MAX));
+            labels.push(c.add(
+                &Vector3::new(1.0, 0.0, i as f64 * 0.02),
+                &-Vector3::x(),
+                0.5,
+                u32::MAX,
+                0,
+            ));
         }
         let nodes = c.into_nodes();
         for (k, &l) in labels.iter().enumerate() {

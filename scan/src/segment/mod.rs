@@ -45,7 +45,10 @@ use serde::{Deserialize, Serialize};
 use crate::cloud::{Scan, ScanError};
 use crate::segmentation::{Segmentation, UNASSIGNED};
 use criterion::{Recursion, SplitRecord, segment_region};
-use graph::{CellGrid, Clusterer, Graph, Node, Pass, anisotropic_distance, normal_angle, proximity, similarity};
+use graph::{
+    CellGrid, Clusterer, Graph, Node, Pass, anisotropic_distance, intensity_similarity, normal_angle, proximity,
+    scale_level, similarity,
+};
 use normals::{LocalSurface, ScanFigures};
 use params::{Choice, Overrides, ParameterError, Parameters};
 use targets::Target;
@@ -202,7 +205,14 @@ fn cluster(
             if t == UNASSIGNED - 1 {
                 continue;
             }
-            nodes[i] = clusterer.add(&scan.positions[i], &surface.normals[i], intensity_of(intensity, i), t);
+            let level = scale_level(f64::from(surface.spacing_m[i]), params.cluster_radius_m);
+            nodes[i] = clusterer.add(
+                &scan.positions[i],
+                &surface.normals[i],
+                intensity_of(intensity, i),
+                t,
+                level,
+            );
         }
         node_of.push(nodes);
     }
@@ -402,12 +412,15 @@ pub fn segment(
                             continue;
                         }
                         let d = anisotropic_distance(p, n, &node.position, &node.normal, final_params.anisotropy);
-                        let mut w = proximity(d, final_params.sigma_c_m)
+                        let mut w = proximity(d, final_params.sigma_c_m * node.scale)
                             * similarity(normal_angle(n, &node.normal), sigma_normal);
                         if intensity {
-                            w *= similarity(
+                            // The point's own noise and the node's mean's.
+                            let noise = final_params.intensity_noise.powi(2)
+                                * (1.0 + 1.0 / f64::from(node.intensity_points.max(1)));
+                            w *= intensity_similarity(
                                 intensity_of(scan_intensity, i) - node.intensity,
-                                final_params.sigma_w_intensity,
+                                (final_params.sigma_w_intensity.powi(2) + noise).sqrt(),
                             );
                         }
                         if w > best.0 {

@@ -79,6 +79,9 @@ pub struct Parameters {
     pub seed: u64,
     /// Intensities are divided by the cosine of the beam's incidence.
     pub correct_incidence: bool,
+    /// One point's intensity noise (σ) as compared: a node of n points
+    /// knows its mean to σ/√n, which widens eq. 2.3's σ_w on its edges.
+    pub intensity_noise: f64,
 }
 
 /// The range of σ_w for normals, degrees.
@@ -237,6 +240,7 @@ impl Parameters {
             min_group_points: min_group_points as usize,
             seed: overrides.seed.unwrap_or(28),
             correct_incidence,
+            intensity_noise: inoise,
         };
         parameters.check()?;
         Ok((parameters, choices))
