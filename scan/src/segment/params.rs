@@ -319,3 +319,51 @@ impl Parameters {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn figures(slope: Option<f64>) -> ScanFigures {
+        ScanFigures {
+            spacing_m: 0.03,
+            noise_m: 0.003,
+            normal_noise_deg: 2.0,
+            intensity_noise: Some(0.01),
+            corrected_intensity_noise: Some(0.02),
+            incidence_slope: slope,
+            points: 1000,
+        }
+    }
+
+    fn correction(parameters: &[Choice]) -> &Choice {
+        parameters.iter().find(|c| c.name == "correct_incidence").unwrap()
+    }
+
+    #[test]
+    fn the_incidence_correction_follows_the_measured_slope_unless_given() {
+        let none = Overrides::default();
+        let (p, c) = Parameters::choose(&figures(Some(0.9)), &none).unwrap();
+        assert!(p.correct_incidence);
+        assert!(correction(&c).reason.contains("exponent 0.90"), "{:?}", correction(&c));
+        // The corrected intensity's noise sets the cluster's limit (4 × 0.02).
+        assert!((p.cluster_intensity - 0.08).abs() < 1e-12);
+        assert!((p.intensity_noise - 0.02).abs() < 1e-12);
+        let (p, _) = Parameters::choose(&figures(Some(0.1)), &none).unwrap();
+        assert!(!p.correct_incidence);
+        assert!((p.intensity_noise - 0.01).abs() < 1e-12);
+        let (p, c) = Parameters::choose(&figures(None), &none).unwrap();
+        assert!(!p.correct_incidence);
+        assert!(correction(&c).reason.contains("no pose"));
+        // A user's word wins, both ways, and is read from RON.
+        let given: Overrides = ron::from_str("(correct_incidence: Some(false))").unwrap();
+        let (p, c) = Parameters::choose(&figures(Some(0.9)), &given).unwrap();
+        assert!(!p.correct_incidence);
+        assert_eq!(correction(&c).reason, "given");
+        let given = Overrides {
+            correct_incidence: Some(true),
+            ..Overrides::default()
+        };
+        assert!(Parameters::choose(&figures(None), &given).unwrap().0.correct_incidence);
+    }
+}
