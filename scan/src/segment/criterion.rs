@@ -368,27 +368,6 @@ pub fn segment_region(
     let mut components = region.components();
     if components.len() > 1 {
         components.sort_by_key(Vec::len);
-        if std::env::var("DBGSPLIT").is_ok() {
-            for c in components.iter().filter(|c| c.len() >= 5) {
-                let n = c.len() as f64;
-                let centre = c
-                    .iter()
-                    .map(|&m| graph.nodes[m as usize].position)
-                    .sum::<nalgebra::Vector3<f64>>()
-                    / n;
-                let pts: u32 = c.iter().map(|&m| graph.nodes[m as usize].points).sum();
-                eprintln!(
-                    "DBGC {:?} of {} comp n{} pts{} c({:.2},{:.2},{:.2})",
-                    settings.pass,
-                    region.len(),
-                    c.len(),
-                    pts,
-                    centre.x,
-                    centre.y,
-                    centre.z
-                );
-            }
-        }
         record(SplitRecord {
             pass: settings.pass,
             nodes: region.len(),
@@ -450,41 +429,6 @@ pub fn segment_region(
     let mut side_a = vec![false; region.len()];
     for &i in &order[..cut.k] {
         side_a[i] = true;
-    }
-    if std::env::var("DBGSPLIT").is_ok() {
-        let stat = |sel: bool| {
-            let v: Vec<&super::graph::NodeAttributes> = region
-                .members
-                .iter()
-                .enumerate()
-                .filter(|(i, _)| side_a[*i] == sel)
-                .map(|(_, &m)| &graph.nodes[m as usize])
-                .collect();
-            let n = v.len() as f64;
-            let c = v.iter().map(|a| a.position).sum::<nalgebra::Vector3<f64>>() / n;
-            let nn = v.iter().map(|a| a.normal).sum::<nalgebra::Vector3<f64>>() / n;
-            let mi = v.iter().map(|a| a.intensity).filter(|x| x.is_finite()).sum::<f64>() / n;
-            let pts = v.iter().map(|a| a.points as f64).sum::<f64>() / n;
-            format!(
-                "n{} c({:.2},{:.2},{:.2}) nrm({:.2},{:.2},{:.2}) I{mi:.3} pts{pts:.1}",
-                v.len(),
-                c.x,
-                c.y,
-                c.z,
-                nn.x,
-                nn.y,
-                nn.z
-            )
-        };
-        let small = cut.k <= region.len() - cut.k;
-        eprintln!(
-            "DBG {:?} small [{}] big [{}] ncut {:.3} nwa {:.4}",
-            settings.pass,
-            stat(small),
-            stat(!small),
-            cut.ncut,
-            cut.nwacut
-        );
     }
     if settings.boundary_voting {
         boundary::improve(
