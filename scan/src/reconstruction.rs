@@ -84,7 +84,8 @@ pub struct GroupReport {
 pub struct ReconstructionReport {
     /// One line per group.
     pub groups: Vec<GroupReport>,
-    /// Groups meshed by planar polygons, scan-order neighbours and height fields.
+    /// Groups meshed by planar polygons (one plane or several), scan-order
+    /// neighbours and height fields.
     pub planar: usize,
     /// See `planar`.
     pub scan_grid: usize,
@@ -223,6 +224,17 @@ pub fn reconstruct(
             groups.push(report);
             continue;
         }
+        if m.method == MeshMethod::PlanePieces {
+            judge(
+                Verdict::Ok,
+                format!(
+                    "{} planes, each a polygon; {} points ({:.1} % of the group's) on none of them, not meshed",
+                    m.pieces,
+                    m.unmeshed_points,
+                    100.0 * m.unmeshed_points as f64 / m.points.max(1) as f64
+                ),
+            );
+        }
         if m.mesh.is_empty() {
             // A speck or a line of points (edge pixels a group of their own)
             // loses little; a real share of the scan lost is a failure.
@@ -281,7 +293,7 @@ pub fn reconstruct(
     let count = |method| groups.iter().filter(|g| g.method == method).count();
     let meshed = !written.is_empty();
     let mut report = ReconstructionReport {
-        planar: count(MeshMethod::PlanarPolygon),
+        planar: count(MeshMethod::PlanarPolygon) + count(MeshMethod::PlanePieces),
         scan_grid: count(MeshMethod::ScanGrid),
         height_field: count(MeshMethod::HeightField),
         ball_pivoting: count(MeshMethod::BallPivoting),

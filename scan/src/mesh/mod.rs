@@ -35,6 +35,7 @@ pub mod height_field;
 pub mod outline;
 pub mod planar_polygon;
 pub mod plane_fit;
+pub mod plane_pieces;
 pub mod simplification;
 pub mod triangle_mesh;
 
@@ -207,6 +208,9 @@ impl MeshOptions {
 pub enum MeshMethod {
     /// A polygon in the group's plane.
     PlanarPolygon,
+    /// A polygon in each of the group's planes
+    /// ([`plane_pieces::plane_pieces`]): a table's top and sides.
+    PlanePieces,
     /// Scan-order neighbours of organised scans.
     ScanGrid,
     /// Curved unorganised groups that are height fields over their plane.
@@ -237,6 +241,11 @@ pub struct GroupMesh {
     pub triangles_before: usize,
     /// The simplifier's error estimate, metres (0 when not simplified).
     pub simplify_error_m: f64,
+    /// [`MeshMethod::PlanePieces`]: the planes found.
+    pub pieces: usize,
+    /// [`MeshMethod::PlanePieces`]: points on none of them (thin strips
+    /// between the planes, clutter), left out of the mesh.
+    pub unmeshed_points: usize,
     /// The mesh (simplified), normals facing the scanner.
     pub mesh: TriangleMesh,
 }
@@ -386,6 +395,8 @@ impl Context<'_> {
             folded: 0,
             triangles_before: 0,
             simplify_error_m: 0.0,
+            pieces: 0,
+            unmeshed_points: 0,
             mesh: TriangleMesh::default(),
         };
         let plane = (points.len() >= options.min_points.max(3))
@@ -405,6 +416,25 @@ impl Context<'_> {
                 options.outline_tolerance_m,
             )
             .0;
+            out.triangles_before = out.mesh.triangles.len();
+            return out;
+        } else if let Some(pieces) = plane_pieces::plane_pieces(
+            &points,
+            &views,
+            options.min_points,
+            2.0 * options.planar_rms_m,
+            options.planar_rms_m,
+        ) {
+            out.method = MeshMethod::PlanePieces;
+            out.pieces = pieces.len();
+            out.unmeshed_points = points.len() - pieces.iter().map(|p| p.points.len()).sum::<usize>();
+            for piece in &pieces {
+                let pts: Vec<Vector3<f64>> = piece.points.iter().map(|&i| points[i]).collect();
+                let view = piece.points.iter().map(|&i| views[i]).sum::<Vector3<f64>>() / pts.len() as f64;
+                let plane = piece.plane.facing(&view);
+                out.mesh
+                    .append(&planar_polygon(&pts, &plane, options.outline_alpha_factor, options.outline_tolerance_m).0);
+            }
             out.triangles_before = out.mesh.triangles.len();
             return out;
         } else if all_organised {
