@@ -30,6 +30,11 @@ pub const NORMAL_DEG: f64 = 15.0;
 pub const COVERED: f64 = 0.9;
 /// The most pieces a group is split into.
 pub const MAX_PIECES: usize = 12;
+/// A piece must span at least this many tolerances along its longest
+/// in-plane direction: a plane 2 cm thick is a plane only over metres (a
+/// table's top, a wall); over a 15 cm bunny, a tolerance that wide would
+/// make facets of a curved body.
+pub const MIN_EXTENT_OVER_TOLERANCE: f64 = 20.0;
 /// Seed points tried per piece.
 const SEEDS: usize = 64;
 
@@ -43,8 +48,9 @@ pub struct PlanePiece {
 }
 
 /// Splits `points` (seen from `views`, one per point) into planar pieces of
-/// at least `min_points` points within `tolerance_m` of their planes and of
-/// RMS at most `planar_rms_m`; `None` when they are not such planes (the
+/// at least `min_points` points within `tolerance_m` of their planes, of
+/// RMS at most `planar_rms_m` and spanning [`MIN_EXTENT_OVER_TOLERANCE`]
+/// tolerances; `None` when they are not such planes (the
 /// pieces hold under [`COVERED`] of the points). One piece is a plane with
 /// a few stray points (a table top with its edge strips) that pulled the
 /// whole group's fit past the planar limit.
@@ -112,7 +118,10 @@ pub fn plane_pieces(
         }
         let pts: Vec<Vector3<f64>> = members.iter().map(|&i| points[i]).collect();
         let Some(fit) = PlaneFit::of(&pts).or(plane) else { break };
-        if members.len() < min_points || fit.rms_m > planar_rms_m {
+        let along: Vec<f64> = members.iter().map(|&i| fit.project(&points[i])[0]).collect();
+        let extent = along.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+            - along.iter().copied().fold(f64::INFINITY, f64::min);
+        if members.len() < min_points || fit.rms_m > planar_rms_m || extent < MIN_EXTENT_OVER_TOLERANCE * tolerance_m {
             break;
         }
         for &i in &members {
@@ -208,6 +217,16 @@ mod tests {
         }
         let held: usize = pieces.iter().map(|p| p.points.len()).sum();
         assert!(held as f64 >= 0.98 * points.len() as f64, "{held} of {}", points.len());
+    }
+
+    #[test]
+    fn a_small_curved_body_is_not_made_of_facets() {
+        // The table shrunk to 15 cm: its planes are as flat as before, but
+        // span under 20 tolerances (40 cm).
+        let (points, views) = table();
+        let small: Vec<Vector3<f64>> = points.iter().map(|p| p * 0.15).collect();
+        assert!(plane_pieces(&small, &views, 10, 0.02, 0.01).is_none());
+        assert!(plane_pieces(&small, &views, 10, 0.002, 0.01).is_some());
     }
 
     #[test]
