@@ -280,6 +280,24 @@ def check_metrics(xyz, truth, surfaces):
         sys.exit(1)
 
 
+def print_header():
+    """The table's header (campanile_segment.py prints rows of the same table)."""
+    print("| scene | points | method | parameters | time (s) | load before → after | right | under | over | "
+          "missed | boundary within 2 cm, mean / p95 (cm) | segments |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+
+
+def print_row(scene, points, method, params, seconds, before, after, m):
+    """One method's row (stdout) from its metrics `m`, and the surfaces
+    behind its under, over and missed counts (stderr)."""
+    b = "none" if m["boundary"] is None else f"{100 * m['boundary'][0]:.1f} %, {m['boundary'][1]:.1f} / {m['boundary'][2]:.1f}"
+    print(f"| {scene} | {points} | {method} | {params} | {seconds} | {before} → {after} | "
+          f"{100 * m['right']:.1f} % | {m['under']}/{m['counted']} | {m['over']}/{m['counted']} | "
+          f"{m['missed']}/{m['counted']} | {b} | {m['segments']} |", flush=True)
+    print(f"#   {scene} {method.split(' ')[0]}: under: {m['under_names']}; over: {m['over_names']}; "
+          f"missed: {m['missed_names']}; {m['true_boundary']} points next to a true boundary", file=sys.stderr)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                  epilog="example: python open3d_segment.py /tmp/scans room --methods ransac")
@@ -303,9 +321,7 @@ def main():
           f"{o3d.utility.get_num_threads() if hasattr(o3d.utility, 'get_num_threads') else os.cpu_count()} threads",
           file=sys.stderr)
     if args.header:
-        print("| scene | points | method | parameters | time (s) | load before → after | right | under | over | "
-              "missed | boundary within 2 cm, mean / p95 (cm) | segments |")
-        print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+        print_header()
     for method in args.methods.split(","):
         pcd = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(xyz))
         before = loadavg()
@@ -322,13 +338,8 @@ def main():
             sys.exit(f"--methods {method!r}: expected ransac or patches")
         seconds = time.perf_counter() - clock
         after = loadavg()
-        m = metrics(xyz, truth, found, surfaces)
-        b = "none" if m["boundary"] is None else f"{100 * m['boundary'][0]:.1f} %, {m['boundary'][1]:.1f} / {m['boundary'][2]:.1f}"
-        print(f"| {args.set} | {len(xyz)} | {method} ({what}) | {params} | {seconds:.1f} | {before} → {after} | "
-              f"{100 * m['right']:.1f} % | {m['under']}/{m['counted']} | {m['over']}/{m['counted']} | "
-              f"{m['missed']}/{m['counted']} | {b} | {m['segments']} |", flush=True)
-        print(f"#   {args.set} {method}: under: {m['under_names']}; over: {m['over_names']}; "
-              f"missed: {m['missed_names']}; {m['true_boundary']} points next to a true boundary", file=sys.stderr)
+        print_row(args.set, len(xyz), f"{method} ({what})", params, f"{seconds:.1f}", before, after,
+                  metrics(xyz, truth, found, surfaces))
 
 
 if __name__ == "__main__":

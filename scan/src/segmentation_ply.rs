@@ -3,6 +3,11 @@
 //! and the group as an int, −1 for unassigned) that MeshLab, CloudCompare
 //! and Open3D open.
 //!
+//! The vertices are the scans' points in their order (scan by scan, in the
+//! order given, each scan's points as read), so the `group` property is
+//! also every point's label for a program that scores the segmentation
+//! against per-point truth (`bench/segment/campanile_segment.py`).
+//!
 //! Colours are deterministic: group `g` takes the hue `g × 0.618…` turns
 //! (the golden ratio's fraction, which keeps neighbouring numbers far
 //! apart) at full saturation and value 0.9; unassigned points are grey.
@@ -96,20 +101,29 @@ mod tests {
                 assert_ne!(colours[i], colours[j], "groups {i} and {j}");
             }
         }
-        let scan = Scan::from_positions("s", vec![Vector3::new(1.0, 2.0, 3.0), Vector3::zeros()]);
+        let scans = [
+            Scan::from_positions("s", vec![Vector3::new(1.0, 2.0, 3.0), Vector3::zeros()]),
+            Scan::from_positions("t", vec![Vector3::new(-4.0, 5.0, 6.5)]),
+        ];
         let seg = Segmentation {
-            labels: vec![vec![1, UNASSIGNED]],
+            labels: vec![vec![1, UNASSIGNED], vec![0]],
             names: vec!["a".into(), "b".into()],
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("seg.ply");
-        write_segmentation_ply(&path, &[scan], &seg).unwrap();
+        write_segmentation_ply(&path, &scans, &seg).unwrap();
         let bytes = std::fs::read(&path).unwrap();
         let header_end = bytes.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
-        assert_eq!(bytes.len() - header_end, 2 * 31);
-        let first = &bytes[header_end..header_end + 31];
-        assert_eq!(f64::from_le_bytes(first[16..24].try_into().unwrap()), 3.0);
-        assert_eq!(&first[24..27], &group_colour(1));
-        assert_eq!(i32::from_le_bytes(bytes[bytes.len() - 4..].try_into().unwrap()), -1);
+        assert_eq!(bytes.len() - header_end, 3 * 31);
+        // The vertices in scan order: (x, y, z, group) of each.
+        let vertex = |i: usize| {
+            let r = &bytes[header_end + 31 * i..header_end + 31 * (i + 1)];
+            let f = |k: usize| f64::from_le_bytes(r[8 * k..8 * k + 8].try_into().unwrap());
+            (f(0), f(1), f(2), i32::from_le_bytes(r[27..31].try_into().unwrap()))
+        };
+        assert_eq!(vertex(0), (1.0, 2.0, 3.0, 1));
+        assert_eq!(vertex(1), (0.0, 0.0, 0.0, -1));
+        assert_eq!(vertex(2), (-4.0, 5.0, 6.5, 0));
+        assert_eq!(&bytes[header_end + 24..header_end + 27], &group_colour(1));
     }
 }
