@@ -89,6 +89,10 @@ fn main() {
             continue;
         };
         let material = material_of[surface];
+        if material == u32::MAX {
+            // A true surface with no triangle of its own has no material.
+            continue;
+        }
         if keep_true.iter().any(|k| *k == surfaces[surface]) {
             for t in scene.triangles().iter().filter(|t| t.surface as usize == surface) {
                 triangles.push(Triangle {

@@ -73,8 +73,9 @@ pub fn plane_pieces(
     let cos = NORMAL_DEG.to_radians().cos();
     let mut taken = vec![false; points.len()];
     let mut pieces = Vec::new();
-    let agrees = |i: usize, normal: &Vector3<f64>, on: &dyn Fn(&Vector3<f64>) -> f64| {
-        normals[i].dot(normal).abs() >= cos && on(&points[i]).abs() <= tolerance_m
+    // Point i agrees with the plane through `origin` with unit `normal`.
+    let agrees = |i: usize, origin: &Vector3<f64>, normal: &Vector3<f64>| {
+        normals[i].dot(normal).abs() >= cos && (points[i] - origin).dot(normal).abs() <= tolerance_m
     };
     while pieces.len() < MAX_PIECES {
         let remaining: Vec<usize> = (0..points.len()).filter(|&i| !taken[i]).collect();
@@ -88,10 +89,7 @@ pub fn plane_pieces(
             .filter(|&&s| normals[s].norm_squared() > 0.5)
             .map(|&s| {
                 let (p, n) = (points[s], normals[s]);
-                let count = remaining
-                    .iter()
-                    .filter(|&&i| agrees(i, &n, &|q| (q - p).dot(&n)))
-                    .count();
+                let count = remaining.iter().filter(|&&i| agrees(i, &p, &n)).count();
                 (count, s)
             })
             .max_by_key(|&(count, s)| (count, std::cmp::Reverse(s)));
@@ -100,11 +98,7 @@ pub fn plane_pieces(
             break;
         }
         let (p, n) = (points[seed], normals[seed]);
-        let mut members: Vec<usize> = remaining
-            .iter()
-            .copied()
-            .filter(|&i| agrees(i, &n, &|q| (q - p).dot(&n)))
-            .collect();
+        let mut members: Vec<usize> = remaining.iter().copied().filter(|&i| agrees(i, &p, &n)).collect();
         let mut plane = None;
         for _ in 0..2 {
             let pts: Vec<Vector3<f64>> = members.iter().map(|&i| points[i]).collect();
@@ -112,7 +106,7 @@ pub fn plane_pieces(
             members = remaining
                 .iter()
                 .copied()
-                .filter(|&i| agrees(i, &fit.normal, &|q| fit.distance(q)))
+                .filter(|&i| agrees(i, &fit.centroid, &fit.normal))
                 .collect();
             plane = Some(fit);
         }

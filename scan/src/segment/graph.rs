@@ -33,6 +33,15 @@ pub fn intensity_similarity(diff: f64, sigma_w: f64) -> f64 {
     if diff.is_nan() { 1.0 } else { similarity(diff, sigma_w) }
 }
 
+/// The variance of the difference of two means of `a` and `b` samples
+/// each of noise σ = `noise`: σ²(1/a + 1/b), a mean of no sample adding
+/// nothing (its intensity is NaN, which [`intensity_similarity`] takes as
+/// no evidence).
+pub fn mean_difference_variance(noise: f64, a: u32, b: u32) -> f64 {
+    let inverse = |n: u32| if n == 0 { 0.0 } else { 1.0 / f64::from(n) };
+    noise.powi(2) * (inverse(a) + inverse(b))
+}
+
 /// Eq. (2.4): P(u, v) = exp(−dist²(u, v) / 2σ_c²).
 pub fn proximity(dist: f64, sigma_c: f64) -> f64 {
     (-dist * dist / (2.0 * sigma_c * sigma_c)).exp()
@@ -144,16 +153,18 @@ impl CellGrid {
 pub const LEVELS: usize = 7;
 
 /// The scale level of a point whose local spacing is `spacing` m, for
-/// clusters of `radius` m: 0 while a cluster of that radius still holds a
-/// dozen points (the spacing up to half the radius), then one more for each
-/// doubling of the spacing, up to `LEVELS − 1`.
+/// clusters of `radius` m: 0 while the spacing is at most the radius (a
+/// cluster then holds π (radius / spacing)² ≥ 3 points), then one more for
+/// each doubling of the spacing, up to `LEVELS − 1`. (Levels from half the
+/// radius on were tried first: on the simulated room's coarse scans they
+/// split the table off and the floor in three, 94.7 % against 95.8 %.)
 ///
 /// A scanner's points thin out with range (their spacing is the range
 /// times the beam step) and at grazing incidence. With one radius for all
 /// (§2.3.2), a tower 30 m away from scans whose median spacing is a few
 /// centimetres on the ground nearby gets one point per cluster, no edge
 /// within the edge radius, and falls apart into single points. With its
-/// level, every cluster holds about as many points wherever it is.
+/// level, a cluster keeps at least a few points wherever it is.
 pub fn scale_level(spacing: f64, radius: f64) -> u8 {
     if !(spacing.is_finite() && radius > 0.0) || spacing <= radius {
         return 0;
@@ -449,9 +460,11 @@ impl Graph {
     /// The variance of nodes `i` and `j`'s intensity difference from their
     /// own noise, σ²(1/n_i + 1/n_j).
     pub fn intensity_variance(&self, i: usize, j: usize) -> f64 {
-        let inverse = |n: u32| if n == 0 { 0.0 } else { 1.0 / f64::from(n) };
-        self.intensity_noise.powi(2)
-            * (inverse(self.nodes[i].intensity_points) + inverse(self.nodes[j].intensity_points))
+        mean_difference_variance(
+            self.intensity_noise,
+            self.nodes[i].intensity_points,
+            self.nodes[j].intensity_points,
+        )
     }
 
     /// S (eq. 2.3) between any two nodes for `pass`. For intensity, σ_w is
@@ -516,7 +529,8 @@ mod tests {
 
     #[test]
     fn scale_levels_double_with_the_spacing() {
-        // Clusters of 0.125 m: a dozen points each up to 0.125 m spacing.
+        // Clusters of 0.125 m: level 0 up to 0.125 m spacing, then one
+        // level per doubling.
         assert_eq!(scale_level(0.03, 0.125), 0);
         assert_eq!(scale_level(0.125, 0.125), 0);
         assert_eq!(scale_level(0.2, 0.125), 1);
@@ -530,7 +544,7 @@ mod tests {
     }
 
     #[test]
-    fn sparse_clusters_join_at_their_own_level_and_meet_the_dense_ones() {
+    fn sparse_points_cluster_at_their_own_level_apart_from_the_dense_ones() {
         // A line of points 0.02 m apart, then one 0.3 m apart: with one
         // radius (0.1 m) every far point would be a node of its own.
         let mut c = Clusterer::new(0.1, 20.0, 0.1);

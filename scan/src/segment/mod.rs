@@ -46,8 +46,8 @@ use crate::cloud::{Scan, ScanError};
 use crate::segmentation::{Segmentation, UNASSIGNED};
 use criterion::{Recursion, SplitRecord, segment_region};
 use graph::{
-    CellGrid, Clusterer, Graph, Node, Pass, anisotropic_distance, intensity_similarity, normal_angle, proximity,
-    scale_level, similarity,
+    CellGrid, Clusterer, Graph, Node, Pass, anisotropic_distance, intensity_similarity, mean_difference_variance,
+    normal_angle, proximity, scale_level, similarity,
 };
 use normals::{LocalSurface, ScanFigures};
 use params::{Choice, Overrides, ParameterError, Parameters};
@@ -416,8 +416,8 @@ pub fn segment(
                             * similarity(normal_angle(n, &node.normal), sigma_normal);
                         if intensity {
                             // The point's own noise and the node's mean's.
-                            let noise = final_params.intensity_noise.powi(2)
-                                * (1.0 + 1.0 / f64::from(node.intensity_points.max(1)));
+                            let noise =
+                                mean_difference_variance(final_params.intensity_noise, 1, node.intensity_points);
                             w *= intensity_similarity(
                                 intensity_of(scan_intensity, i) - node.intensity,
                                 (final_params.sigma_w_intensity.powi(2) + noise).sqrt(),

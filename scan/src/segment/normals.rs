@@ -98,8 +98,7 @@ pub struct LocalSurface {
     /// scale level, [`crate::segment::graph::scale_level`]).
     pub spacing_m: Vec<f32>,
     /// Per point, the cosine of the beam's incidence (from the scan's pose
-    /// and the point's normal); `None`
-    /// without a pose.
+    /// and the point's normal); `None` without a pose.
     pub incidence_cos: Option<Vec<f32>>,
     /// The scan's figures.
     pub figures: ScanFigures,
@@ -422,12 +421,13 @@ pub fn corrected_intensity(scan: &Scan, incidence_cos: Option<&[f32]>, correct: 
 /// The least-squares slope, through the origin, of Δ ln I on Δ ln cos over
 /// pairs of points five cells apart along the row and along the column
 /// ([`neighbourhoods`]' partners; for a cloud, the farthest of the
-/// nearest) whose
-/// normals agree within 5°, whose intensities are both above 0.02 and
-/// whose cosines are both above [`MIN_INCIDENCE_COS`] and differ by at
-/// least 2 %: one surface's reflectance cancels
-/// in each pair, so what is left is how the scanner's returns follow the
-/// incidence. `None` under 100 pairs.
+/// nearest) whose normals agree within 5°, whose intensities are both
+/// above 0.02 and whose cosines are both above [`MIN_INCIDENCE_COS`] and
+/// differ by at least 2 %: one surface's reflectance cancels in each pair,
+/// so what is left is how the scanner's returns follow the incidence.
+/// `None` under 100 pairs. Noisy normals attenuate it (errors in the
+/// variable): on 4 mm-spaced scans with 2 mm noise it reads 0.2–0.4 where
+/// coarser scans of the same scene read 0.9–1.0.
 fn incidence_slope(
     intensity: &[f32],
     cos: &[f32],
