@@ -44,6 +44,18 @@ fn simulated_room_scans_become_a_scene_that_can_be_edited() {
         assert_eq!(g["method"], "PlanarPolygon", "{g}");
         assert!(g["area_m2"].as_f64().unwrap() > 5.0, "{g}");
     }
+    // The two posters, 1 cm proud of the north wall, are layers of it, and
+    // the three spheres on the table are objects; the page lists them.
+    let segment: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("segment-report.json")).unwrap()).unwrap();
+    let layers = segment["layers"].as_array().unwrap();
+    assert_eq!(layers.len(), 2, "{segment}");
+    for l in layers {
+        assert!((l["offset_m"].as_f64().unwrap() - 0.01).abs() < 0.002, "{l}");
+    }
+    assert_eq!(segment["objects"].as_array().unwrap().len(), 3, "{segment}");
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(page.contains("<h2>Layers and objects</h2>") && page.contains("layer of surface_"));
     let check = campanile_exits(&["config", "check", out.join("scene.ron").to_str().unwrap()], 0);
     assert!(check.contains("surface_0"), "{check}");
 

@@ -93,6 +93,8 @@ pub struct ReconstructionReport {
     pub height_field: usize,
     /// Groups meshed by ball pivoting.
     pub ball_pivoting: usize,
+    /// Groups meshed as spheres.
+    pub spheres: usize,
     /// Groups left out for having too few points.
     pub skipped: usize,
     /// Triangles before simplification, all groups.
@@ -235,6 +237,26 @@ pub fn reconstruct(
                 ),
             );
         }
+        if let Some(ball) = &m.sphere {
+            judge(
+                Verdict::Ok,
+                format!(
+                    "a sphere of radius {:.3} m: {:.1} % of the points within {:.1} mm RMS",
+                    ball.radius,
+                    100.0 * ball.inliers,
+                    1000.0 * ball.rms_m
+                ),
+            );
+        }
+        if m.corners_moved > 0 {
+            judge(
+                Verdict::Ok,
+                format!(
+                    "{} outline corners closed onto the planes of the groups it meets",
+                    m.corners_moved
+                ),
+            );
+        }
         if m.mesh.is_empty() {
             // A speck or a line of points (edge pixels a group of their own)
             // loses little; a real share of the scan lost is a failure.
@@ -297,6 +319,7 @@ pub fn reconstruct(
         scan_grid: count(MeshMethod::ScanGrid),
         height_field: count(MeshMethod::HeightField),
         ball_pivoting: count(MeshMethod::BallPivoting),
+        spheres: count(MeshMethod::Sphere),
         skipped: count(MeshMethod::TooFewPoints),
         triangles_before: groups.iter().map(|g| g.triangles_before).sum(),
         triangles_after: groups.iter().map(|g| g.triangles_after).sum(),
@@ -439,10 +462,14 @@ mod tests {
         // seen by the second: the truth's farthest point from the mesh goes
         // from 0.82 m to 0.40 m (what is left: under the cabinet and where
         // both shadows overlap), the mean distance from 5.8 to 1.4 mm, the
-        // area from 10.54 to 10.79 m².
+        // area from 10.77 to 10.93 m². (Before outlines were closed up to
+        // the walls (`mesh::corners`), 10.54 to 10.79: the second scan also
+        // reached more of the band along the walls that one scan misses at
+        // grazing angles, which both now reach by the closing; what is left
+        // is the shadow.)
         assert!(h2.reference_to_mesh_m < h1.reference_to_mesh_m - 0.3, "{h1:?} {h2:?}");
         assert!(h2.mean_m * 3.0 < h1.mean_m, "{h1:?} {h2:?}");
-        assert!(f2.area_m2 > f1.area_m2 + 0.2);
+        assert!(f2.area_m2 > f1.area_m2 + 0.12, "{} {}", f1.area_m2, f2.area_m2);
         assert_eq!(two.verdict, Verdict::Ok);
     }
 

@@ -186,7 +186,7 @@ fn report_page(run: &SceneRun, inputs: &[PathBuf], views: &[PathBuf]) -> String 
     let _ = write!(
         h,
         "<p>Segmentation <b>{}</b>: {} groups from {} points ({} unassigned), {}.<br>Meshes <b>{}</b>: \
-         {} triangles ({} before simplification); {} planar, {} from scan order, {} height fields, {} ball pivoting, {} skipped.</p>",
+         {} triangles ({} before simplification); {} planar, {} spheres, {} from scan order, {} height fields, {} ball pivoting, {} skipped.</p>",
         verdict_text(s.verdict),
         s.groups,
         s.points,
@@ -196,6 +196,7 @@ fn report_page(run: &SceneRun, inputs: &[PathBuf], views: &[PathBuf]) -> String 
         m.triangles_after,
         m.triangles_before,
         m.planar,
+        m.spheres,
         m.scan_grid,
         m.height_field,
         m.ball_pivoting,
@@ -234,6 +235,34 @@ fn report_page(run: &SceneRun, inputs: &[PathBuf], views: &[PathBuf]) -> String 
         );
     }
     h.push_str("</table>");
+    if !s.layers.is_empty() || !s.objects.is_empty() {
+        h.push_str(
+            "<h2>Layers and objects</h2><p>Layers stand proud of a plane or are set into it (posters, boards); \
+             objects are points no cluster held, lying together (small things).</p>\
+             <table><tr><th>group</th><th>kind</th><th>points</th><th>figures</th></tr>",
+        );
+        for l in &s.layers {
+            let _ = write!(
+                h,
+                "<tr><td>{}</td><td>layer of {}</td><td>{}</td><td>step {:+.1} mm, spread {:.1} mm</td></tr>",
+                escape(&l.group),
+                escape(&l.from),
+                l.points,
+                1000.0 * l.offset_m,
+                1000.0 * l.spread_m
+            );
+        }
+        for o in &s.objects {
+            let _ = write!(
+                h,
+                "<tr><td>{}</td><td>object</td><td>{}</td><td>{:.2} m across</td></tr>",
+                escape(&o.group),
+                o.points,
+                o.extent_m
+            );
+        }
+        h.push_str("</table>");
+    }
     if !s.targets.is_empty() {
         h.push_str(
             "<h2>Calibration targets</h2><table><tr><th>scan</th><th>centre</th><th>normal</th><th>radius m</th></tr>",

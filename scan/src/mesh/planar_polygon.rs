@@ -2,7 +2,10 @@
 //! points projected into it, their outline with holes ([`AlphaShape`]),
 //! simplified within a tolerance and triangulated by ear clipping. Most of
 //! a building and of a room are planar (thesis §2.5.1 fits "a single plane"
-//! to the floor); a polygon is their smallest exact mesh.
+//! to the floor); a polygon is their smallest exact mesh. Edges shared with
+//! another surface are then closed ([`super::corners`]); free edges stay at
+//! the outermost points (on average about half a spacing inside the
+//! surface's true edge).
 
 use nalgebra::Vector3;
 
@@ -17,20 +20,24 @@ pub fn planar_polygon(
     plane: &PlaneFit,
     alpha_factor: f64,
     tolerance_m: f64,
-) -> (TriangleMesh, Option<AlphaShape>) {
+) -> (TriangleMesh, Option<AlphaShape>, Vec<bool>) {
     let flat: Vec<[f64; 2]> = points.iter().map(|p| plane.project(p)).collect();
     let Some(shape) = AlphaShape::of(&flat, alpha_factor) else {
-        return (TriangleMesh::default(), None);
+        return (TriangleMesh::default(), None, Vec::new());
     };
     let mut mesh = TriangleMesh::default();
+    let mut outer = Vec::new();
     for polygon in shape.polygons(&flat, tolerance_m) {
         let (corners, triangles) = triangulate(&polygon);
+        // `triangulate` lists the outline's corners first, then the holes'.
+        let outline = polygon.exterior().0.len().saturating_sub(1);
+        outer.extend((0..corners.len()).map(|k| k < outline));
         mesh.append(&TriangleMesh {
             positions: corners.into_iter().map(|q| plane.lift(q)).collect(),
             triangles,
         });
     }
-    (mesh, Some(shape))
+    (mesh, Some(shape), outer)
 }
 
 #[cfg(test)]
@@ -49,7 +56,10 @@ mod tests {
         let viewpoint = Vector3::zeros();
         let plane = PlaneFit::of(&points).unwrap().facing(&viewpoint);
         assert!((plane.rms_m - 0.003).abs() < 1e-4, "{}", plane.rms_m);
-        let (mesh, shape) = planar_polygon(&points, &plane, 3.0, 0.005);
+        let (mesh, shape, outer) = planar_polygon(&points, &plane, 3.0, 0.005);
+        // The outline's 4 corners (a square) come first, then the hole's.
+        assert_eq!(outer.iter().filter(|o| **o).count(), 4, "{outer:?}");
+        assert!(outer[..4].iter().all(|o| *o), "{outer:?}");
         assert_eq!(shape.unwrap().rings.len(), 2);
         // Area within 2 % of 0.84 m² (the noise tilts the fitted plane a little).
         assert!((mesh.area() / 0.84 - 1.0).abs() < 0.02, "{}", mesh.area());

@@ -45,7 +45,19 @@ pub struct Metrics {
     pub boundary_median_m: Option<f64>,
     /// Found boundary points.
     pub boundary_points: usize,
+    /// The share of them within [`BOUNDARY_TOLERANCE_M`] of a true
+    /// boundary point (`None` when nothing was found as boundary): how many
+    /// found boundaries are real.
+    pub boundary_within: Option<f64>,
+    /// The share of the true boundary points within
+    /// [`BOUNDARY_TOLERANCE_M`] of a found boundary point (`None` when the
+    /// truth has no boundary or nothing was found as one): how many real
+    /// boundaries were found, and where (the peers' bench measures this).
+    pub true_boundary_found: Option<f64>,
 }
+
+/// The boundary tolerance the issue asks for (2 cm).
+pub const BOUNDARY_TOLERANCE_M: f64 = 0.02;
 
 /// Why two segmentations cannot be compared.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -212,6 +224,16 @@ pub fn compare(scans: &[Scan], found: &Segmentation, truth: &Segmentation) -> Re
     };
     let boundary_mean_m = (!distances.is_empty()).then(|| distances.iter().sum::<f64>() / distances.len() as f64);
     let boundary_points = distances.len();
+    let true_boundary_found = (!true_boundary.is_empty() && !found_boundary.is_empty()).then(|| {
+        let tree = point_tree(&found_boundary);
+        let near = true_boundary
+            .iter()
+            .filter(|p| nearest(&tree, p, 1)[0].0 <= BOUNDARY_TOLERANCE_M)
+            .count();
+        near as f64 / true_boundary.len() as f64
+    });
+    let boundary_within = (!distances.is_empty())
+        .then(|| distances.iter().filter(|&&d| d <= BOUNDARY_TOLERANCE_M).count() as f64 / distances.len() as f64);
     let boundary_median_m = (!distances.is_empty()).then(|| median(distances));
     Ok(Metrics {
         points,
@@ -223,6 +245,8 @@ pub fn compare(scans: &[Scan], found: &Segmentation, truth: &Segmentation) -> Re
         boundary_mean_m,
         boundary_median_m,
         boundary_points,
+        boundary_within,
+        true_boundary_found,
     })
 }
 
@@ -230,6 +254,34 @@ pub fn compare(scans: &[Scan], found: &Segmentation, truth: &Segmentation) -> Re
 mod tests {
     use super::*;
     use nalgebra::Vector3;
+
+    #[test]
+    fn boundaries_are_scored_both_ways_within_two_centimetres() {
+        // 100 points 8 mm apart on a line, each with its 6 nearest as
+        // neighbours; truth a | b between points 49 and 50, so points 47–52
+        // are next to the true boundary.
+        let scan = Scan::from_positions(
+            "line",
+            (0..100).map(|i| Vector3::new(i as f64 * 0.008, 0.0, 0.0)).collect(),
+        );
+        let truth = Segmentation {
+            labels: vec![(0..100).map(|i| u32::from(i >= 50)).collect()],
+            names: vec!["a".into(), "b".into()],
+        };
+        // Found: the boundary 5 points early (42–47 next to it) and a
+        // spurious one between 79 and 80 (77–82).
+        let found = Segmentation {
+            labels: vec![(0..100).map(|i| u32::from(i >= 45) + u32::from(i >= 80)).collect()],
+            names: vec!["s0".into(), "s1".into(), "s2".into()],
+        };
+        let m = compare(std::slice::from_ref(&scan), &found, &truth).unwrap();
+        // True boundary points 47, 48, 49 are within 2 spacings (16 mm) of a
+        // found one; 50–52 are 3–5 spacings off: 3 of 6.
+        assert_eq!(m.true_boundary_found, Some(0.5));
+        // Found 45, 46, 47 are that near a true one; 42–44 and the spurious
+        // 77–82 are not: 3 of 12.
+        assert_eq!(m.boundary_within, Some(0.25));
+    }
 
     #[test]
     fn a_merge_and_a_split_are_counted_and_the_right_fraction_is_exact() {
@@ -254,6 +306,8 @@ mod tests {
         let same = compare(std::slice::from_ref(&scan), &truth, &truth).unwrap();
         assert_eq!(same.right_fraction, 1.0);
         assert_eq!(same.boundary_mean_m, Some(0.0));
+        assert_eq!(same.boundary_within, Some(1.0));
+        assert_eq!(same.true_boundary_found, Some(1.0));
         // A wrong shape is refused.
         let short = Segmentation {
             labels: vec![vec![0; 9]],

@@ -32,7 +32,9 @@ pub mod criterion;
 pub mod graph;
 pub mod metrics;
 pub mod normals;
+pub mod objects;
 pub mod params;
+pub mod relief;
 pub mod room_fixture;
 pub mod targets;
 
@@ -50,7 +52,9 @@ use graph::{
     normal_angle, proximity, scale_level, similarity,
 };
 use normals::{LocalSurface, ScanFigures};
+use objects::Object;
 use params::{Choice, Overrides, ParameterError, Parameters};
+use relief::{Layer, ReliefSettings};
 use targets::Target;
 
 /// Where the segmentation is, for a progress bar.
@@ -107,6 +111,12 @@ pub struct SegmentReport {
     pub sizes: Vec<usize>,
     /// Groups dissolved for being under `min_group_points` points.
     pub dissolved_groups: usize,
+    /// Layers split from a plane's group ([`relief`]).
+    #[serde(default)]
+    pub layers: Vec<Layer>,
+    /// Groups made of points no cluster held ([`objects`]).
+    #[serde(default)]
+    pub objects: Vec<Object>,
     /// Points in no group.
     pub unassigned: usize,
     /// Points in all.
@@ -391,7 +401,7 @@ pub fn segment(
         }
     }
     let sigma_normal = final_params.sigma_w_normal_deg.to_radians();
-    let raw_labels: Vec<Vec<u32>> = scans
+    let mut raw_labels: Vec<Vec<u32>> = scans
         .iter()
         .zip(&surfaces)
         .zip(&final_node_of)
@@ -434,6 +444,31 @@ pub fn segment(
         .collect();
     lap("points", &mut stages);
 
+    let mut layers = if params.relief {
+        progress(Progress {
+            stage: "relief",
+            done: 0,
+            total: group_count,
+        });
+        let settings = ReliefSettings {
+            noise_m: figures.noise_m,
+            step_m: params.relief_step_m,
+            min_points: params.min_group_points,
+        };
+        relief::split_layers(scans, &surfaces, &mut raw_labels, group_count, &settings)
+    } else {
+        Vec::new()
+    };
+    let group_count = group_count + layers.len();
+    lap("relief", &mut stages);
+    let mut objects = if params.objects {
+        objects::group_leftovers(scans, &mut raw_labels, group_count, params.min_group_points)
+    } else {
+        Vec::new()
+    };
+    let group_count = group_count + objects.len();
+    lap("objects", &mut stages);
+
     // Dense numbering, the largest group first.
     let mut sizes = vec![0usize; group_count];
     for &l in raw_labels.iter().flatten() {
@@ -459,6 +494,20 @@ pub fn segment(
         labels,
         names: (0..order.len()).map(|g| format!("surface_{g}")).collect(),
     };
+    let name = |raw: &str| {
+        raw.parse::<usize>()
+            .ok()
+            .and_then(|g| segmentation.names.get(renumber[g] as usize))
+            .cloned()
+            .unwrap_or_default()
+    };
+    for layer in &mut layers {
+        layer.from = name(&layer.from);
+        layer.group = name(&layer.group);
+    }
+    for object in &mut objects {
+        object.group = name(&object.group);
+    }
     let sizes = segmentation.sizes();
     let unassigned = points - sizes.iter().sum::<usize>();
 
@@ -509,6 +558,8 @@ pub fn segment(
         groups: sizes.len(),
         sizes,
         dissolved_groups,
+        layers,
+        objects,
         unassigned,
         points,
         targets,

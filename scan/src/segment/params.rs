@@ -41,6 +41,14 @@ pub struct Overrides {
     /// Divide intensities by the cosine of the beam's incidence
     /// ([`crate::segment::normals::corrected_intensity`]).
     pub correct_incidence: Option<bool>,
+    /// Split layers proud of a plane or set into it from its group
+    /// ([`crate::segment::relief`]).
+    pub relief: Option<bool>,
+    /// The least step such a layer stands off its plane, m.
+    pub relief_step_m: Option<f64>,
+    /// Make sets of unassigned points that lie together groups of their own
+    /// ([`crate::segment::objects`]).
+    pub objects: Option<bool>,
 }
 
 /// The parameters in force.
@@ -82,6 +90,14 @@ pub struct Parameters {
     /// One point's intensity noise (σ) as compared: a node of n points
     /// knows its mean to σ/√n, which widens eq. 2.3's σ_w on its edges.
     pub intensity_noise: f64,
+    /// Split layers proud of a plane or set into it from its group
+    /// ([`crate::segment::relief`]).
+    pub relief: bool,
+    /// The least step such a layer stands off its plane, m.
+    pub relief_step_m: f64,
+    /// Make sets of unassigned points that lie together groups of their own
+    /// ([`crate::segment::objects`]).
+    pub objects: bool,
 }
 
 /// The range of σ_w for normals, degrees.
@@ -223,6 +239,26 @@ impl Parameters {
             30.0,
             "30 points: smaller groups are clutter and edge pixels".into(),
         );
+        let relief = pick(
+            "relief",
+            overrides.relief.map(|r| f64::from(u8::from(r))),
+            1.0,
+            "layers proud of a plane (posters, boards) are split from its group".into(),
+        ) > 0.5;
+        let relief_step_m = pick(
+            "relief_step_m",
+            overrides.relief_step_m,
+            2.0 * noise,
+            format!(
+                "2 × noise {noise:.4} m: a layer's median point stands this far off its plane; cells of about 10 points see it at 5 standard errors or more"
+            ),
+        );
+        let objects = pick(
+            "objects",
+            overrides.objects.map(|o| f64::from(u8::from(o))),
+            1.0,
+            "unassigned points within 2.5 spacings of each other, at least min_group_points of them, make a group: objects smaller than a cluster".into(),
+        ) > 0.5;
         let parameters = Parameters {
             cluster_radius_m: radius,
             cluster_normal_deg: cluster_normal,
@@ -241,6 +277,9 @@ impl Parameters {
             seed: overrides.seed.unwrap_or(28),
             correct_incidence,
             intensity_noise: inoise,
+            relief,
+            relief_step_m,
+            objects,
         };
         parameters.check()?;
         Ok((parameters, choices))
@@ -264,6 +303,13 @@ impl Parameters {
                     expected: "a finite number above 0",
                 });
             }
+        }
+        if !(self.relief_step_m.is_finite() && self.relief_step_m >= 0.0) {
+            return Err(ParameterError {
+                name: "relief_step_m",
+                value: self.relief_step_m,
+                expected: "a finite number ≥ 0, in metres",
+            });
         }
         if !(self.anisotropy.is_finite() && self.anisotropy >= 1.0) {
             return Err(ParameterError {

@@ -1,0 +1,279 @@
+//! Groups that are spheres: a least-squares sphere and a tessellated mesh
+//! of it.
+//!
+//! A ball on a table, a lamp's globe, a dome: a few hundred points of a
+//! curved surface meshed in scan order give one partial, noisy shell per
+//! scan, overlapping and spiked by the mixed pixels at the silhouette; a
+//! renderer then sees the wrong normals and the wrong outline. When a
+//! curved group's points lie on a sphere within the planar tolerance
+//! ([`super::MeshOptions::planar_rms_m`]: the same noise figure), the
+//! sphere is the better model, and the one the scene needs. The fit is
+//! started from the sphere through four of the points with the least median
+//! distance to all (300 seeded draws), refined by Gauss–Newton on the
+//! geometric distance |p − c| − r (a four-point sphere is Kåsa's algebraic
+//! |p|² + D·p + E = 0, linear), refitted
+//! three times on the 80 % of the points nearest it (stray points pull the
+//! first fit off) and three times on the points within 3 σ of it (σ from
+//! the median absolute residual). It is kept when at least [`INLIER_SHARE`] of the
+//! points are within, their RMS is within the tolerance, and the points
+//! span at least a radius across (a cap of 60° or more, so that the radius
+//! is measured rather than guessed).
+
+use nalgebra::{Matrix4, Vector3, Vector4};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::TriangleMesh;
+
+/// The share of a group's points that must lie on its sphere.
+pub const INLIER_SHARE: f64 = 0.8;
+/// Refits on the nearest [`INLIER_SHARE`] of the points, then as many
+/// without the points beyond 3 σ.
+const REFITS: usize = 3;
+/// Gauss–Newton steps per fit.
+const STEPS: usize = 10;
+/// Four-point spheres tried for the start.
+const TRIALS: usize = 300;
+
+/// A sphere fitted to points.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SphereFit {
+    /// Centre, metres.
+    pub centre: Vector3<f64>,
+    /// Radius, metres.
+    pub radius: f64,
+    /// RMS geometric residual of the points kept, metres.
+    pub rms_m: f64,
+    /// The share of the points kept.
+    pub inliers: f64,
+}
+
+/// The algebraic sphere through `points`; `None` when degenerate.
+fn algebraic(points: &[Vector3<f64>]) -> Option<(Vector3<f64>, f64)> {
+    // Centred for conditioning.
+    let mean = points.iter().sum::<Vector3<f64>>() / points.len() as f64;
+    let mut ata = Matrix4::zeros();
+    let mut atb = Vector4::zeros();
+    for p in points {
+        let q = p - mean;
+        let row = Vector4::new(q.x, q.y, q.z, 1.0);
+        ata += row * row.transpose();
+        atb -= row * q.norm_squared();
+    }
+    let x = ata.lu().solve(&atb)?;
+    let centre = Vector3::new(-x[0] / 2.0, -x[1] / 2.0, -x[2] / 2.0);
+    let r2 = centre.norm_squared() - x[3];
+    (r2 > 0.0 && r2.is_finite()).then(|| (centre + mean, r2.sqrt()))
+}
+
+/// The sphere through four of `points` whose median distance to all of
+/// them is least, over [`TRIALS`] seeded draws (least median of squares:
+/// stray points, under half of them, do not move it).
+fn least_median(points: &[Vector3<f64>]) -> Option<(Vector3<f64>, f64)> {
+    let mut rng = ChaCha8Rng::seed_from_u64(points.len() as u64);
+    let mut best: Option<(f64, (Vector3<f64>, f64))> = None;
+    let mut deviations = vec![0.0; points.len()];
+    for _ in 0..TRIALS {
+        let four: Vec<Vector3<f64>> = (0..4).map(|_| points[rng.random_range(0..points.len())]).collect();
+        let Some((c, r)) = algebraic(&four) else { continue };
+        for (d, p) in deviations.iter_mut().zip(points) {
+            *d = ((p - c).norm() - r).abs();
+        }
+        let mid = deviations.len() / 2;
+        let median = *deviations.select_nth_unstable_by(mid, f64::total_cmp).1;
+        if median.is_finite() && best.is_none_or(|(m, _)| median < m) {
+            best = Some((median, (c, r)));
+        }
+    }
+    best.map(|(_, sphere)| sphere)
+}
+
+/// Gauss–Newton on |p − c| − r from `start`.
+fn refine(points: &[Vector3<f64>], (mut c, mut r): (Vector3<f64>, f64)) -> (Vector3<f64>, f64) {
+    for _ in 0..STEPS {
+        let mut jtj = Matrix4::zeros();
+        let mut jtr = Vector4::zeros();
+        for p in points {
+            let d = p - c;
+            let n = d.norm();
+            if n <= 0.0 {
+                continue;
+            }
+            let j = Vector4::new(-d.x / n, -d.y / n, -d.z / n, -1.0);
+            let res = n - r;
+            jtj += j * j.transpose();
+            jtr += j * res;
+        }
+        let Some(step) = jtj.lu().solve(&-jtr) else { break };
+        c += Vector3::new(step[0], step[1], step[2]);
+        r += step[3];
+        if step.norm() < 1e-9 {
+            break;
+        }
+    }
+    (c, r)
+}
+
+/// The sphere through `points` within `tolerance_m` RMS, or `None` when
+/// they are not a sphere (see the module's criteria).
+pub fn fit_sphere(points: &[Vector3<f64>], tolerance_m: f64) -> Option<SphereFit> {
+    if points.len() < 10 {
+        return None;
+    }
+    let (mut c, mut r) = least_median(points)?;
+    let mut kept: Vec<Vector3<f64>> = points.to_vec();
+    // First the nearest share of the points (stray points can pull the
+    // first fit far off, and a far-off fit's σ is large), then those
+    // within 3 σ.
+    for round in 0..2 * REFITS {
+        let mut deviations: Vec<f64> = points.iter().map(|p| ((p - c).norm() - r).abs()).collect();
+        let cut = if round < REFITS {
+            let k = ((INLIER_SHARE * points.len() as f64) as usize).min(points.len() - 1);
+            *deviations.select_nth_unstable_by(k, f64::total_cmp).1
+        } else {
+            let mid = deviations.len() / 2;
+            3.0 * (1.4826 * *deviations.select_nth_unstable_by(mid, f64::total_cmp).1).max(1e-6)
+        };
+        kept = points
+            .iter()
+            .copied()
+            .filter(|p| ((p - c).norm() - r).abs() <= cut)
+            .collect();
+        if kept.len() < 10 {
+            return None;
+        }
+        (c, r) = refine(&kept, (c, r));
+    }
+    let rms = (kept.iter().map(|p| ((p - c).norm() - r).powi(2)).sum::<f64>() / kept.len() as f64).sqrt();
+    let inliers = kept.len() as f64 / points.len() as f64;
+    let (lo, hi) = kept
+        .iter()
+        .fold((kept[0], kept[0]), |(lo, hi), p| (lo.inf(p), hi.sup(p)));
+    let ok = r.is_finite() && r > 0.0 && rms <= tolerance_m && inliers >= INLIER_SHARE && (hi - lo).max() >= r;
+    ok.then_some(SphereFit {
+        centre: c,
+        radius: r,
+        rms_m: rms,
+        inliers,
+    })
+}
+
+/// A UV sphere of `rings` × `2 rings` quads (triangles at the poles),
+/// normals outward.
+pub fn sphere_mesh(sphere: &SphereFit, rings: usize) -> TriangleMesh {
+    let rings = rings.max(2);
+    let segments = 2 * rings;
+    let mut mesh = TriangleMesh::default();
+    let point = |i: usize, j: usize| {
+        let theta = std::f64::consts::PI * i as f64 / rings as f64;
+        let phi = 2.0 * std::f64::consts::PI * j as f64 / segments as f64;
+        sphere.centre + sphere.radius * Vector3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
+    };
+    // Poles once, rings between.
+    mesh.positions.push(point(0, 0));
+    for i in 1..rings {
+        for j in 0..segments {
+            mesh.positions.push(point(i, j));
+        }
+    }
+    mesh.positions.push(point(rings, 0));
+    let south = (mesh.positions.len() - 1) as u32;
+    let at = |i: usize, j: usize| (1 + (i - 1) * segments + j % segments) as u32;
+    for j in 0..segments {
+        mesh.triangles.push([0, at(1, j), at(1, j + 1)]);
+        mesh.triangles.push([at(rings - 1, j), south, at(rings - 1, j + 1)]);
+    }
+    for i in 1..rings - 1 {
+        for j in 0..segments {
+            mesh.triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            mesh.triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    mesh
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand_distr::{Distribution, Normal};
+
+    /// Points on the near half of a 20 cm ball, 3 mm noise, and `mixed`
+    /// stray points between it and a wall 2 m behind.
+    fn ball(mixed: usize) -> Vec<Vector3<f64>> {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let noise = Normal::new(0.0, 0.003).unwrap();
+        let centre = Vector3::new(2.0, 1.8, 0.95);
+        let mut points = Vec::new();
+        for _ in 0..200 {
+            let (u, v): (f64, f64) = (rng.random_range(0.0..1.0), rng.random_range(0.0..1.0));
+            let z = v * 2.0 - 1.0;
+            let phi = std::f64::consts::PI * (1.0 + u);
+            let d = Vector3::new((1.0 - z * z).sqrt() * phi.cos(), (1.0 - z * z).sqrt() * phi.sin(), z);
+            points.push(centre + (0.2 + noise.sample(&mut rng)) * d);
+        }
+        for _ in 0..mixed {
+            points.push(centre + Vector3::new(rng.random_range(-0.2..0.2), rng.random_range(0.3..2.0), 0.0));
+        }
+        points
+    }
+
+    #[test]
+    fn a_noisy_half_ball_with_stray_points_is_its_sphere() {
+        let fit = fit_sphere(&ball(15), 0.01).unwrap();
+        assert!((fit.centre - Vector3::new(2.0, 1.8, 0.95)).norm() < 0.002, "{fit:?}");
+        assert!((fit.radius - 0.2).abs() < 0.002, "{fit:?}");
+        assert!(fit.rms_m < 0.0035, "{fit:?}");
+        // The 15 stray points of 215 are left out.
+        assert!((fit.inliers - 200.0 / 215.0).abs() < 0.01, "{fit:?}");
+        let mesh = sphere_mesh(&fit, 12);
+        assert_eq!(mesh.triangles.len(), 2 * 24 + 2 * 24 * 10);
+        // Area within 2 % of 4πr² (the facets' sagitta), normals outward.
+        let area = mesh.area();
+        assert!(
+            (area / (4.0 * std::f64::consts::PI * fit.radius.powi(2)) - 1.0).abs() < 0.02,
+            "{area}"
+        );
+        for t in 0..mesh.triangles.len() {
+            let [a, b, c] = mesh.corners(t);
+            assert!(
+                mesh.area_normal(t).dot(&((a + b + c) / 3.0 - fit.centre)) > 0.0,
+                "triangle {t}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_plane_a_cylinder_and_a_small_cap_are_not_spheres() {
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let noise = Normal::new(0.0, 0.003).unwrap();
+        let plane: Vec<Vector3<f64>> = (0..200)
+            .map(|_| {
+                Vector3::new(
+                    rng.random_range(0.0..1.0),
+                    rng.random_range(0.0..1.0),
+                    noise.sample(&mut rng),
+                )
+            })
+            .collect();
+        assert!(fit_sphere(&plane, 0.01).is_none());
+        // A cylinder of 20 cm radius, 1 m long, its near half.
+        let cylinder: Vec<Vector3<f64>> = (0..300)
+            .map(|_| {
+                let a = rng.random_range(0.0..std::f64::consts::PI);
+                Vector3::new(0.2 * a.cos(), 0.2 * a.sin(), rng.random_range(0.0..1.0))
+            })
+            .collect();
+        assert!(fit_sphere(&cylinder, 0.01).is_none());
+        // A 20° cap of a 1 m sphere: 35 cm across, under a radius.
+        let cap: Vec<Vector3<f64>> = (0..200)
+            .map(|_| {
+                let (t, p) = (
+                    rng.random_range(0.0..0.17f64),
+                    rng.random_range(0.0..std::f64::consts::TAU),
+                );
+                (1.0 + noise.sample(&mut rng)) * Vector3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
+            })
+            .collect();
+        assert!(fit_sphere(&cap, 0.01).is_none());
+    }
+}
