@@ -24,10 +24,10 @@ use campanile_scan::mesh::{MeshOptions, mesh_groups};
 use campanile_scan::segment::metrics::compare;
 use campanile_scan::segment::params::Overrides;
 use campanile_scan::segment::segment;
-use campanile_scan::segmentation::UNASSIGNED;
 use campanile_sim::world::igi_photograph::PhotoSettings;
 use campanile_sim::world::range_scanner::{ScannerSettings, room_poses, scan_scene};
 use campanile_sim::world::room_igi::{ROOM_BOUNCES, RoomIgi};
+use campanile_sim::world::scanned_scene::{Majority, majority_surfaces};
 
 fn fail(message: String) -> ! {
     eprintln!("{message}");
@@ -65,14 +65,7 @@ fn main() {
 
     // Each group's majority true surface.
     let surfaces = scene.surfaces();
-    let mut votes = vec![vec![0usize; surfaces.len()]; found.groups()];
-    for (labels, truth) in found.labels.iter().zip(&scans.truth.labels) {
-        for (&g, &s) in labels.iter().zip(truth) {
-            if g != UNASSIGNED && s != UNASSIGNED {
-                votes[g as usize][s as usize] += 1;
-            }
-        }
-    }
+    let majority = majority_surfaces(&found, &scans.truth);
     // The error budget's knob: these true surfaces keep their true
     // triangles in place of their groups' meshes.
     let keep_true: Vec<String> = std::env::var("CAMPANILE_TRUE_SURFACES")
@@ -80,12 +73,7 @@ fn main() {
         .unwrap_or_default();
     let mut triangles = Vec::new();
     for mesh in &meshes {
-        let Some((surface, _)) = votes[mesh.group as usize]
-            .iter()
-            .enumerate()
-            .max_by_key(|(_, c)| **c)
-            .filter(|(_, c)| **c > 0)
-        else {
+        let Some(Some(Majority { surface, .. })) = majority.get(mesh.group as usize).copied() else {
             continue;
         };
         let material = material_of[surface];

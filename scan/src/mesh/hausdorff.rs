@@ -109,12 +109,7 @@ fn samples(mesh: &TriangleMesh, spacing: f64) -> Vec<Vector3<f64>> {
 
 /// The closest point to `p` of triangle `a b c` (Ericson, *Real-Time
 /// Collision Detection*, §5.1.5).
-pub(crate) fn closest_on_triangle(
-    p: &Vector3<f64>,
-    a: &Vector3<f64>,
-    b: &Vector3<f64>,
-    c: &Vector3<f64>,
-) -> Vector3<f64> {
+pub fn closest_on_triangle(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>, c: &Vector3<f64>) -> Vector3<f64> {
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
     if d1 <= 0.0 && d2 <= 0.0 {

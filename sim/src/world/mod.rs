@@ -14,10 +14,12 @@ pub mod range_scanner;
 pub mod range_truth;
 pub mod rig;
 pub mod room_igi;
+pub mod scanned_scene;
 pub mod scene_file;
 pub mod sun_track;
 pub mod target_photos;
 pub mod texture_truth;
+pub mod tower_from_scans;
 pub mod truth;
 pub mod zoom_truth;
 
