@@ -82,7 +82,9 @@ pub struct MeshOptions {
     /// this many times the points' spacing (default 6): a gap wider than
     /// that becomes a hole.
     pub outline_alpha_factor: f64,
-    /// Outlines are simplified within this distance, metres (default 0.01).
+    /// Outlines are simplified within this distance, metres (default 0.01),
+    /// or within half the points' spacing where that is more (an outline
+    /// is not known closer).
     pub outline_tolerance_m: f64,
     /// Curved meshes are simplified until the next collapse would move the
     /// surface more than this, metres (default 0.005; 0 keeps every

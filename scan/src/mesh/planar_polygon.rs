@@ -27,7 +27,11 @@ pub fn planar_polygon(
     };
     let mut mesh = TriangleMesh::default();
     let mut outer = Vec::new();
-    for polygon in shape.polygons(&flat, tolerance_m) {
+    // An outline cannot be known closer than the points' spacing: simplify
+    // within half of it at least, so that a wall sampled a metre apart is a
+    // few corners, not a jag at every point.
+    let tolerance = tolerance_m.max(0.5 * shape.spacing);
+    for polygon in shape.polygons(&flat, tolerance) {
         let (corners, triangles) = triangulate(&polygon);
         // `triangulate` lists the outline's corners first, then the holes'.
         let outline = polygon.exterior().0.len().saturating_sub(1);

@@ -12,8 +12,8 @@
 //!
 //! 1. the group's plane, fitted robustly (points within 3 σ of it, σ from
 //!    the median absolute residual, refitted three times); a group that is
-//!    not a plane (under half its points within, or their RMS over twice
-//!    the scan's noise) is left alone;
+//!    not a plane (under half its points within, or that σ over twice the
+//!    scan's noise) is left alone;
 //! 2. the points binned on the plane into square cells of three point
 //!    spacings; a cell is **off the plane** when its mean residual is more
 //!    than five of its standard errors from 0 and at least half the step
@@ -176,7 +176,10 @@ fn robust_plane(positions: &[Vector3<f64>], noise_m: f64) -> Option<PlaneFit> {
         inside.extend(positions.iter().filter(|p| fit.distance(p).abs() <= 3.0 * sigma));
         fit = PlaneFit::of(&inside)?;
     }
-    let planar = 2 * inside.len() >= positions.len() && fit.rms_m <= 2.0 * noise_m;
+    // Judged by the median absolute residual: the layers it is looking
+    // for are within 3 σ and would inflate an RMS.
+    let spread = robust_spread(positions.iter().map(|p| fit.distance(p)), 0.0);
+    let planar = 2 * inside.len() >= positions.len() && spread <= 2.0 * noise_m;
     planar.then_some(fit)
 }
 
