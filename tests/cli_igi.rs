@@ -297,3 +297,31 @@ fn igi_refuses_bad_scene_files_by_field() {
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && e.contains("s.ron: line 2"), "{e}");
 }
+
+/// An error target that is not a fraction in (0, 1) is refused before any
+/// work, naming the flag and the value, with exit 2.
+#[test]
+fn an_error_target_out_of_range_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    for (args, shown) in [
+        (
+            vec!["igi", "s.ron", "--relight", "l.ron", "--error", "1.5"],
+            "--error 1.5",
+        ),
+        (
+            vec!["render", "--igi", "s.ron", "--lights", "l.ron", "--error", "0"],
+            "--error 0",
+        ),
+    ] {
+        let mut args = args;
+        args.extend(["--out", out.to_str().unwrap()]);
+        let o = campanile(&args);
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        assert!(
+            e.contains(shown) && e.contains("expected a fraction above 0 and below 1"),
+            "{e}"
+        );
+    }
+}

@@ -14,13 +14,14 @@ use campanile_process::exr_io::write_radiance_exr;
 use campanile_process::hdr::merge::RadianceMap;
 use campanile_process::igi::albedo_chart::{AlbedoMapIndex, LAYOUT_FILE, MapRecord, SkippedGroup, chart, origin_code};
 use campanile_process::igi::albedo_map::{AlbedoMap, AlbedoMapOptions};
+use campanile_process::igi::error_target::{ErrorTarget, ErrorTargetReport, relight_to_error};
 use campanile_process::igi::material_record::{records, seen_frame, variant_name};
 use campanile_process::igi::relight::{RelightSettings, relight};
 use campanile_process::igi::relit_scene::recovered_scene;
 use campanile_process::igi::scene_file::{LoadedIgiScene, WardVariantEntry, load};
 use campanile_process::igi::variant_choice::{VariantEvidence, describe, recover_each_variant};
-use campanile_process::igi::{IgiLight, IgiOptions, IgiResult, format_table};
-use campanile_process::quality::{QualityReport, gates};
+use campanile_process::igi::{IgiLight, IgiOptions, IgiResult, ViewCamera, format_table};
+use campanile_process::quality::{QualityReport, Verdict, gates};
 
 use crate::Result;
 use crate::progress::bar;
@@ -161,14 +162,40 @@ pub fn recover_loaded(loaded: LoadedIgiScene, quick: bool, choice: ModelChoice) 
 impl Recovered {
     /// The scene under `lights` from camera `camera` of the scene file.
     pub fn relight(&self, lights: &[IgiLight], camera: &str, quick: bool) -> Result<RadianceImage> {
-        let (_, cam) = self
-            .loaded
+        let cam = self.camera(camera)?;
+        let scene = recovered_scene(&self.loaded.input, &self.result).map_err(|e| anyhow!("{e}"))?;
+        Ok(relight(&scene, Some(&self.map), lights, cam, &settings(quick).2))
+    }
+
+    /// [`Recovered::relight`] with paths drawn until `target` is met
+    /// ([`campanile_process::igi::error_target`]); `done` ticks once per
+    /// block finished.
+    pub fn relight_to_error(
+        &self,
+        lights: &[IgiLight],
+        camera: &str,
+        target: &ErrorTarget,
+        done: &(dyn Fn() + Sync),
+    ) -> Result<(RadianceImage, ErrorTargetReport)> {
+        let cam = self.camera(camera)?;
+        let scene = recovered_scene(&self.loaded.input, &self.result).map_err(|e| anyhow!("{e}"))?;
+        relight_to_error(&scene, Some(&self.map), lights, cam, &settings(false).2, target, done)
+            .map_err(|e| crate::Error::input(e.to_string()))
+    }
+
+    /// Blocks of `target` in camera `camera`'s image.
+    pub fn blocks(&self, camera: &str, target: &ErrorTarget) -> Result<u64> {
+        let cam = self.camera(camera)?;
+        Ok((cam.width.div_ceil(target.block_px) * cam.height.div_ceil(target.block_px)) as u64)
+    }
+
+    fn camera(&self, camera: &str) -> Result<&ViewCamera> {
+        self.loaded
             .cameras
             .iter()
             .find(|(n, _)| n == camera)
-            .ok_or_else(|| anyhow!("no camera {camera:?} in the scene file"))?;
-        let scene = recovered_scene(&self.loaded.input, &self.result).map_err(|e| anyhow!("{e}"))?;
-        Ok(relight(&scene, Some(&self.map), lights, cam, &settings(quick).2))
+            .map(|(_, c)| c)
+            .ok_or_else(|| anyhow!("no camera {camera:?} in the scene file").into())
     }
 
     /// Names of the cameras that took the solver's images.
@@ -529,25 +556,55 @@ pub fn lights_file(path: &Path) -> Result<Vec<IgiLight>> {
 
 /// Renders the view `camera` (`None`: every photographed view) of the
 /// recovered scene under `lights` into `DIR/relit-VIEW.exr`, one line per
-/// view to `out`.
+/// view to `out`. With `error`, each view's paths are drawn until every
+/// 4 × 4 block's mean is known to that relative standard error
+/// ([`campanile_process::igi::error_target`]) and its line says how that
+/// went; returns the worst view's verdict (`ok` without a target).
 pub fn relight_views(
     r: &Recovered,
     lights: &[IgiLight],
     camera: Option<&str>,
     dir: &Path,
     quick: bool,
+    error: Option<f64>,
     out: &mut dyn Write,
-) -> Result<()> {
+) -> Result<Verdict> {
     let cameras = camera.map_or_else(|| r.image_cameras(), |c| vec![c.to_owned()]);
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let bar = bar(cameras.len() as u64, "relighting");
+    let target = error.map(ErrorTarget::new);
+    if let Some(t) = &target {
+        t.check().map_err(|e| crate::Error::input(format!("--error: {e}")))?;
+    }
+    let total = match &target {
+        Some(t) => cameras.iter().map(|c| r.blocks(c, t)).sum::<Result<u64>>()?,
+        None => cameras.len() as u64,
+    };
+    let bar = bar(
+        total,
+        if target.is_some() {
+            "relighting (blocks)"
+        } else {
+            "relighting"
+        },
+    );
+    let mut verdict = Verdict::Ok;
     for cam in cameras {
-        let img = r.relight(lights, &cam, quick)?;
         let path = dir.join(format!("relit-{cam}.exr"));
-        write_exr(&img, &path)?;
-        bar.inc(1);
-        bar.suspend(|| writeln!(out, "relit {}", path.display()))?;
+        let line = match &target {
+            Some(t) => {
+                let (img, report) = r.relight_to_error(lights, &cam, t, &|| bar.inc(1))?;
+                write_exr(&img, &path)?;
+                verdict = verdict.max(report.verdict);
+                format!("relit {}: {report}", path.display())
+            }
+            None => {
+                write_exr(&r.relight(lights, &cam, quick)?, &path)?;
+                bar.inc(1);
+                format!("relit {}", path.display())
+            }
+        };
+        bar.suspend(|| writeln!(out, "{line}"))?;
     }
     bar.finish_and_clear();
-    Ok(())
+    Ok(verdict)
 }

@@ -45,6 +45,15 @@ pub fn is_bad_input(cause: &(dyn std::error::Error + 'static)) -> bool {
 
 pub use campanile_session::error::shown;
 
+/// `--error F`: a relative standard error a relight can aim at (a fraction
+/// above 0 and below 1), or bad input naming the flag and the value.
+pub fn error_target(error: Option<f64>) -> anyhow::Result<()> {
+    match error.map(|e| (e, campanile_process::igi::error_target::ErrorTarget::new(e).check())) {
+        Some((e, Err(why))) => Err(bad_input(format!("--error {}: expected {}", shown(e), why.expected))),
+        _ => Ok(()),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -201,24 +201,29 @@ pub fn path_radiance(scene: &Scene, points: &[PointLight], ray: Ray, events: u32
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use rand::SeedableRng;
 
     use super::*;
     use crate::render::Texture;
 
-    /// The twelve inward-facing triangles of the cube [0, 1]³ (material 0).
-    fn unit_cube() -> Vec<Triangle> {
-        let v = |x: f64, y: f64, z: f64| Vector3::new(x, y, z);
-        let quads = [
+    /// The six faces of the cube [0, size]³, each a quad wound so that its
+    /// normal points inward.
+    pub(in crate::igi) fn cube_quads(size: f64) -> [[Vector3<f64>; 4]; 6] {
+        let v = |x: f64, y: f64, z: f64| Vector3::new(size * x, size * y, size * z);
+        [
             [v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.), v(0., 1., 0.)],
             [v(0., 0., 1.), v(0., 1., 1.), v(1., 1., 1.), v(1., 0., 1.)],
             [v(0., 0., 0.), v(0., 1., 0.), v(0., 1., 1.), v(0., 0., 1.)],
             [v(1., 0., 0.), v(1., 0., 1.), v(1., 1., 1.), v(1., 1., 0.)],
             [v(0., 0., 0.), v(0., 0., 1.), v(1., 0., 1.), v(1., 0., 0.)],
             [v(0., 1., 0.), v(1., 1., 0.), v(1., 1., 1.), v(0., 1., 1.)],
-        ];
-        quads
+        ]
+    }
+
+    /// The twelve inward-facing triangles of the cube [0, 1]³ (material 0).
+    fn unit_cube() -> Vec<Triangle> {
+        cube_quads(1.0)
             .iter()
             .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
             .filter_map(|t| Triangle::new(t, 0, 0))

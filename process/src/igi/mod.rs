@@ -14,7 +14,9 @@
 //!   [`highlight`]: highlight detection (Fig. 4.4); `recover`: the ΔS loop
 //!   and model choice; `stratified`: the strata of the Monte Carlo rays;
 //!   [`lamp_paths`]: light paths under point lamps (relighting, albedo
-//!   maps, the simulator's photographs).
+//!   maps, the simulator's photographs); [`relight`]: the room under new
+//!   lamps, and [`error_target`]: the same with paths drawn per block
+//!   until an error target is met.
 //!
 //! Ward normalization: the solver fits the lobe in the variant
 //! [`IgiOptions::variant`] names, by default
@@ -28,6 +30,7 @@ pub mod albedo_map;
 pub mod camera;
 mod delta_s;
 mod error;
+pub mod error_target;
 mod geometry;
 pub mod highlight;
 pub mod input;

@@ -86,16 +86,41 @@ fn pixel(
     settings: &RelightSettings,
     rng: &mut ChaCha8Rng,
 ) -> [f64; 3] {
+    match primary(scene, albedo, lights, ray) {
+        Primary::Radiance(l) => l,
+        Primary::Surface(v) => surface_radiance(
+            scene,
+            points,
+            &v,
+            (settings.indirect_samples, settings.max_bounces, true),
+            rng,
+        ),
+    }
+}
+
+/// What a camera ray sees first: a known radiance (a bulb, or nothing),
+/// or a surface whose light must be estimated.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Primary {
+    /// A bulb's radiance I / (π r²), or black where the ray leaves the scene.
+    Radiance([f64; 3]),
+    /// The first surface, with the recovered material there.
+    Surface(PathVertex),
+}
+
+/// The first thing `ray` meets (module doc): a bulb in view, nothing, or
+/// the surface vertex with the albedo map's ρd where given.
+pub(super) fn primary(scene: &Scene, albedo: Option<&AlbedoMap>, lights: &[IgiLight], ray: &Ray) -> Primary {
     let hit = scene.intersect(ray, f64::INFINITY);
     let limit = hit.map_or(f64::INFINITY, |h| h.t);
     if let Some(l) = lights
         .iter()
         .find(|l| l.radius > 0.0 && sphere_hit(&l.position, l.radius, ray, limit))
     {
-        return l.intensity.map(|i| i / (std::f64::consts::PI * l.radius * l.radius));
+        return Primary::Radiance(l.intensity.map(|i| i / (std::f64::consts::PI * l.radius * l.radius)));
     }
     let Some(hit) = hit else {
-        return [0.0; 3];
+        return Primary::Radiance([0.0; 3]);
     };
     let tri = &scene.triangles()[hit.triangle];
     let base = &scene.materials()[tri.material as usize];
@@ -108,14 +133,7 @@ fn pixel(
         },
         None => base.clone(),
     };
-    let v = PathVertex::at(&material, tri, &hit.point, -ray.direction);
-    surface_radiance(
-        scene,
-        points,
-        &v,
-        (settings.indirect_samples, settings.max_bounces, true),
-        rng,
-    )
+    Primary::Surface(PathVertex::at(&material, tri, &hit.point, -ray.direction))
 }
 
 /// Relative root-mean-square difference of `a` from `reference` over the
