@@ -257,7 +257,7 @@ impl Parameters {
             "objects",
             overrides.objects.map(|o| f64::from(u8::from(o))),
             1.0,
-            "unassigned points within 2.5 spacings of each other, at least min_group_points of them, make a group: objects smaller than a cluster".into(),
+            "unassigned points within twice their distance to their nearest unassigned neighbour of each other (both ways), at least min_group_points of them, make a group: objects smaller than a cluster".into(),
         ) > 0.5;
         let parameters = Parameters {
             cluster_radius_m: radius,
