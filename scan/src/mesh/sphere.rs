@@ -24,6 +24,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::TriangleMesh;
+use crate::segment::normals::robust_spread;
 
 /// The share of a group's points that must lie on its sphere.
 pub const INLIER_SHARE: f64 = 0.8;
@@ -121,7 +122,7 @@ pub fn fit_sphere(points: &[Vector3<f64>], tolerance_m: f64) -> Option<SphereFit
         return None;
     }
     let (mut c, mut r) = least_median(points)?;
-    let mut kept: Vec<Vector3<f64>> = points.to_vec();
+    let mut kept: Vec<Vector3<f64>> = Vec::new();
     // First the nearest share of the points (stray points can pull the
     // first fit far off, and a far-off fit's σ is large), then those
     // within 3 σ.
@@ -131,8 +132,7 @@ pub fn fit_sphere(points: &[Vector3<f64>], tolerance_m: f64) -> Option<SphereFit
             let k = ((INLIER_SHARE * points.len() as f64) as usize).min(points.len() - 1);
             *deviations.select_nth_unstable_by(k, f64::total_cmp).1
         } else {
-            let mid = deviations.len() / 2;
-            3.0 * (1.4826 * *deviations.select_nth_unstable_by(mid, f64::total_cmp).1).max(1e-6)
+            3.0 * robust_spread(deviations.into_iter(), 0.0).max(1e-6)
         };
         kept = points
             .iter()

@@ -444,7 +444,7 @@ pub fn segment(
         .collect();
     lap("points", &mut stages);
 
-    let mut layers = if params.relief {
+    let layers = if params.relief {
         progress(Progress {
             stage: "relief",
             done: 0,
@@ -461,7 +461,7 @@ pub fn segment(
     };
     let group_count = group_count + layers.len();
     lap("relief", &mut stages);
-    let mut objects = if params.objects {
+    let objects = if params.objects {
         objects::group_leftovers(scans, &mut raw_labels, group_count, params.min_group_points)
     } else {
         Vec::new()
@@ -494,20 +494,15 @@ pub fn segment(
         labels,
         names: (0..order.len()).map(|g| format!("surface_{g}")).collect(),
     };
-    let name = |raw: &str| {
-        raw.parse::<usize>()
-            .ok()
-            .and_then(|g| segmentation.names.get(renumber[g] as usize))
+    let name = |raw: u32| {
+        segmentation
+            .names
+            .get(renumber[raw as usize] as usize)
             .cloned()
             .unwrap_or_default()
     };
-    for layer in &mut layers {
-        layer.from = name(&layer.from);
-        layer.group = name(&layer.group);
-    }
-    for object in &mut objects {
-        object.group = name(&object.group);
-    }
+    let layers: Vec<Layer> = layers.iter().map(|l| l.named(name)).collect();
+    let objects: Vec<Object> = objects.iter().map(|o| o.named(name)).collect();
     let sizes = segmentation.sizes();
     let unassigned = points - sizes.iter().sum::<usize>();
 

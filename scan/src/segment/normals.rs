@@ -244,6 +244,12 @@ pub(crate) fn median(mut values: Vec<f64>) -> f64 {
     *m
 }
 
+/// 1.4826 × the median absolute deviation of `values` from `centre`: a
+/// normal variable's σ, unmoved by outliers under half of them.
+pub(crate) fn robust_spread(values: impl Iterator<Item = f64>, centre: f64) -> f64 {
+    1.4826 * median(values.map(|v| (v - centre).abs()).collect())
+}
+
 /// For a normal random variable X, median |X − X'| = 0.954 σ (X' an
 /// independent copy): turns a median neighbour difference into a σ.
 const MEDIAN_DIFF_TO_SIGMA: f64 = 0.953_872;

@@ -24,15 +24,27 @@ use crate::segmentation::UNASSIGNED;
 /// its distance to its nearest other unassigned point of the other.
 pub const LINK_SPACINGS: f64 = 2.0;
 
-/// A group made of unassigned points.
+/// A group made of unassigned points; its group is `G`: a raw number as
+/// the pass finds it, a name in the report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Object {
-    /// Its group (the raw number as text until groups are numbered).
-    pub group: String,
+pub struct Object<G = String> {
+    /// Its group.
+    pub group: G,
     /// Its points.
     pub points: usize,
     /// Its bounding box's longest side, m.
     pub extent_m: f64,
+}
+
+impl Object<u32> {
+    /// The same object with its group named by `name`.
+    pub fn named(&self, name: impl Fn(u32) -> String) -> Object {
+        Object {
+            group: name(self.group),
+            points: self.points,
+            extent_m: self.extent_m,
+        }
+    }
 }
 
 /// The root of `i`'s set, halving the path on the way.
@@ -47,8 +59,8 @@ fn root(parent: &mut [u32], mut i: u32) -> u32 {
 
 /// Makes each set of at least `min_points` unassigned points of `labels`
 /// that lie together a group, numbered from `groups` on; returns them in
-/// that order.
-pub fn group_leftovers(scans: &[Scan], labels: &mut [Vec<u32>], groups: usize, min_points: usize) -> Vec<Object> {
+/// that order (the caller names them: [`Object::named`]).
+pub fn group_leftovers(scans: &[Scan], labels: &mut [Vec<u32>], groups: usize, min_points: usize) -> Vec<Object<u32>> {
     let left: Vec<(u32, u32)> = labels
         .iter()
         .enumerate()
@@ -106,7 +118,7 @@ pub fn group_leftovers(scans: &[Scan], labels: &mut [Vec<u32>], groups: usize, m
             hi = hi.sup(&positions[k]);
         }
         objects.push(Object {
-            group: group.to_string(),
+            group,
             points: set.len(),
             extent_m: (hi - lo).max(),
         });

@@ -39,7 +39,7 @@ use nalgebra::Vector3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::normals::{LocalSurface, nearest, point_tree};
+use super::normals::{LocalSurface, median, nearest, point_tree, robust_spread};
 use crate::cloud::Scan;
 use crate::mesh::plane_fit::PlaneFit;
 use crate::segmentation::UNASSIGNED;
@@ -71,13 +71,14 @@ fn dilate<'a>(cells: impl IntoIterator<Item = &'a (i64, i64)>) -> HashSet<(i64, 
     out
 }
 
-/// A layer found in a group and made a group of its own.
+/// A layer found in a group and made a group of its own; groups are
+/// `G`: raw numbers as the pass finds them, names in the report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Layer {
-    /// The group it was found in (its name once groups are numbered).
-    pub from: String,
+pub struct Layer<G = String> {
+    /// The group it was found in.
+    pub from: G,
     /// Its own group.
-    pub group: String,
+    pub group: G,
     /// The step from the surface around it (two cells out) to its median
     /// point, along the group's plane's normal, m: positive toward the side
     /// the scanners saw the plane from.
@@ -87,6 +88,19 @@ pub struct Layer {
     /// Its points' spread about that offset (1.4826 × median absolute
     /// deviation), m.
     pub spread_m: f64,
+}
+
+impl Layer<u32> {
+    /// The same layer with its groups named by `name`.
+    pub fn named(&self, name: impl Fn(u32) -> String) -> Layer {
+        Layer {
+            from: name(self.from),
+            group: name(self.group),
+            offset_m: self.offset_m,
+            points: self.points,
+            spread_m: self.spread_m,
+        }
+    }
 }
 
 /// What the pass needs to know.
@@ -109,16 +123,15 @@ struct Found {
 }
 
 /// Finds layers in every planar group of `labels` (groups `0..groups`) and
-/// gives each a new group from `groups` on; returns them in that order, with
-/// `from` and `group` the raw group numbers as text (the caller renames
-/// them once groups are numbered).
+/// gives each a new group from `groups` on; returns them in that order (the
+/// caller names them once groups are numbered: [`Layer::named`]).
 pub fn split_layers(
     scans: &[Scan],
     surfaces: &[LocalSurface],
     labels: &mut [Vec<u32>],
     groups: usize,
     settings: &ReliefSettings,
-) -> Vec<Layer> {
+) -> Vec<Layer<u32>> {
     let mut members: Vec<Vec<(u32, u32)>> = vec![Vec::new(); groups];
     for (s, scan_labels) in labels.iter().enumerate() {
         for (i, &g) in scan_labels.iter().enumerate() {
@@ -139,29 +152,14 @@ pub fn split_layers(
             labels[s as usize][i as usize] = group;
         }
         layers.push(Layer {
-            from: f.from.to_string(),
-            group: group.to_string(),
+            from: f.from,
+            group,
             offset_m: f.offset_m,
             points: f.points.len(),
             spread_m: f.spread_m,
         });
     }
     layers
-}
-
-/// The median of `values` (NaN-free), which it reorders; 0 when empty.
-fn median(values: &mut [f64]) -> f64 {
-    if values.is_empty() {
-        return 0.0;
-    }
-    let mid = values.len() / 2;
-    *values.select_nth_unstable_by(mid, f64::total_cmp).1
-}
-
-/// 1.4826 × the median absolute deviation of `values` from `centre`.
-fn robust_spread(values: impl Iterator<Item = f64>, centre: f64) -> f64 {
-    let mut deviations: Vec<f64> = values.map(|v| (v - centre).abs()).collect();
-    1.4826 * median(&mut deviations)
 }
 
 /// The group's plane fitted to the points within 3 σ of it; `None` when the
@@ -207,12 +205,12 @@ fn layers_of(
         Some(pose) => plane.facing(&pose.origin),
         None => plane,
     };
-    let mut spacings: Vec<f64> = points
+    let spacings: Vec<f64> = points
         .iter()
         .map(|&(s, i)| f64::from(surfaces[s as usize].spacing_m[i as usize]))
         .filter(|v| v.is_finite() && *v > 0.0)
         .collect();
-    let cell = CELL_SPACINGS * median(&mut spacings);
+    let cell = CELL_SPACINGS * median(spacings);
     if cell <= 0.0 {
         return Vec::new();
     }
@@ -261,14 +259,14 @@ fn layers_of(
                 }
             }
         }
-        let mut inner: Vec<f64> = component
+        let inner: Vec<f64> = component
             .iter()
             .flat_map(|c| cells[c].iter().map(|&k| residual[k as usize]))
             .collect();
         if inner.len() < settings.min_points {
             continue;
         }
-        let offset = median(&mut inner);
+        let offset = median(inner.clone());
         let spread = robust_spread(inner.iter().copied(), offset);
         if offset.abs() < settings.step_m || spread > 2.0 * noise {
             continue;
@@ -352,7 +350,7 @@ mod tests {
     /// A 3 m × 2 m wall in the plane y = 0 seen from y > 0, points 2 cm
     /// apart with 3 mm noise along y; `height(x, z)` moves a point off the
     /// wall. Returns the split and whether each point was truly raised.
-    fn wall(height: impl Fn(f64, f64) -> f64) -> (Vec<Layer>, Vec<u32>, Vec<bool>) {
+    fn wall(height: impl Fn(f64, f64) -> f64) -> (Vec<Layer<u32>>, Vec<u32>, Vec<bool>) {
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let normal = Normal::new(0.0, NOISE).unwrap();
         let (mut positions, mut raised) = (Vec::new(), Vec::new());
@@ -384,7 +382,7 @@ mod tests {
         let (layers, labels, raised) = wall(|x, z| if poster(x, z) { 0.01 } else { 0.0 });
         assert_eq!(layers.len(), 1, "{layers:?}");
         let layer = &layers[0];
-        assert_eq!((layer.from.as_str(), layer.group.as_str()), ("0", "1"));
+        assert_eq!((layer.from, layer.group), (0, 1));
         // Toward the scanner, within a millimetre; flat to the noise.
         assert!((layer.offset_m - 0.01).abs() < 0.001, "{layer:?}");
         assert!(layer.spread_m < 1.5 * NOISE, "{layer:?}");
