@@ -187,6 +187,8 @@ pub fn reconstruct(
     })?;
     let total_points = scans.iter().map(Scan::len).sum::<usize>().max(1);
     let names = object_names(&segmentation.names);
+    // Each group's object name, for the groups a sphere covers.
+    let name_of: Vec<(u32, String)> = meshes.iter().map(|m| m.group).zip(names.iter().cloned()).collect();
     let mut groups = Vec::with_capacity(meshes.len());
     let mut written = Vec::new();
     let mut objects = Vec::new();
@@ -248,6 +250,16 @@ pub fn reconstruct(
                 ),
             );
         }
+        for slab in &m.slabs {
+            judge(
+                Verdict::Ok,
+                format!(
+                    "closed into a slab {:.1} cm thick (underside and sides added): {} points show its sides",
+                    100.0 * slab.thickness_m,
+                    slab.side_points
+                ),
+            );
+        }
         if m.corners_moved > 0 {
             judge(
                 Verdict::Ok,
@@ -257,7 +269,16 @@ pub fn reconstruct(
                 ),
             );
         }
-        if m.mesh.is_empty() {
+        if let Some(cover) = m.covered_by {
+            let name = name_of
+                .iter()
+                .find(|(g, _)| *g == cover)
+                .map_or_else(|| cover.to_string(), |(_, n)| n.clone());
+            judge(
+                Verdict::Ok,
+                format!("a piece of {name}'s sphere, which its mesh covers: no mesh of its own"),
+            );
+        } else if m.mesh.is_empty() {
             // A speck or a line of points (edge pixels a group of their own)
             // loses little; a real share of the scan lost is a failure.
             let share = m.points as f64 / total_points as f64;

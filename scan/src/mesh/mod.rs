@@ -8,7 +8,9 @@
 //!   plane, its outline and holes from an alpha shape, triangulated by ear
 //!   clipping ([`planar_polygon`]);
 //! - groups that are **spheres** within the planar tolerance: a tessellated
-//!   sphere ([`sphere`]);
+//!   sphere ([`sphere`]); other groups whose points lie on such a sphere
+//!   (pieces of one ball) are covered by its mesh and get none of their
+//!   own ([`sphere::cover_pieces`]);
 //! - curved groups of **organised** scans: triangles between scan-order
 //!   neighbours, refusing depth jumps ([`grid_mesh`]), one partial mesh per
 //!   scan put together as the thesis does;
@@ -20,7 +22,9 @@
 //!   `poisson_reconstruction` 0.4 needs nalgebra 0.33 and parry3d).
 //!
 //! Planar polygons that meet another planar group at an edge (a room's
-//! corners) are closed up to it ([`corners`]).
+//! corners) are closed up to it ([`corners`]). A planar top whose group
+//! also holds its narrow sides (a table top) is closed into a slab, its
+//! unscanned underside added ([`slab`], [`MeshOptions::close_slabs`]).
 //!
 //! Curved meshes are then simplified by quadric error metrics to
 //! [`MeshOptions::simplify_error_m`] ([`simplification`]); the polygons are
@@ -43,6 +47,7 @@ pub mod planar_polygon;
 pub mod plane_fit;
 pub mod plane_pieces;
 pub mod simplification;
+pub mod slab;
 pub mod sphere;
 pub mod triangle_mesh;
 
@@ -95,6 +100,9 @@ pub struct MeshOptions {
     /// Curved groups that are spheres within `planar_rms_m` are meshed as
     /// spheres ([`sphere`]; default true).
     pub fit_spheres: bool,
+    /// Planar groups whose points show sides under the plane (a table top)
+    /// are closed into slabs ([`slab`]; default true).
+    pub close_slabs: bool,
     /// Ball pivoting's ball radius, in the points' spacing (the median
     /// nearest-neighbour distance; default 2): a gap wider than twice the
     /// radius stays open.
@@ -122,6 +130,7 @@ impl Default for MeshOptions {
             simplify_error_m: 0.005,
             min_points: 10,
             fit_spheres: true,
+            close_slabs: true,
             ball_radius_factor: 2.0,
             truth: None,
             hausdorff_spacing_m: 0.02,
@@ -273,6 +282,13 @@ pub struct GroupMesh {
     pub corners_moved: usize,
     /// [`MeshMethod::Sphere`]: the sphere.
     pub sphere: Option<sphere::SphereFit>,
+    /// A group whose points lie on another group's fitted sphere (a ball
+    /// that the segmentation split in pieces, denser scans): that group,
+    /// whose sphere mesh covers it; its own mesh is then empty.
+    pub covered_by: Option<u32>,
+    /// [`MeshMethod::PlanarPolygon`], [`MeshMethod::PlanePieces`]: the
+    /// slabs the planes were closed into ([`slab`]), one per plane closed.
+    pub slabs: Vec<slab::Slab>,
     /// [`MeshMethod::PlanarPolygon`]: per mesh vertex, whether it is a
     /// corner of an outline (not of a hole); empty for other methods.
     pub outer: Vec<bool>,
@@ -375,7 +391,24 @@ pub fn mesh_groups(
         .into_par_iter()
         .map(|g| context.mesh_group(g as u32))
         .collect();
+    sphere::cover_pieces(&mut meshes, 2.0 * options.planar_rms_m);
     corners::close_corners(&mut meshes);
+    // Planar polygons found to be slabs are closed on their outlines as
+    // the corners pass left them.
+    for mesh in meshes.iter_mut().filter(|m| m.method == MeshMethod::PlanarPolygon) {
+        let Some(found) = mesh.slabs.first().copied() else {
+            continue;
+        };
+        let normal = (0..mesh.mesh.triangles.len())
+            .map(|t| mesh.mesh.area_normal(t))
+            .sum::<Vector3<f64>>()
+            .try_normalize(0.0);
+        let Some(normal) = normal else { continue };
+        let closing = slab::closing(&mesh.mesh, &normal, found.thickness_m);
+        mesh.outer.extend(std::iter::repeat_n(false, closing.positions.len()));
+        mesh.mesh.append(&closing);
+        mesh.triangles_before += closing.triangles.len();
+    }
     Ok(meshes)
 }
 
@@ -391,6 +424,34 @@ struct Context<'a> {
 }
 
 impl Context<'_> {
+    /// The slab under `top` (a polygon of `out`'s mesh in `plane`, facing
+    /// the scanners) when the group's `points` show its sides ([`slab`]),
+    /// recorded in `out`.
+    fn find_slab(
+        &self,
+        out: &mut GroupMesh,
+        top: &TriangleMesh,
+        plane: &PlaneFit,
+        points: &[Vector3<f64>],
+        spacing: f64,
+    ) -> Option<slab::Slab> {
+        let options = self.options;
+        if !options.close_slabs {
+            return None;
+        }
+        let found = slab::slab_under(
+            top,
+            &plane.centroid,
+            &plane.normal,
+            points,
+            2.0 * options.planar_rms_m,
+            spacing,
+            options.min_points,
+        )?;
+        out.slabs.push(found);
+        Some(found)
+    }
+
     fn mesh_group(&self, group: u32) -> GroupMesh {
         let g = group as usize;
         let options = self.options;
@@ -432,6 +493,8 @@ impl Context<'_> {
             spacing_m: None,
             corners_moved: 0,
             sphere: None,
+            covered_by: None,
+            slabs: Vec::new(),
             outer: Vec::new(),
             mesh: TriangleMesh::default(),
         };
@@ -454,6 +517,12 @@ impl Context<'_> {
             out.mesh = mesh;
             out.spacing_m = shape.map(|s| s.spacing);
             out.outer = outer;
+            // Closed after the corners pass has moved the outline
+            // (`mesh_groups`).
+            if let Some(spacing) = out.spacing_m {
+                let top = out.mesh.clone();
+                self.find_slab(&mut out, &top, &plane, &points, spacing);
+            }
             out.triangles_before = out.mesh.triangles.len();
             return out;
         } else if let Some(pieces) = plane_pieces::plane_pieces(
@@ -466,12 +535,25 @@ impl Context<'_> {
             out.method = MeshMethod::PlanePieces;
             out.pieces = pieces.len();
             out.unmeshed_points = points.len() - pieces.iter().map(|p| p.points.len()).sum::<usize>();
+            let spacing = nearest_spacing(&points);
+            // A slab's sides are the points no piece holds (a side tall
+            // enough to be a piece is meshed as one).
+            let mut held = vec![false; points.len()];
+            for piece in &pieces {
+                for &i in &piece.points {
+                    held[i] = true;
+                }
+            }
+            let loose: Vec<Vector3<f64>> = (0..points.len()).filter(|&i| !held[i]).map(|i| points[i]).collect();
             for piece in &pieces {
                 let pts: Vec<Vector3<f64>> = piece.points.iter().map(|&i| points[i]).collect();
                 let view = piece.points.iter().map(|&i| views[i]).sum::<Vector3<f64>>() / pts.len() as f64;
                 let plane = piece.plane.facing(&view);
-                out.mesh
-                    .append(&planar_polygon(&pts, &plane, options.outline_alpha_factor, options.outline_tolerance_m).0);
+                let top = planar_polygon(&pts, &plane, options.outline_alpha_factor, options.outline_tolerance_m).0;
+                out.mesh.append(&top);
+                if let Some(found) = self.find_slab(&mut out, &top, &plane, &loose, spacing) {
+                    out.mesh.append(&slab::closing(&top, &plane.normal, found.thickness_m));
+                }
             }
             out.triangles_before = out.mesh.triangles.len();
             return out;

@@ -11,7 +11,11 @@
 //! plane) starts a piece; the piece's plane is refitted to those points
 //! and takes every remaining point that agrees with it; repeat. Points
 //! left (near edges, where normals blend two faces) go to the nearest
-//! plane within the tolerance. The split
+//! plane within the tolerance. A piece is one connected patch: its points
+//! linked within [`LINK_SPACINGS`] point spacings, the largest such set
+//! kept (a plane through a table top's edge strip and the underside of a
+//! ball resting on it would otherwise be meshed across the empty space
+//! between them). The split
 //! is used only when the pieces are planar (RMS within the planar limit)
 //! and together hold nearly all the points ([`COVERED`]); a curved group
 //! (a sphere, a curtain) is not split and is meshed as before.
@@ -20,6 +24,41 @@ use nalgebra::Vector3;
 
 use super::ball_pivoting::{estimate_normals, nearest_spacing};
 use super::plane_fit::PlaneFit;
+use crate::segment::normals::{PointTree, point_tree};
+
+/// The largest set of `members` (indices into the tree's points) linked
+/// within `link` of each other.
+fn largest_patch(tree: &PointTree, points: &[Vector3<f64>], members: &[usize], link: f64) -> Vec<usize> {
+    let mut label = vec![u32::MAX; points.len()];
+    for &i in members {
+        label[i] = u32::MAX - 1;
+    }
+    let mut best: Vec<usize> = Vec::new();
+    for &start in members {
+        if label[start] != u32::MAX - 1 {
+            continue;
+        }
+        label[start] = start as u32;
+        let mut patch = vec![start];
+        let mut k = 0;
+        while k < patch.len() {
+            let p = points[patch[k]];
+            k += 1;
+            for n in tree.within_unsorted::<kiddo::SquaredEuclidean>(&[p.x, p.y, p.z], link * link) {
+                let j = n.item as usize;
+                if label[j] == u32::MAX - 1 {
+                    label[j] = start as u32;
+                    patch.push(j);
+                }
+            }
+        }
+        if patch.len() > best.len() {
+            best = patch;
+        }
+    }
+    best.sort_unstable();
+    best
+}
 
 /// Largest angle between a point's normal and its piece's, degrees.
 pub const NORMAL_DEG: f64 = 15.0;
@@ -35,6 +74,11 @@ pub const MAX_PIECES: usize = 12;
 /// table's top, a wall); over a 15 cm bunny, a tolerance that wide would
 /// make facets of a curved body.
 pub const MIN_EXTENT_OVER_TOLERANCE: f64 = 20.0;
+/// Points of one piece are linked when closer than this many times the
+/// group's point spacing (its median nearest-neighbour distance): wide
+/// enough for a table top seen at a grazing angle, whose rows lie several
+/// spacings apart along the beams.
+pub const LINK_SPACINGS: f64 = 4.0;
 /// Seed points tried per piece.
 const SEEDS: usize = 64;
 
@@ -70,6 +114,8 @@ pub fn plane_pieces(
         return None;
     }
     let normals = estimate_normals(points, views, 2.5 * spacing);
+    let tree = point_tree(points);
+    let link = LINK_SPACINGS * spacing;
     let cos = NORMAL_DEG.to_radians().cos();
     let mut taken = vec![false; points.len()];
     let mut pieces = Vec::new();
@@ -110,6 +156,7 @@ pub fn plane_pieces(
                 .collect();
             plane = Some(fit);
         }
+        let members = largest_patch(&tree, points, &members, link);
         let pts: Vec<Vector3<f64>> = members.iter().map(|&i| points[i]).collect();
         let Some(fit) = PlaneFit::of(&pts).or(plane) else { break };
         let along: Vec<f64> = members.iter().map(|&i| fit.project(&points[i])[0]).collect();
@@ -211,6 +258,39 @@ mod tests {
         }
         let held: usize = pieces.iter().map(|p| p.points.len()).sum();
         assert!(held as f64 >= 0.98 * points.len() as f64, "{held} of {}", points.len());
+    }
+
+    /// Two 1 × 1 m tops at one height, 0.5 m apart along x (two tables
+    /// of one group), each with 3 mm of noise; seen from above.
+    #[test]
+    fn coplanar_patches_apart_are_pieces_of_their_own() {
+        let mut points = Vec::new();
+        for x0 in [0.0, 1.5] {
+            for i in 0..=40 {
+                for j in 0..=40 {
+                    let k = points.len() as f64;
+                    let w = 0.003 * ((k * 12.9898).sin() * 43758.5453).rem_euclid(1.0).mul_add(2.0, -1.0);
+                    points.push(Vector3::new(x0 + i as f64 / 40.0, j as f64 / 40.0, 0.75 + w));
+                }
+            }
+        }
+        let views = vec![Vector3::new(1.25, 0.5, 2.5); points.len()];
+        let pieces = plane_pieces(&points, &views, 10, 0.02, 0.01).expect("split");
+        assert_eq!(
+            pieces.len(),
+            2,
+            "{:?}",
+            pieces.iter().map(|p| p.points.len()).collect::<Vec<_>>()
+        );
+        for piece in &pieces {
+            // All of one top: no piece spans the 0.5 m gap.
+            let xs: Vec<f64> = piece.points.iter().map(|&i| points[i].x).collect();
+            let (lo, hi) = xs
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(lo, hi), &x| (lo.min(x), hi.max(x)));
+            assert!(hi - lo <= 1.0 + 1e-9, "a piece spans x {lo:.2}..{hi:.2}");
+            assert_eq!(piece.points.len(), 41 * 41);
+        }
     }
 
     #[test]

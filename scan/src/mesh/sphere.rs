@@ -192,6 +192,70 @@ pub fn sphere_mesh(sphere: &SphereFit, rings: usize) -> TriangleMesh {
     mesh
 }
 
+/// The share of a group's mesh vertices within the tolerance of a sphere
+/// for the sphere to cover it (the rest: mixed pixels along its outline).
+pub const COVERED_SHARE: f64 = 0.9;
+
+/// The cover's tolerance is at most this share of the ball's radius: a
+/// 2 cm band around a 5.3 cm ball (the Stanford bunny's body, fitted as
+/// one) took in its flat base (`validation/scans/bunnyInt19.e57`).
+pub const COVER_RADIUS_SHARE: f64 = 0.1;
+
+/// Marks the groups of `meshes` that are pieces of another group's
+/// fitted sphere as covered by it ([`super::GroupMesh::covered_by`]) and
+/// empties their meshes. A ball the segmentation split in pieces (denser
+/// scans: the room's spheres came in two or three groups at 180 × 360)
+/// would otherwise be meshed as overlapping whole spheres, or as a sphere
+/// and a shell inside it. A sphere covers another sphere with a centre and
+/// radius within the tolerance of its own, and any smaller group all of
+/// whose mesh vertices but a tenth ([`COVERED_SHARE`]) lie within the
+/// tolerance of its surface, the tolerance being `tolerance_m` or
+/// [`COVER_RADIUS_SHARE`] of the radius, whichever is less; the groups
+/// with the most points cover first.
+pub fn cover_pieces(meshes: &mut [super::GroupMesh], tolerance_m: f64) {
+    let mut balls: Vec<(usize, SphereFit)> = meshes
+        .iter()
+        .enumerate()
+        .filter_map(|(k, m)| Some((k, m.sphere?)))
+        .collect();
+    balls.sort_by_key(|&(k, _)| (std::cmp::Reverse(meshes[k].points), k));
+    for (i, &(k, ball)) in balls.iter().enumerate() {
+        if meshes[k].covered_by.is_some() {
+            continue;
+        }
+        let cover = meshes[k].group;
+        let tolerance_m = tolerance_m.min(COVER_RADIUS_SHARE * ball.radius);
+        for j in 0..meshes.len() {
+            let m = &meshes[j];
+            if j == k || m.covered_by.is_some() || m.mesh.is_empty() || m.points > meshes[k].points {
+                continue;
+            }
+            let on = match m.sphere {
+                Some(other) => {
+                    // Only spheres after this one in the order are covered.
+                    balls[i + 1..].iter().any(|&(b, _)| b == j)
+                        && (other.centre - ball.centre).norm() <= tolerance_m
+                        && (other.radius - ball.radius).abs() <= tolerance_m
+                }
+                None => {
+                    let near = m
+                        .mesh
+                        .positions
+                        .iter()
+                        .filter(|p| ((*p - ball.centre).norm() - ball.radius).abs() <= tolerance_m)
+                        .count();
+                    near as f64 >= COVERED_SHARE * m.mesh.positions.len() as f64
+                }
+            };
+            if on {
+                meshes[j].covered_by = Some(cover);
+                meshes[j].mesh = super::TriangleMesh::default();
+                meshes[j].outer.clear();
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -275,5 +339,86 @@ mod tests {
             })
             .collect();
         assert!(fit_sphere(&cap, 0.01).is_none());
+    }
+
+    /// A group of `points` points with `mesh`, a sphere's when `ball`.
+    fn group(group: u32, points: usize, ball: Option<SphereFit>, mesh: TriangleMesh) -> crate::mesh::GroupMesh {
+        crate::mesh::GroupMesh {
+            group,
+            name: format!("surface_{group}"),
+            points,
+            method: if ball.is_some() {
+                crate::mesh::MeshMethod::Sphere
+            } else {
+                crate::mesh::MeshMethod::ScanGrid
+            },
+            plane_rms_m: None,
+            folded: 0,
+            triangles_before: mesh.triangles.len(),
+            simplify_error_m: 0.0,
+            pieces: 0,
+            unmeshed_points: 0,
+            spacing_m: None,
+            corners_moved: 0,
+            sphere: ball,
+            covered_by: None,
+            slabs: Vec::new(),
+            outer: Vec::new(),
+            mesh,
+        }
+    }
+
+    #[test]
+    fn pieces_of_one_ball_are_covered_by_its_sphere() {
+        let ball = |x: f64, r: f64| SphereFit {
+            centre: Vector3::new(x, 0.0, 1.0),
+            radius: r,
+            rms_m: 0.003,
+            inliers: 1.0,
+        };
+        // The ball's main piece, a second piece fitted 4 mm off, a shell
+        // of its scan-order triangles 3 mm proud, a second ball 0.5 m
+        // away, and a wall patch through the ball's middle.
+        let main = ball(0.0, 0.2);
+        let second = ball(0.004, 0.195);
+        let shell = {
+            let mut m = sphere_mesh(&ball(0.0, 0.203), 6);
+            m.triangles.truncate(20);
+            m
+        };
+        let other = ball(0.5, 0.2);
+        let wall = TriangleMesh {
+            positions: vec![
+                Vector3::new(-0.3, 0.0, 0.7),
+                Vector3::new(0.3, 0.0, 0.7),
+                Vector3::new(0.3, 0.0, 1.3),
+            ],
+            triangles: vec![[0, 1, 2]],
+        };
+        // A 5 cm ball (0.5 cm tolerance) and a 6 × 6 cm square touching
+        // its bottom: the square's corners 1.6 cm off the ball.
+        let small = ball(2.0, 0.05);
+        let base = TriangleMesh {
+            positions: [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0), (0.0, 0.0)]
+                .map(|(x, y)| Vector3::new(2.0 + 0.03 * x, 0.03 * y, 0.95))
+                .to_vec(),
+            triangles: vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]],
+        };
+        let mut meshes = vec![
+            group(5, 500, Some(small), sphere_mesh(&small, 12)),
+            group(6, 100, None, base),
+            group(0, 90, Some(second), sphere_mesh(&second, 12)),
+            group(1, 300, Some(main), sphere_mesh(&main, 12)),
+            group(2, 60, None, shell),
+            group(3, 280, Some(other), sphere_mesh(&other, 12)),
+            group(4, 50, None, wall),
+        ];
+        cover_pieces(&mut meshes, 0.02);
+        let covered: Vec<Option<u32>> = meshes.iter().map(|m| m.covered_by).collect();
+        assert_eq!(covered, [None, None, Some(1), None, Some(1), None, None]);
+        assert!(meshes[2].mesh.is_empty() && meshes[4].mesh.is_empty());
+        assert_eq!(meshes[3].mesh.triangles.len(), 528);
+        assert_eq!(meshes[6].mesh.triangles.len(), 1);
+        assert_eq!(meshes[1].mesh.triangles.len(), 4);
     }
 }

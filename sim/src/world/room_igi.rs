@@ -128,15 +128,7 @@ impl RoomIgi {
     /// The triangles as the solver takes them: `surface` is the material
     /// index (the group sharing one BRDF).
     pub fn igi_triangles(&self) -> Vec<Triangle> {
-        self.loaded
-            .scene
-            .triangles()
-            .iter()
-            .map(|t| Triangle {
-                surface: t.material,
-                ..*t
-            })
-            .collect()
+        igi_triangles_of(&self.loaded.scene)
     }
 
     /// The named cameras at the scene's poses, `width` × `height`, vertical
@@ -290,6 +282,21 @@ impl RoomIgi {
         }
         out
     }
+}
+
+/// The triangles of `scene` as inverse global illumination takes them:
+/// each triangle's surface is its material (the solver's surfaces are the
+/// groups that share specular parameters); the true room's
+/// ([`RoomIgi::igi_triangles`]) or one rebuilt from scans.
+pub fn igi_triangles_of(scene: &Scene) -> Vec<Triangle> {
+    scene
+        .triangles()
+        .iter()
+        .map(|t| Triangle {
+            surface: t.material,
+            ..*t
+        })
+        .collect()
 }
 
 /// Distance from a highlight to the camera of [`RoomIgi::mirror_cameras`], metres.

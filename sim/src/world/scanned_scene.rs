@@ -10,6 +10,11 @@
 //!   the groups would; the group's triangles take that surface's index and
 //!   material. A replaced surface that no group stands for is missing from
 //!   the rebuilt scene.
+//! - **Inverse global illumination.** The solver's surfaces are the
+//!   scene's materials ([`super::room_igi::igi_triangles_of`]); a solve is scored by each
+//!   parameter's absolute error averaged over solver seeds
+//!   ([`mean_igi_errors`]), and two geometries by the worst ratio of their
+//!   errors ([`worst_ratio`]).
 //! - **Truth at a point.** A point of the rebuilt geometry is moved to the
 //!   nearest point of the true scene, and the true albedo is read there
 //!   ([`projected_cell_truth`]); on the true geometry this is the point
@@ -18,7 +23,10 @@
 // Channel loops index several arrays at once; they read better with an index.
 #![allow(clippy::needless_range_loop)]
 
+use campanile_process::brdf::WardMaterial;
 use campanile_process::error_figures::quantile;
+use campanile_process::igi::table::errors;
+use campanile_process::igi::{IgiError, IgiInput, IgiOptions, recover};
 use campanile_process::outdoor::{CellStatus, Grid, Reflectance};
 use campanile_process::render::{Scene, SceneError, Triangle};
 use campanile_scan::mesh::GroupMesh;
@@ -142,6 +150,59 @@ pub fn scanned_scene(
         groups,
         missing,
     })
+}
+
+/// Per material of `truth`, the absolute errors of ρd, ρs, αx, αy (%) and
+/// γ (°) ([`errors`]) averaged over `seeds` solves of `input` with
+/// `options` and solver seeds `options.seed + first ..`; each parameter
+/// over the solves that have it (a lobe's α is missing from a solve that
+/// found the surface diffuse). At few gather rays one seed's error moves
+/// several-fold for a glossy material, so a ratio of single solves
+/// measures the seed as much as the geometry.
+pub fn mean_igi_errors(
+    input: &IgiInput,
+    options: &IgiOptions,
+    first: u64,
+    seeds: u64,
+    truth: &[WardMaterial],
+) -> Result<Vec<[Option<f64>; 5]>, IgiError> {
+    let mut sum = vec![[(0.0, 0usize); 5]; truth.len()];
+    for k in 0..seeds {
+        let solved = recover(
+            input,
+            &IgiOptions {
+                seed: options.seed + first + k,
+                ..*options
+            },
+        )?;
+        for (s, total) in sum.iter_mut().enumerate() {
+            let Some(m) = solved.surfaces.get(s).and_then(|r| r.material.as_ref()) else {
+                continue;
+            };
+            for ((total, n), e) in total.iter_mut().zip(errors(m, &truth[s])) {
+                if let Some(e) = e {
+                    *total += e.abs();
+                    *n += 1;
+                }
+            }
+        }
+    }
+    Ok(sum
+        .iter()
+        .map(|m| m.map(|(total, n)| (n > 0).then(|| total / n as f64)))
+        .collect())
+}
+
+/// The worst ratio `b / a` over the parameters both have, each error
+/// floored at 0.5 % (γ at 0.1°) so that a near-zero reference does not
+/// make noise look like a failure; `None` when they share none.
+pub fn worst_ratio(a: &[Option<f64>; 5], b: &[Option<f64>; 5]) -> Option<f64> {
+    (0..5)
+        .filter_map(|k| {
+            let floor = if k == 4 { 0.1 } else { 0.5 };
+            Some(b[k]?.max(floor) / a[k]?.max(floor))
+        })
+        .reduce(f64::max)
 }
 
 /// The true albedo averaged over each cell of `grid` (laid over `scene`,
