@@ -249,21 +249,58 @@ fn igi_recovers_the_simulated_room_from_its_scene_file_and_relights_it() {
 
     // `campanile render --igi` writes the same relit image.
     let rendered = dir.path().join("render");
-    let o = campanile(&[
-        "render",
-        "--igi",
-        scene.to_str().unwrap(),
-        "--lights",
-        lights.to_str().unwrap(),
-        "--camera",
-        "wide-sw",
-        "--quick",
-        "--out",
-        rendered.to_str().unwrap(),
-    ]);
+    let render = |to: &std::path::Path, extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            "--igi",
+            scene.to_str().unwrap(),
+            "--lights",
+            lights.to_str().unwrap(),
+            "--camera",
+            "wide-sw",
+            "--quick",
+            "--out",
+            to.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        campanile(&args)
+    };
+    let o = render(&rendered, &[]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let again = read_rgb_exr(&rendered.join("relit-wide-sw.exr")).unwrap();
     assert_eq!(again.data, relit.data, "the same seeds give the same image");
+    assert!(!rendered.join("quality.json").exists(), "no target, no verdict");
+
+    // Relit to an error target, each view is a product in quality.json: a
+    // loose target is met (ok, exit 0); one that 1024 paths a pixel cannot
+    // reach leaves most blocks above it (failed, exit 3).
+    for (target, code, verdict) in [("0.5", 0, "ok"), ("0.0005", 3, "failed")] {
+        let to = dir.path().join(format!("render-{target}"));
+        let o = render(&to, &["--error", target]);
+        let stdout = String::from_utf8_lossy(&o.stdout);
+        assert_eq!(
+            o.status.code(),
+            Some(code),
+            "{stdout}\n{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let q: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(to.join("quality.json")).unwrap()).unwrap();
+        let view = q["products"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["product"] == "igi relit wide-sw")
+            .unwrap_or_else(|| panic!("{q}"));
+        assert_eq!(view["verdict"], verdict, "{view}");
+        let share = view["checks"][0]["value"].as_f64().unwrap();
+        eprintln!("--error {target}: {share:.3} of the blocks above the target");
+        if verdict == "ok" {
+            assert_eq!(share, 0.0, "{view}");
+        } else {
+            assert!(share > 0.5, "{view}");
+        }
+    }
 }
 
 #[test]

@@ -240,6 +240,12 @@ pub struct IgiGates {
     /// indirect share (19–45 % on single-bounce renders solved as
     /// interreflected).
     pub interreflection: Gate,
+    /// The share of a relit view's 4 × 4-pixel blocks whose estimated
+    /// relative standard error stayed above the `--error` target at the
+    /// most paths a pixel (`process::igi::error_target`; lower is better).
+    /// Default poor 0 (any block), failed 0.5: most of the image is then
+    /// noisier than was asked for.
+    pub relit_blocks: Gate,
 }
 
 impl Default for IgiGates {
@@ -248,6 +254,7 @@ impl Default for IgiGates {
             residual: Gate::new(0.5, 2.0),
             energy: Gate::new(0.95, 1.0),
             interreflection: Gate::new(0.02, 0.1),
+            relit_blocks: Gate::new(0.0, 0.5),
         }
     }
 }
@@ -296,7 +303,7 @@ impl Default for OutdoorGates {
 impl Validate for Quality {
     fn validate(&self, v: &mut Validator) {
         use Better::{Higher, Lower};
-        let gates: [(&str, &str, &Gate, Better); 20] = [
+        let gates: [(&str, &str, &Gate, Better); 21] = [
             ("response", "condition", &self.response.condition, Lower),
             ("response", "exposures_used", &self.response.exposures_used, Higher),
             ("response", "code_coverage", &self.response.code_coverage, Higher),
@@ -323,6 +330,7 @@ impl Validate for Quality {
             ("igi", "residual", &self.igi.residual, Lower),
             ("igi", "energy", &self.igi.energy, Lower),
             ("igi", "interreflection", &self.igi.interreflection, Lower),
+            ("igi", "relit_blocks", &self.igi.relit_blocks, Lower),
             ("outdoor", "residual", &self.outdoor.residual, Lower),
             ("outdoor", "render", &self.outdoor.render, Lower),
             ("outdoor", "estimated_light", &self.outdoor.estimated_light, Lower),

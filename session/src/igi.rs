@@ -21,7 +21,7 @@ use campanile_process::igi::relit_scene::recovered_scene;
 use campanile_process::igi::scene_file::{LoadedIgiScene, WardVariantEntry, load};
 use campanile_process::igi::variant_choice::{VariantEvidence, describe, recover_each_variant};
 use campanile_process::igi::{IgiLight, IgiOptions, IgiResult, ViewCamera, format_table};
-use campanile_process::quality::{QualityReport, Verdict, gates};
+use campanile_process::quality::{ProductQuality, Quality, QualityReport, gates};
 
 use crate::Result;
 use crate::progress::bar;
@@ -554,21 +554,32 @@ pub fn lights_file(path: &Path) -> Result<Vec<IgiLight>> {
         .collect())
 }
 
-/// Renders the view `camera` (`None`: every photographed view) of the
-/// recovered scene under `lights` into `DIR/relit-VIEW.exr`, one line per
-/// view to `out`. With `error`, each view's paths are drawn until every
-/// 4 × 4 block's mean is known to that relative standard error
+/// Which views [`relight_views`] renders and how.
+#[derive(Debug, Clone, Copy)]
+pub struct RelightRequest<'a> {
+    /// One view, or `None` for every photographed view.
+    pub camera: Option<&'a str>,
+    /// The quick settings (fewer paths).
+    pub quick: bool,
+    /// The error target (relative standard error of a 4 × 4 block's mean).
+    pub error: Option<f64>,
+}
+
+/// Renders the requested views of the recovered scene under `lights` into
+/// `DIR/relit-VIEW.exr`, one line per view to `out`. With an error
+/// target, each view's paths are drawn until every 4 × 4 block's mean is
+/// known to that relative standard error
 /// ([`campanile_process::igi::error_target`]) and its line says how that
-/// went; returns the worst view's verdict (`ok` without a target).
+/// went; returns each view's quality under `q` (none without a target).
 pub fn relight_views(
     r: &Recovered,
     lights: &[IgiLight],
-    camera: Option<&str>,
+    request: RelightRequest,
     dir: &Path,
-    quick: bool,
-    error: Option<f64>,
+    q: &Quality,
     out: &mut dyn Write,
-) -> Result<Verdict> {
+) -> Result<Vec<ProductQuality>> {
+    let RelightRequest { camera, quick, error } = request;
     let cameras = camera.map_or_else(|| r.image_cameras(), |c| vec![c.to_owned()]);
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let target = error.map(ErrorTarget::new);
@@ -587,14 +598,14 @@ pub fn relight_views(
             "relighting"
         },
     );
-    let mut verdict = Verdict::Ok;
+    let mut relit = Vec::new();
     for cam in cameras {
         let path = dir.join(format!("relit-{cam}.exr"));
         let line = match &target {
             Some(t) => {
                 let (img, report) = r.relight_to_error(lights, &cam, t, &|| bar.inc(1))?;
                 write_exr(&img, &path)?;
-                verdict = verdict.max(report.verdict);
+                relit.push(gates::relit_view(&cam, &report, q));
                 format!("relit {}: {report}", path.display())
             }
             None => {
@@ -606,5 +617,5 @@ pub fn relight_views(
         bar.suspend(|| writeln!(out, "{line}"))?;
     }
     bar.finish_and_clear();
-    Ok(verdict)
+    Ok(relit)
 }

@@ -7,8 +7,9 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use campanile_process::igi::scene_file::WardVariantEntry;
+use campanile_process::quality::QualityReport;
 use campanile_session::igi::{
-    ModelChoice, lights_file, quality, recover_scene_with, relight_views, write_products, write_summary,
+    ModelChoice, RelightRequest, lights_file, quality, recover_scene_with, relight_views, write_products, write_summary,
 };
 use clap::Args;
 
@@ -117,11 +118,26 @@ pub fn run(args: IgiArgs) -> Result<()> {
     for w in &r.loaded.warnings {
         eprintln!("warning: {w}");
     }
-    let quality = quality(&r, &q);
+    let mut quality = quality(&r, &q);
     let written = write_products(&r, &args.out, &quality)?;
     write_summary(&r, &written, out)?;
     if let Some(lights) = &lights {
-        relight_views(&r, lights, None, &args.out, args.quick, args.error, out)?;
+        // Views relit to an error target are products too.
+        let relit = relight_views(
+            &r,
+            lights,
+            RelightRequest {
+                camera: None,
+                quick: args.quick,
+                error: args.error,
+            },
+            &args.out,
+            &q,
+            out,
+        )?;
+        if !relit.is_empty() {
+            quality = QualityReport::new(quality.products.into_iter().chain(relit).collect(), &q);
+        }
     }
     super::verdicts::finish(&quality, &args.out.join("quality.json"))
 }

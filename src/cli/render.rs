@@ -6,7 +6,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use campanile_session::igi::{lights_file, recover_scene, relight_views};
+use campanile_process::quality::QualityReport;
+use campanile_session::igi::{RelightRequest, lights_file, recover_scene, relight_views};
 use campanile_session::scene_render::{self, Rendered, SceneRenderOptions};
 use chrono::{DateTime, NaiveDate, Utc};
 use clap::Args;
@@ -140,16 +141,19 @@ fn run_room(args: &RenderArgs, scene: &Path, lights: &Path) -> Result<()> {
         eprintln!("warning: {w}");
     }
     let out = &mut std::io::stdout();
-    relight_views(
-        &r,
-        &lights,
-        args.camera.as_deref(),
-        &args.out,
-        args.quick,
-        args.error,
-        out,
-    )?;
-    Ok(())
+    let q = super::verdicts::thresholds(None, None)?;
+    let request = RelightRequest {
+        camera: args.camera.as_deref(),
+        quick: args.quick,
+        error: args.error,
+    };
+    let relit = relight_views(&r, &lights, request, &args.out, &q, out)?;
+    // With an error target each view is judged (OUT/quality.json; exit 3
+    // when one failed).
+    if relit.is_empty() {
+        return Ok(());
+    }
+    super::verdicts::finish(&QualityReport::new(relit, &q), &args.out.join("quality.json"))
 }
 
 pub fn run(args: RenderArgs) -> Result<()> {

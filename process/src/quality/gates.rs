@@ -10,6 +10,7 @@ use crate::hdr::curve::ResponseCurve;
 use crate::hdr::debevec::Calibration;
 use crate::hdr::merge::{MASK_SATURATED, MASK_UNDEREXPOSED, RadianceMap};
 use crate::igi::SurfaceResult;
+use crate::igi::error_target::ErrorTargetReport;
 use crate::igi::interreflection_check::InterreflectionCheck;
 use crate::sky::ChannelSky;
 use crate::sky_series::ScanProducts;
@@ -304,6 +305,25 @@ pub fn interreflection(check: &InterreflectionCheck, q: &Quality) -> ProductQual
         )],
     )
     .with_note(check.message.clone())
+}
+
+/// A view relit to an error target (`igi --relight … --error`, `render
+/// --igi … --error`): the share of its blocks that stopped at the most
+/// paths above the target, with the run's figures as a note.
+pub fn relit_view(view: &str, report: &ErrorTargetReport, q: &Quality) -> ProductQuality {
+    ProductQuality::new(
+        format!("igi relit {view}"),
+        vec![Check::new(
+            format!(
+                "share of 4 × 4 blocks above the {:.2} % error target",
+                100.0 * report.target
+            ),
+            report.not_converged as f64 / report.blocks.max(1) as f64,
+            q.igi.relit_blocks,
+            Better::Lower,
+        )],
+    )
+    .with_note(report.to_string())
 }
 
 /// The outdoor pseudo-albedos (thesis §5.4) from their fit's diagnostics:
