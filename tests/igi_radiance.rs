@@ -240,19 +240,21 @@ fn exact_glossy_interreflection_rendered_by_mitsuba_is_recovered_within_the_issu
     // Every untextured face is held to the issue's bounds.
     //
     // One exception, measured and not met: the corridor floor's weak wide
-    // lobe (ρs 0.02, α 0.15) comes out ρs −2.4 %, α −5.3 % through the
-    // command (solver seeds 2–4: ρs −3.9 to −6.1 %, α −4.4 to −8.1 %; 64
-    // ΔS rays instead of 16: +4.3 %, −1.6 %). Its error moves with the
-    // ΔS estimate (the lobe's reflection of the room), not with the
-    // reference, which agrees with Campanile's own exact transport to
-    // 0.2 % on that floor (`validation/igi/README.md`). It is held to
-    // ρs 4 %, α 8 % here so that it cannot get worse unseen.
+    // lobe (ρs 0.02, α 0.15). Its ρs came out −2.4 to −6.1 % and α −4.4 to
+    // −8.1 % over solver seeds 1–4 while the fit took the Monte Carlo
+    // estimates of the indirect light as exact: ΔS's noise in the ρs
+    // regressor diluted it (ρs −8 %, α −6 % at 16 ΔS rays with the
+    // gather converged, −1.4 %, −1.6 % at 256). With the noise measured
+    // and taken out (`IgiOptions::correct_noise`, `igi::ward_fit`) and
+    // 4096 gather rays, ρs is within 1.42 % over seeds 1–3 (the issue's 2 %
+    // held here) and α −2.4 to −5.6 %, held to 6 % (`igi_knobs … 12 4096 16
+    // 3 SEED 8 1 1`). The reference agrees with Campanile's own exact
+    // transport to 0.2 % on that floor (`validation/igi/README.md`).
     //
     // The studio's metal wall (ρd 0.24/0.20/0.15 under ρs 0.56/0.43/0.28,
-    // α 0.10): its red ρd sits at the bound, −0.61, −1.15 and −0.89 % over
-    // solver seeds 1–3 before the texel-group fit and −1.01, −1.16 and
-    // −0.80 % after it (`igi_knobs … 12 1024 16 3 SEED 8 1`); 16 ΔS rays a
-    // pixel more on it do not move it (−1.05, −1.27, −0.91 %), and with
+    // α 0.10): its red ρd sits at the bound, −0.89, −1.15 and −1.00 % over
+    // solver seeds 1–3 (−1.01, −1.16 and −0.80 % before the noise
+    // correction); 16 ΔS rays a pixel more on it did not move it, and with
     // the true materials the forward model alone would put it +0.7 to
     // +1.3 % (`igi_model_bias`). Not understood; held to 1.3 % so that it
     // cannot get worse unseen.
@@ -261,7 +263,9 @@ fn exact_glossy_interreflection_rendered_by_mitsuba_is_recovered_within_the_issu
     // (`texel_groups`; before it the studio's was lost, ρs 0): the
     // corridor's (ρs 0.04, α 0.10) within the issue's bounds; the
     // studio's weak wide one (ρs 0.02, α 0.15) within them in α and held
-    // to 4 % in ρs (measured +1.8 to +3.4 % over solver seeds 1–3).
+    // to 3 % in ρs (measured +0.55 to +2.16 % over solver seeds 1–3 with
+    // the indirect light interpolated between cells, +1.8 to +3.4 %
+    // before).
     let dir = tempfile::tempdir().unwrap();
     let room = "studio-mitsuba-interreflection";
     let out = dir.path().join(room);
@@ -271,11 +275,11 @@ fn exact_glossy_interreflection_rendered_by_mitsuba_is_recovered_within_the_issu
         room,
         check_room_except(room, &out, ISSUE_BOUNDS, &[("wall_west", metal)]),
     );
-    check_textured_lobe(room, &out, "wall_east", [0.04, ISSUE_BOUNDS[2]]);
+    check_textured_lobe(room, &out, "wall_east", [0.03, ISSUE_BOUNDS[2]]);
     let room = "corridor-mitsuba-interreflection";
     let out = dir.path().join(room);
     run_igi(room, &out, &[], "the images hold interreflected light, as assumed");
-    let floor = [ISSUE_BOUNDS[0], 0.04, 0.08, ISSUE_BOUNDS[3]];
+    let floor = [ISSUE_BOUNDS[0], ISSUE_BOUNDS[1], 0.06, ISSUE_BOUNDS[3]];
     report(room, check_room_except(room, &out, ISSUE_BOUNDS, &[("floor", floor)]));
     check_textured_lobe(room, &out, "wall_south", [ISSUE_BOUNDS[1], ISSUE_BOUNDS[2]]);
 }

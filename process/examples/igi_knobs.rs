@@ -4,7 +4,9 @@
 //! (`validation/igi`).
 //!
 //! `cargo run --release -p campanile-process --example igi_knobs -- SCENE OUT
-//! [cells_per_edge gather_rays lobe_rays iterations seed lobe_ray_factor_max lobe_ray_block]`
+//! [cells_per_edge gather_rays lobe_rays iterations seed lobe_ray_factor_max lobe_ray_block correct_noise]`
+//! (`correct_noise` 0 or 1, `IgiOptions::correct_noise`; the command line's
+//! full settings are `12 4096 16 3 SEED 8 1 1`)
 
 use campanile_process::brdf::WardVariant;
 use campanile_process::igi::material_record::{records, variant_name};
@@ -14,7 +16,7 @@ use campanile_process::igi::{IgiOptions, recover};
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if args.len() < 3 {
-        eprintln!("usage: igi_knobs SCENE OUT [cells gather lobe iterations seed factor block]");
+        eprintln!("usage: igi_knobs SCENE OUT [cells gather lobe iterations seed factor block correct_noise]");
         std::process::exit(2);
     }
     let knob = |i: usize, d: u64| args.get(i).and_then(|a| a.parse().ok()).unwrap_or(d);
@@ -38,6 +40,7 @@ fn main() {
         lobe_ray_block: knob(9, 1) as usize,
         iterations: knob(6, 4) as u32,
         seed: knob(7, 1),
+        correct_noise: knob(10, 0) != 0,
         ..IgiOptions::default()
     };
     let r = match recover(&loaded.input, &options) {

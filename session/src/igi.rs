@@ -44,13 +44,17 @@ pub fn settings(quick: bool) -> (IgiOptions, AlbedoMapOptions, RelightSettings) 
         // most within 2–5 % (examples/igi_knobs; BENCHMARKS.md), 24 is no
         // better at 64² views with 1.7 % noise.
         cells_per_edge: if quick { 4 } else { 12 },
-        // 1024 gather rays: on the RADIANCE studio with interreflection the
+        // 4096 gather rays: on the RADIANCE studio with interreflection the
         // weak lobes' ρs moved by 3.8 % and 10.5 % between seeds at 64
         // rays (more than their views-bootstrap σ), 1.8 % and 3.2 % at 256;
         // at 256 the south wall's ρs (0.03) was still 6.5 % high, at 1024
-        // within 2 % (examples/igi_knobs; BENCHMARKS.md), for about 0.5 s a
-        // pass (the gather does not grow with the pixels).
-        gather_rays: if quick { 32 } else { 1024 },
+        // within 2 %. Since the fit takes the Monte Carlo noise out of its
+        // regressors (igi::ward_fit), the Mitsuba corridor floor's weak
+        // lobe (ρs 0.02) came out −6.3 to +4.9 % over seeds 1–3 at 1024,
+        // within 1.4 % at 4096 (examples/igi_knobs; BENCHMARKS.md), for
+        // about 2 s more on the 64² rooms (the gather does not grow with
+        // the pixels).
+        gather_rays: if quick { 32 } else { 4096 },
         // Three ΔS passes: beyond the third the largest change between
         // passes is the gather's and ΔS's noise (1.4 %, 4.3 %, 2.4 % at
         // passes 4–6), and a fourth put the RADIANCE studio's floor and
@@ -71,6 +75,11 @@ pub fn settings(quick: bool) -> (IgiOptions, AlbedoMapOptions, RelightSettings) 
         // ρs 1.442 → 1.626 %, α 2.166 → 2.497 %, γ 0.659 → 0.726°;
         // BENCHMARKS.md, the IGI table), so it is not the default yet.
         lobe_ray_block: 1,
+        // The Monte Carlo noise of the gather and of ΔS measured and taken
+        // out of the fit, the indirect irradiance interpolated between
+        // cells (IgiOptions::correct_noise): the Mitsuba corridor floor's
+        // weak lobe ρs −2.4 to −6.1 % → within 1.4 % (seeds 1–4).
+        correct_noise: !quick,
         ..IgiOptions::default()
     };
     // Stratified rays and paths (igi::lamp_paths): the maps' irradiance and

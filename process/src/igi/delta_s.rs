@@ -25,7 +25,7 @@ use super::input::IgiInput;
 use super::observation::Observation;
 use super::radiosity::{REFLECTION_DEPTH, RadiosityField, SurfaceLobe, surface_lobes};
 use super::specular_albedo::SpecularAlbedo;
-use super::stratified::Strata;
+use super::stratified::{GroupedMean, Strata, variance_groups};
 use super::texel_groups::TEXTURED_RAY_FACTOR;
 use crate::brdf::{WardLobe, WardMaterial};
 use crate::render::Ray;
@@ -54,7 +54,17 @@ const BLOCK_SPAN_M: f64 = 0.02;
 /// degree, so the ratio stays near 1), except that the ray leaves q's
 /// point rather than p's: the light is taken over the block's footprint
 /// (at 128² views a 64² pixel). With `block` = 1 each pixel traces its
-/// own rays alone, the estimator of earlier versions to the last bit.
+/// own rays alone.
+///
+/// Each pixel's rays are drawn in independently stratified groups
+/// (`stratified::variance_groups`), so that the estimate's variance is
+/// measured without bias from the groups' spread (returned beside it, per
+/// channel; `stratified::GroupedMean`). The fit needs it: ΔS is a regressor of
+/// the linear step (`ward_fit`), and noise in a regressor pulls its
+/// coefficient toward zero (regression dilution). On the Mitsuba corridor
+/// (`validation/igi`) the floor's weak lobe (ρs 0.02, α 0.15) came out
+/// ρs −8 %, α −6 % at 16 rays a pixel and −1.4 %, −1.6 % at 256, with the
+/// indirect light otherwise converged; `ward_fit` subtracts the noise.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn indirect_specular(
     geometry: &Geometry,
@@ -68,8 +78,9 @@ pub(crate) fn indirect_specular(
     rays: u32,
     factor_max: u32,
     block: usize,
+    measure: bool,
     seed: u64,
-) -> Vec<[f64; 3]> {
+) -> IndirectSpecular {
     let lobes = surface_lobes(materials);
     // Per surface: the lobe sampled (its shape) and the rays per pixel.
     let sampled: Vec<Option<(SurfaceLobe, u32)>> = shapes
@@ -108,7 +119,7 @@ pub(crate) fn indirect_specular(
             blocks.push(vec![i]);
         }
     }
-    let per_block: Vec<Vec<(usize, [f64; 3])>> = blocks
+    let per_block: Vec<Vec<PixelEstimate>> = blocks
         .par_iter()
         .map(|members| {
             let first = &observations[members[0]];
@@ -118,41 +129,57 @@ pub(crate) fn indirect_specular(
             // The block's rays, split between its pixels.
             let m = members.len() as u32;
             let total = rays.max(m);
-            // (direction in the shared local frame, its density under the
-            // drawing pixel's lobe, the radiance it brings back).
-            let mut traced: Vec<(nalgebra::Vector3<f64>, f64, [f64; 3])> = Vec::with_capacity(total as usize);
+            // Every pixel draws its rays in the same independent groups
+            // (`variance_groups` of the block's rays), so that the spread
+            // between the groups measures the estimate's variance.
+            // Without `measure` (`IgiOptions::correct_noise`), and on a
+            // textured surface, whose fit does not use the variance
+            // (`ward_fit`), the rays stay one stratified set.
+            let measured = measure && !textured.get(first.surface).copied().unwrap_or(false);
+            let groups = if measured { variance_groups(total) } else { vec![total] };
+            let mut drawn = vec![0u32; groups.len()];
+            // (group, direction in the shared local frame, its density under
+            // the drawing pixel's lobe, the radiance it brings back).
+            let mut traced: Vec<(usize, nalgebra::Vector3<f64>, f64, [f64; 3])> = Vec::with_capacity(total as usize);
             for (k, &i) in members.iter().enumerate() {
                 let o = &observations[i];
                 let n = total / m + u32::from((k as u32) < total % m);
                 let mut rng = ChaCha8Rng::seed_from_u64(seed);
                 rng.set_stream(i as u64);
-                let strata = Strata::new(n, &mut rng);
                 let origin = o.point + o.frame.normal * SURFACE_OFFSET * (1.0 + o.point.norm());
-                for r in 0..n {
-                    let u = strata.point(r, &mut rng);
-                    let Some(wi) = sampler.sample(&o.wo, u) else {
-                        continue;
-                    };
-                    let pdf = sampler.pdf(&wi, &o.wo);
-                    if !(pdf > 0.0 && pdf.is_finite()) {
-                        continue;
+                let own = if measured { variance_groups(n) } else { vec![n] };
+                for (g, count) in own.into_iter().enumerate() {
+                    // A pixel of a shared block draws fewer rays than the
+                    // block: its groups fold onto the block's.
+                    let g = g % groups.len();
+                    drawn[g] += count;
+                    let strata = Strata::new(count, &mut rng);
+                    for r in 0..count {
+                        let u = strata.point(r, &mut rng);
+                        let Some(wi) = sampler.sample(&o.wo, u) else {
+                            continue;
+                        };
+                        let pdf = sampler.pdf(&wi, &o.wo);
+                        if !(pdf > 0.0 && pdf.is_finite()) {
+                            continue;
+                        }
+                        let direction = o.frame.to_world(&wi);
+                        let Some(hit) = geometry.intersect(&Ray { origin, direction }, f64::INFINITY) else {
+                            continue;
+                        };
+                        let l = field.radiance_toward(
+                            geometry,
+                            input,
+                            &lobes,
+                            albedos,
+                            hit.triangle,
+                            &hit.point,
+                            &-direction,
+                            REFLECTION_DEPTH,
+                            &mut rng,
+                        );
+                        traced.push((g, wi, pdf, l));
                     }
-                    let direction = o.frame.to_world(&wi);
-                    let Some(hit) = geometry.intersect(&Ray { origin, direction }, f64::INFINITY) else {
-                        continue;
-                    };
-                    let l = field.radiance_toward(
-                        geometry,
-                        input,
-                        &lobes,
-                        albedos,
-                        hit.triangle,
-                        &hit.point,
-                        &-direction,
-                        REFLECTION_DEPTH,
-                        &mut rng,
-                    );
-                    traced.push((wi, pdf, l));
                 }
             }
             let kernel = sampler.kernel();
@@ -160,23 +187,42 @@ pub(crate) fn indirect_specular(
                 .iter()
                 .map(|&i| {
                     let wo = &observations[i].wo;
-                    let mut sum = [0.0; 3];
-                    for (wi, pdf, l) in &traced {
-                        let weight = kernel.eval(wi, wo) * wi.z / pdf;
-                        for c in 0..3 {
-                            sum[c] += weight * l[c];
-                        }
+                    let mut acc = GroupedMean::new(groups.len());
+                    for (g, &n) in drawn.iter().enumerate() {
+                        acc.count(g, n);
                     }
-                    (i, sum.map(|s| s / f64::from(total)))
+                    for (g, wi, pdf, l) in &traced {
+                        let weight = kernel.eval(wi, wo) * wi.z / pdf;
+                        acc.add(*g, l.map(|v| weight * v));
+                    }
+                    let (mean, variance) = acc.mean_and_variance(1.0);
+                    (i, mean, variance)
                 })
                 .collect()
         })
         .collect();
-    let mut out = vec![[0.0; 3]; observations.len()];
-    for (i, v) in per_block.into_iter().flatten() {
-        out[i] = v;
+    let mut out = IndirectSpecular {
+        mean: vec![[0.0; 3]; observations.len()],
+        variance: vec![[0.0; 3]; observations.len()],
+    };
+    for (i, mean, variance) in per_block.into_iter().flatten() {
+        out.mean[i] = mean;
+        out.variance[i] = variance;
     }
     out
+}
+
+/// One pixel's ΔS estimate: its observation, mean and variance.
+type PixelEstimate = (usize, [f64; 3], [f64; 3]);
+
+/// [`indirect_specular`]'s answer, per observation and channel.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct IndirectSpecular {
+    /// ΔS per unit ρs.
+    pub mean: Vec<[f64; 3]>,
+    /// The variance of `mean`'s Monte Carlo estimate, measured from its two
+    /// halves (0 where a half drew no ray).
+    pub variance: Vec<[f64; 3]>,
 }
 
 /// The factor on the base ΔS rays for a surface with material `m`: its
@@ -281,10 +327,11 @@ mod tests {
                 16,
                 1,
                 block,
+                true,
                 7,
             );
             let mut ratio = [0.0; 3];
-            for (v, a) in s.iter().zip(&a) {
+            for (v, a) in s.mean.iter().zip(&a) {
                 for c in 0..3 {
                     ratio[c] += v[c] / (b[c] * a) / observations.len() as f64;
                 }

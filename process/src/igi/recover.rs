@@ -241,6 +241,7 @@ pub fn recover_with_progress(
         })
         .collect();
     let mut kind_ind: Vec<[f64; 3]> = vec![[0.0; 3]; obs.len()];
+    let mut kind_var: Vec<[f64; 3]> = vec![[0.0; 3]; obs.len()];
     let mut highlights: Vec<Vec<HighlightReport>> = vec![Vec::new(); n_surf];
     let mut fits: Vec<SurfaceFit> = Vec::new();
     let mut iterations = Vec::new();
@@ -263,7 +264,7 @@ pub fn recover_with_progress(
             &materials,
             &shapes,
             &textured,
-            &mut kind_ind,
+            (&mut kind_ind, &mut kind_var),
             it,
             options,
             &mut report,
@@ -279,7 +280,7 @@ pub fn recover_with_progress(
                 .iter()
                 .map(|&i| {
                     let o = &obs[i];
-                    let e = total_irradiance(o, &field);
+                    let e = total_irradiance(o, &field, &geometry);
                     DetectorSample {
                         view: o.view,
                         radiance: o.radiance.iter().sum::<f64>() / 3.0,
@@ -299,7 +300,17 @@ pub fn recover_with_progress(
                 let floor = weight_floor(&by_surface[s], &obs);
                 let mut samples: Vec<FitSample> = by_surface[s]
                     .iter()
-                    .map(|&i| fit_sample(&obs[i], &field, kind_ind[i], materials[s].as_ref(), floor, group_key[i]))
+                    .map(|&i| {
+                        fit_sample(
+                            &obs[i],
+                            &field,
+                            &geometry,
+                            (kind_ind[i], kind_var[i]),
+                            materials[s].as_ref(),
+                            floor,
+                            group_key[i],
+                        )
+                    })
                     .collect();
                 let groups = number_groups(&mut samples);
                 let sparse = sparse_set(&by_surface[s], &obs, &samples, options.sparse_samples);
@@ -379,7 +390,17 @@ pub fn recover_with_progress(
             let refit = |draw: &[usize]| -> Option<WardMaterial> {
                 let mut dense: Vec<FitSample> = draw
                     .iter()
-                    .map(|&i| fit_sample(&obs[i], &field, kind_ind[i], Some(&reference), floor, group_key[i]))
+                    .map(|&i| {
+                        fit_sample(
+                            &obs[i],
+                            &field,
+                            &geometry,
+                            (kind_ind[i], kind_var[i]),
+                            Some(&reference),
+                            floor,
+                            group_key[i],
+                        )
+                    })
                     .collect();
                 let groups = number_groups(&mut dense);
                 let albedo = if textured {
@@ -486,7 +507,8 @@ fn setup(
     for (s, t) in side.iter_mut().zip(geometry.triangles()) {
         *s = if s.dot(&t.normal) >= 0.0 { t.normal } else { -t.normal };
     }
-    let field = RadiosityField::new(&geometry, input, side);
+    let mut field = RadiosityField::new(&geometry, input, side);
+    field.interpolate = options.correct_noise;
     Ok((geometry, obs, dropped, field))
 }
 
@@ -534,6 +556,7 @@ pub fn predict(
     let (geometry, obs, _, mut field) = setup(input, options)?;
     let shapes: Vec<Option<WardLobe>> = materials.iter().map(|m| m.and_then(|m| m.lobe)).collect();
     let mut kind_ind: Vec<[f64; 3]> = vec![[0.0; 3]; obs.len()];
+    let mut kind_var: Vec<[f64; 3]> = vec![[0.0; 3]; obs.len()];
     for it in 0..options.passes() {
         light_pass(
             &mut field,
@@ -543,7 +566,7 @@ pub fn predict(
             materials,
             &shapes,
             &[],
-            &mut kind_ind,
+            (&mut kind_ind, &mut kind_var),
             it,
             options,
             &mut |_| {},
@@ -554,7 +577,7 @@ pub fn predict(
         .enumerate()
         .map(|(i, o)| {
             let m = materials[o.surface].as_ref();
-            let e = total_irradiance(o, &field);
+            let e = total_irradiance(o, &field, &geometry);
             PredictedSample {
                 surface: o.surface,
                 view: o.view,
@@ -621,9 +644,10 @@ fn weight_floor(indices: &[usize], obs: &[Observation]) -> f64 {
     (WEIGHT_FLOOR * mean).max(1e-30)
 }
 
-/// Direct plus indirect irradiance at an observation.
-fn total_irradiance(o: &Observation, field: &RadiosityField) -> [f64; 3] {
-    let e = field.e_indirect[o.cell];
+/// Direct plus indirect irradiance at an observation (the indirect part
+/// interpolated between cells, [`RadiosityField::e_indirect_at`]).
+fn total_irradiance(o: &Observation, field: &RadiosityField, geometry: &Geometry) -> [f64; 3] {
+    let (e, _) = field.e_indirect_at(geometry, o.triangle, &o.point);
     [0, 1, 2].map(|c| o.e_direct[c] + e[c])
 }
 
@@ -656,7 +680,8 @@ fn specular_radiance(o: &Observation, m: Option<&WardMaterial>, kind: [f64; 3]) 
 /// One pass's light under `materials` (Fig. 4.6): (1) each cell's
 /// diffuse radiance, measured minus the specular estimate `kind_ind`;
 /// then, in interreflected images only, (2) the indirect irradiance per
-/// cell and (3) ΔS at every sample, written to `kind_ind`. `recover`
+/// cell and (3) ΔS at every sample, written to `kind_ind` (with its
+/// estimate's variance in `kind_var`, which the fit subtracts). `recover`
 /// refits after it, `predict` does not. Returns the seconds of (2) and (3).
 #[allow(clippy::too_many_arguments)]
 fn light_pass(
@@ -667,7 +692,7 @@ fn light_pass(
     materials: &[Option<WardMaterial>],
     shapes: &[Option<WardLobe>],
     textured: &[bool],
-    kind_ind: &mut Vec<[f64; 3]>,
+    (kind_ind, kind_var): (&mut Vec<[f64; 3]>, &mut Vec<[f64; 3]>),
     pass: u32,
     options: &IgiOptions,
     report: &mut dyn FnMut(&'static str),
@@ -685,7 +710,7 @@ fn light_pass(
     let gather_seconds = t.elapsed().as_secs_f64();
     let t = Instant::now();
     report("ΔS");
-    *kind_ind = indirect_specular(
+    let delta_s = indirect_specular(
         geometry,
         input,
         field,
@@ -697,8 +722,11 @@ fn light_pass(
         options.lobe_rays,
         options.lobe_ray_factor_max,
         options.lobe_ray_block,
+        options.correct_noise,
         seed ^ 0x5555,
     );
+    *kind_ind = delta_s.mean;
+    *kind_var = delta_s.variance;
     (gather_seconds, t.elapsed().as_secs_f64())
 }
 
@@ -722,7 +750,7 @@ fn estimate_diffuse(
         let (dm, sm) = (d.iter().sum::<f64>(), s.iter().sum::<f64>());
         let share = if dm + sm > 0.0 { dm / (dm + sm) } else { 1.0 };
         let w = o.wo.z * share * share;
-        let e = total_irradiance(o, field);
+        let e = total_irradiance(o, field, geometry);
         for c in 0..3 {
             sum[o.cell][c] += w * d[c];
             e_sum[o.cell][c] += w * e[c];
@@ -785,12 +813,14 @@ fn estimate_diffuse(
 fn fit_sample(
     o: &Observation,
     field: &RadiosityField,
-    kind: [f64; 3],
+    geometry: &Geometry,
+    (kind, kind_variance): ([f64; 3], [f64; 3]),
     previous: Option<&WardMaterial>,
     floor: f64,
     group: usize,
 ) -> FitSample {
-    let e = total_irradiance(o, field);
+    let (e_indirect, e_variance) = field.e_indirect_at(geometry, o.triangle, &o.point);
+    let e: [f64; 3] = [0, 1, 2].map(|c| o.e_direct[c] + e_indirect[c]);
     let diffuse = e.map(|v| v * std::f64::consts::FRAC_1_PI);
     let predicted = match previous {
         Some(m) => {
@@ -802,9 +832,11 @@ fn fit_sample(
     let p = predicted.max(floor);
     FitSample {
         diffuse,
+        diffuse_variance: e_variance.map(|v| v * std::f64::consts::FRAC_1_PI.powi(2)),
         lights: o.lights.iter().map(|t| (t.wi, t.irradiance)).collect(),
         wo: o.wo,
         indirect: kind,
+        indirect_variance: kind_variance,
         radiance: o.radiance,
         weight: 1.0 / (p * p),
         group,

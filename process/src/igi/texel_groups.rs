@@ -181,9 +181,11 @@ mod tests {
     fn sample(group: usize, rho_d: f64, d: f64) -> FitSample {
         FitSample {
             diffuse: [d; 3],
+            diffuse_variance: [0.0; 3],
             lights: Vec::new(),
             wo: Vector3::z(),
             indirect: [0.0; 3],
+            indirect_variance: [0.0; 3],
             radiance: [rho_d * d; 3],
             weight: 1.0,
             group,
