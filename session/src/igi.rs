@@ -53,7 +53,8 @@ pub fn settings(quick: bool) -> (IgiOptions, AlbedoMapOptions, RelightSettings) 
         // lobe (ρs 0.02) came out −6.3 to +4.9 % over seeds 1–3 at 1024,
         // within 1.4 % at 4096 (examples/igi_knobs; BENCHMARKS.md), for
         // about 2 s more on the 64² rooms (the gather does not grow with
-        // the pixels).
+        // the pixels). Scenes of many triangles get fewer a cell
+        // (igi::recover's gather budget: the simulated room keeps 1024).
         gather_rays: if quick { 32 } else { 4096 },
         // Three ΔS passes: beyond the third the largest change between
         // passes is the gather's and ΔS's noise (1.4 %, 4.3 %, 2.4 % at
@@ -329,6 +330,7 @@ fn summary(r: &Recovered, albedo: &[String]) -> serde_json::Value {
         "iteration_seconds": r.result.iterations.iter().map(|i| serde_json::json!({
             "total": i.seconds,
             "gather": i.gather_seconds,
+            "gather_rays": i.gather_rays,
             "delta_s": i.delta_s_seconds,
             "fit": i.fit_seconds,
         })).collect::<Vec<_>>(),

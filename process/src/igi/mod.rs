@@ -59,6 +59,6 @@ pub use input::{IgiInput, IgiLight, IgiOptions, View};
 pub use observation::DroppedPixels;
 pub use recover::{
     IgiProgress, IgiResult, IterationReport, PredictedSample, SpecularKind, SurfaceModel, SurfaceResult,
-    canonical_lobe, predict, recover, recover_with_progress, specular_kind,
+    canonical_lobe, gather_rays_per_cell, predict, recover, recover_with_progress, specular_kind,
 };
 pub use table::format_table;

@@ -95,6 +95,9 @@ pub struct IterationReport {
     pub seconds: f64,
     /// Of which: gathering the indirect irradiance (step 2).
     pub gather_seconds: f64,
+    /// Gather rays cast per cell ([`gather_rays_per_cell`]; 0 without
+    /// interreflection).
+    pub gather_rays: u32,
     /// Estimating ΔS at every sample (step 3).
     pub delta_s_seconds: f64,
     /// Highlight detection (first pass) and refitting every surface (step 4).
@@ -342,6 +345,11 @@ pub fn recover_with_progress(
             max_relative_change: change,
             seconds: t0.elapsed().as_secs_f64(),
             gather_seconds,
+            gather_rays: if options.interreflection {
+                gather_rays_per_cell(options.gather_rays, geometry.cell_count())
+            } else {
+                0
+            },
             delta_s_seconds,
             fit_seconds,
             materials: materials.clone(),
@@ -357,7 +365,8 @@ pub fn recover_with_progress(
     if !options.interreflection {
         let albedos = specular_albedos(&materials);
         let seed = options.seed.wrapping_add(u64::from(passes) * 0x9e37_79b9);
-        field.gather(&geometry, input, &materials, &albedos, options.gather_rays, seed);
+        let rays = gather_rays_per_cell(options.gather_rays, geometry.cell_count());
+        field.gather(&geometry, input, &materials, &albedos, rays, seed);
     }
     let mut check_samples: Vec<interreflection_check::SurfaceSamples> = vec![Vec::new(); n_surf];
     for (i, o) in obs.iter().enumerate() {
@@ -644,6 +653,27 @@ fn weight_floor(indices: &[usize], obs: &[Observation]) -> f64 {
     (WEIGHT_FLOOR * mean).max(1e-30)
 }
 
+/// The most rays one gather casts (cells × rays a cell): what 1024 rays a
+/// cell cost on the simulated room's 77 184 cells (536 triangles, 12 cells
+/// a side). The 64² validation rooms (12 triangles, 1728 cells) gather
+/// their full 4096 rays a cell within it.
+const GATHER_BUDGET: u64 = 80_000_000;
+
+/// Gather rays a cell: `requested`, or where `cells` of them would exceed
+/// [`GATHER_BUDGET`], the largest power of two that keeps within it (at
+/// least 64 or `requested`, whichever is fewer). A scene of many small
+/// triangles (faceted spheres) otherwise spends most of the gather on
+/// cells a few millimetres wide.
+pub fn gather_rays_per_cell(requested: u32, cells: usize) -> u32 {
+    let cells = cells.max(1) as u64;
+    if cells * u64::from(requested) <= GATHER_BUDGET {
+        return requested;
+    }
+    let fit = (GATHER_BUDGET / cells).clamp(1, u64::from(u32::MAX)) as u32;
+    let power = 1u32 << (31 - fit.leading_zeros());
+    power.max(requested.min(64))
+}
+
 /// Direct plus indirect irradiance at an observation (the indirect part
 /// interpolated between cells, [`RadiosityField::e_indirect_at`]).
 fn total_irradiance(o: &Observation, field: &RadiosityField, geometry: &Geometry) -> [f64; 3] {
@@ -706,7 +736,8 @@ fn light_pass(
     let t = Instant::now();
     report("indirect light");
     let albedos = specular_albedos(materials);
-    field.gather(geometry, input, materials, &albedos, options.gather_rays, seed);
+    let rays = gather_rays_per_cell(options.gather_rays, geometry.cell_count());
+    field.gather(geometry, input, materials, &albedos, rays, seed);
     let gather_seconds = t.elapsed().as_secs_f64();
     let t = Instant::now();
     report("ΔS");
@@ -1155,6 +1186,19 @@ fn energy(m: &WardMaterial) -> ([f64; 2], bool) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The validation rooms keep their 4096 rays; the simulated room
+    /// (536 triangles at 12 cells a side) gets the 1024 it had; a huge
+    /// scene no fewer than 64.
+    #[test]
+    fn the_gather_keeps_within_its_budget() {
+        assert_eq!(gather_rays_per_cell(4096, 12 * 144), 4096);
+        assert_eq!(gather_rays_per_cell(4096, 536 * 144), 1024);
+        assert_eq!(gather_rays_per_cell(1024, 536 * 144), 1024);
+        assert_eq!(gather_rays_per_cell(4096, 10_000_000), 64);
+        assert_eq!(gather_rays_per_cell(32, 10_000_000), 32);
+        assert_eq!(gather_rays_per_cell(4096, 0), 4096);
+    }
 
     #[test]
     fn the_canonical_representation_is_the_same_lobe_with_gamma_below_90_degrees() {
