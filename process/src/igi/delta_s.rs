@@ -28,7 +28,6 @@ use super::specular_albedo::SpecularAlbedo;
 use super::stratified::{GroupedMean, Strata, variance_groups};
 use super::texel_groups::TEXTURED_RAY_FACTOR;
 use crate::brdf::{WardLobe, WardMaterial};
-use crate::render::Ray;
 
 /// The farthest apart, metres, two pixels' points may be to share ΔS rays
 /// ([`indirect_specular`]): 2 cm. A shared ray leaves another pixel's
@@ -164,21 +163,18 @@ pub(crate) fn indirect_specular(
                             continue;
                         }
                         let direction = o.frame.to_world(&wi);
-                        let Some(hit) = geometry.intersect(&Ray { origin, direction }, f64::INFINITY) else {
-                            continue;
-                        };
-                        let l = field.radiance_toward(
+                        if let Some(l) = field.radiance_along(
                             geometry,
                             input,
                             &lobes,
                             albedos,
-                            hit.triangle,
-                            &hit.point,
-                            &-direction,
+                            origin,
+                            direction,
                             REFLECTION_DEPTH,
                             &mut rng,
-                        );
-                        traced.push((g, wi, pdf, l));
+                        ) {
+                            traced.push((g, wi, pdf, l));
+                        }
                     }
                 }
             }
@@ -249,6 +245,7 @@ mod tests {
 
     use super::*;
     use crate::brdf::WardVariant;
+    use crate::render::Ray;
 
     /// Under a uniform field (every surface Lambertian sending B, no
     /// lamps), ΔS per unit ρs at a pixel is B times the lobe's directional

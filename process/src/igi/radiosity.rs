@@ -90,10 +90,10 @@ pub(crate) struct RadiosityField {
     /// the gather's rays ([`Self::gather`]); the fit takes it
     /// out of its normal equations (`ward_fit`, regression dilution).
     pub e_indirect_variance: Vec<[f64; 3]>,
-    /// Whether [`Self::e_indirect_at`] interpolates between cells (else
-    /// it reads the point's cell), and [`Self::gather`] measures its
-    /// variance (`IgiOptions::correct_noise`).
-    pub interpolate: bool,
+    /// `IgiOptions::correct_noise`: [`Self::gather`] measures its
+    /// variance, and [`Self::e_indirect_at`] interpolates between cells
+    /// (else it reads the point's cell).
+    pub correct_noise: bool,
     /// Direct irradiance, the cell's average ([`DIRECT_POINTS`]), W·m⁻².
     pub e_direct: Vec<[f64; 3]>,
     /// Direct irradiance at the cell's [`DIRECT_POINTS`]² points (row
@@ -170,7 +170,7 @@ impl RadiosityField {
             observed: vec![false; n],
             e_indirect: vec![[0.0; 3]; n],
             e_indirect_variance: vec![[0.0; 3]; n],
-            interpolate: false,
+            correct_noise: false,
             e_direct,
             e_direct_points,
             visible,
@@ -267,18 +267,9 @@ impl RadiosityField {
             {
                 let direction = frame.to_world(&wi);
                 let origin = y + frame.normal * SURFACE_OFFSET * (1.0 + y.norm());
-                if let Some(hit) = geometry.intersect(&Ray { origin, direction }, f64::INFINITY) {
-                    let li = self.radiance_toward(
-                        geometry,
-                        input,
-                        lobes,
-                        albedos,
-                        hit.triangle,
-                        &hit.point,
-                        &-direction,
-                        depth - 1,
-                        rng,
-                    );
+                if let Some(li) =
+                    self.radiance_along(geometry, input, lobes, albedos, origin, direction, depth - 1, rng)
+                {
                     r = li.map(|v| v * weight);
                 }
             }
@@ -293,15 +284,44 @@ impl RadiosityField {
         l
     }
 
+    /// The radiance that reaches `origin` along `direction` (unit, world):
+    /// [`Self::radiance_toward`] at the first surface the ray meets, with
+    /// `depth`; `None` when it meets none.
+    #[allow(clippy::too_many_arguments)]
+    pub fn radiance_along(
+        &self,
+        geometry: &Geometry,
+        input: &IgiInput,
+        lobes: &[Option<SurfaceLobe>],
+        albedos: &[Option<SpecularAlbedo>],
+        origin: Vector3<f64>,
+        direction: Vector3<f64>,
+        depth: u32,
+        rng: &mut ChaCha8Rng,
+    ) -> Option<[f64; 3]> {
+        let hit = geometry.intersect(&Ray { origin, direction }, f64::INFINITY)?;
+        Some(self.radiance_toward(
+            geometry,
+            input,
+            lobes,
+            albedos,
+            hit.triangle,
+            &hit.point,
+            &-direction,
+            depth,
+            rng,
+        ))
+    }
+
     /// The indirect irradiance at point `p` of triangle `tri` and its
-    /// estimate's variance: with [`Self::interpolate`] bilinear between the centres of the point's
-    /// cell and its three nearest neighbours on the triangle's grid (cells
-    /// wholly outside the triangle left out, the weights renormalized;
-    /// the variance `Σ wᵢ² Varᵢ` of independent cells). On the Mitsuba
-    /// corridor (`validation/igi`) cell-constant values left the floor's
-    /// studio's checker wall's weak lobe ρs +3.1 to +3.4 % (seeds 1–3) at
-    /// 12 cells a side, and +0.6 to +2.2 % interpolated. Without, the
-    /// point's cell's value.
+    /// estimate's variance: with [`Self::correct_noise`] bilinear between
+    /// the centres of the point's cell and its three nearest neighbours on
+    /// the triangle's grid (cells wholly outside the triangle left out,
+    /// the weights renormalized; the variance `Σ wᵢ² Varᵢ` of independent
+    /// cells); without, the point's cell's value. On the Mitsuba studio
+    /// (`validation/igi`) cell-constant values left the checker wall's weak
+    /// lobe ρs +1.9 to +3.7 % over seeds 1–3 at 12 cells a side, +0.6 to
+    /// +2.2 % interpolated.
     pub fn e_indirect_at(&self, geometry: &Geometry, tri: usize, p: &Vector3<f64>) -> ([f64; 3], [f64; 3]) {
         let (cell, f) = geometry.cell_with_fraction(tri, p);
         self.e_indirect_in(geometry.n, cell, f)
@@ -310,7 +330,7 @@ impl RadiosityField {
     /// [`Self::e_indirect_at`] at fractional position `f` of cell `cell`
     /// on a grid of `n` cells a side.
     fn e_indirect_in(&self, n: usize, cell: usize, f: [f64; 2]) -> ([f64; 3], [f64; 3]) {
-        if !self.interpolate {
+        if !self.correct_noise {
             return (self.e_indirect[cell], self.e_indirect_variance[cell]);
         }
         let base = cell - cell % (n * n);
@@ -379,7 +399,7 @@ impl RadiosityField {
                 // variance is measured without bias (with
                 // `IgiOptions::correct_noise`; otherwise one set and no
                 // variance).
-                let groups = if self.interpolate {
+                let groups = if self.correct_noise {
                     variance_groups(rays)
                 } else {
                     vec![rays]
@@ -399,21 +419,18 @@ impl RadiosityField {
                         };
                         let direction = frame.to_world(&d);
                         let origin = p + frame.normal * SURFACE_OFFSET * (1.0 + p.norm());
-                        let Some(hit) = geometry.intersect(&Ray { origin, direction }, f64::INFINITY) else {
-                            continue;
-                        };
-                        let l = self.radiance_toward(
+                        if let Some(l) = self.radiance_along(
                             geometry,
                             input,
                             &lobes,
                             albedos,
-                            hit.triangle,
-                            &hit.point,
-                            &-direction,
+                            origin,
+                            direction,
                             REFLECTION_DEPTH,
                             &mut rng,
-                        );
-                        acc.add(g, l);
+                        ) {
+                            acc.add(g, l);
+                        }
                     }
                 }
                 acc.mean_and_variance(std::f64::consts::PI)
@@ -438,7 +455,7 @@ mod tests {
         let geometry = Geometry::new(&input.triangles, &input.surfaces, n).unwrap();
         let side = geometry.triangles().iter().map(|t| t.normal).collect();
         let mut field = RadiosityField::new(&geometry, &input, side);
-        field.interpolate = true;
+        field.correct_noise = true;
         let value = |i: f64, j: f64| 1.0 + 2.0 * i / n as f64 + 3.0 * j / n as f64;
         for cell in 0..geometry.cell_count() {
             let (i, j) = ((cell % (n * n)) / n, cell % n);
@@ -479,7 +496,7 @@ mod tests {
             "{e:?}"
         );
         // Without interpolation, the point's cell.
-        field.interpolate = false;
+        field.correct_noise = false;
         let (e, var) = field.e_indirect_at(&geometry, tri, &p);
         assert_eq!((e[0], var[0]), (value(3.5, 4.5), 1.0));
     }

@@ -517,7 +517,7 @@ fn setup(
         *s = if s.dot(&t.normal) >= 0.0 { t.normal } else { -t.normal };
     }
     let mut field = RadiosityField::new(&geometry, input, side);
-    field.interpolate = options.correct_noise;
+    field.correct_noise = options.correct_noise;
     Ok((geometry, obs, dropped, field))
 }
 
