@@ -90,8 +90,9 @@ def main():
     cv_tp = px_exp / (cv_merge / 1e3)
     camp_tp = camp["campanile_merge_mpx_exp_per_s"]
     # Bytes the Campanile merge must move per pixel·exposure: 3 u16 codes read
-    # (6 B) + its share of 7 f32 written (28 B / exposures) + 1 mask byte.
-    bytes_per_px_exp = 6 + (28 + 1) / len(times)
+    # (6 B) + its share of 6 f32 written (radiance and variance, 24 B) and
+    # the mask byte.
+    bytes_per_px_exp = 6 + (24 + 1) / len(times)
     print(f"stack: {w}x{h}, {len(times)} exposures, 8-bit PNG; OpenCV {cv2.__version__}, "
           f"{cv2.getNumThreads()} OpenCV threads, {int(camp['threads'])} Campanile threads")
     print(f"memory_bandwidth_copy_gb_s={bw:.2f}")
@@ -109,7 +110,12 @@ def main():
           f"ratio={camp_best_tp / cv_best_tp:.1f}")
     print(f"machine load average during the run: {os.getloadavg()[0]:.2f} (2 cores)")
     print(f"campanile_merge_bandwidth_gb_s={camp_tp * 1e6 * bytes_per_px_exp / 1e9:.2f} "
-          f"({100 * camp_tp * 1e6 * bytes_per_px_exp / 1e9 / bw:.0f}% of measured copy bandwidth)")
+          f"({100 * camp_tp * 1e6 * bytes_per_px_exp / 1e9 / bw:.0f}% of numpy's one-thread copy bandwidth)")
+    # The roofline hdr_bench measured in its own process, on the merge's threads.
+    for key in ("memory_copy_gb_s", "merge_best_gb_s", "merge_share_of_copy_roofline",
+                "same_traffic_kernel_best_ms", "merge_share_of_same_traffic_kernel"):
+        if key in camp:
+            print(f"hdr_bench_{key}={camp[key]:.3f}")
     for c, name in enumerate("rgb"):
         print(f"curve_log_rms_{name}: campanile={camp[f'campanile_curve_log_rms_{name}']:.5f} "
               f"opencv={log_rms(g_cv[:, c], truth[:, c]):.5f}")

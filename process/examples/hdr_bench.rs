@@ -75,6 +75,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         merge_into(&bracket, &cal.curve, &mopts, &mut map)?;
         merge_ms.push(t0.elapsed().as_secs_f64() * 1e3);
     }
+    // The memory roofline, measured in this run: the copy bandwidth of
+    // large buffers (read + written bytes per second) on the merge's
+    // threads, and a kernel that moves exactly the merge's bytes (every
+    // frame's codes read, radiance, variance and mask written through the
+    // same row-parallel loop) with next to no arithmetic.
+    let merge_best_ms = merge_ms.iter().copied().fold(f64::INFINITY, f64::min);
+    let copy_gb_s = copy_bandwidth_gb_s(rayon::current_num_threads());
+    let copy1_gb_s = copy_bandwidth_gb_s(1);
+    // (On a copy of the map's buffers: the merged map is scored below.)
+    let traffic_ms = same_traffic_ms(&bracket, &mut map.clone(), repeats.max(10));
+    let bytes_per_px_exp = merge_bytes_per_px_exp(bracket.len());
+    let merge_gb_s = (w * h * bracket.len()) as f64 * bytes_per_px_exp / (merge_best_ms / 1e3) / 1e9;
+    println!("memory_copy_gb_s={copy_gb_s:.2}");
+    println!("memory_copy_one_thread_gb_s={copy1_gb_s:.2}");
+    println!("merge_bytes_per_px_exp={bytes_per_px_exp:.3}");
+    println!("merge_best_gb_s={merge_gb_s:.2}");
+    println!("merge_share_of_copy_roofline={:.3}", merge_gb_s / copy_gb_s);
+    println!("same_traffic_kernel_best_ms={traffic_ms:.3}");
+    println!("merge_share_of_same_traffic_kernel={:.3}", traffic_ms / merge_best_ms);
     let (err, _) = median_relative_error(&map, &scene.data);
     let valid = map.mask.iter().filter(|&&m| m == 0).count() as f64 / map.mask.len() as f64;
     campanile_process::exr_io::write_radiance_exr(&map, &out.join("campanile_radiance.exr"))?;
@@ -141,4 +160,76 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     Ok(())
+}
+
+/// Bytes the merge must move per pixel and exposure: three u16 codes read,
+/// and its share of the 25 bytes a pixel written (radiance and variance, 3
+/// f32 each, and the mask byte).
+fn merge_bytes_per_px_exp(exposures: usize) -> f64 {
+    6.0 + 25.0 / exposures as f64
+}
+
+/// Best of five copies of a 256 MiB buffer on `threads` threads, in GB/s of
+/// bytes read plus bytes written.
+fn copy_bandwidth_gb_s(threads: usize) -> f64 {
+    let n = 256 << 20;
+    let src = vec![1u8; n];
+    let mut dst = vec![0u8; n];
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a thread pool");
+    let chunk = n / threads;
+    let mut best = f64::INFINITY;
+    for _ in 0..5 {
+        let t0 = Instant::now();
+        pool.install(|| {
+            use rayon::prelude::*;
+            dst.par_chunks_mut(chunk)
+                .zip(src.par_chunks(chunk))
+                .for_each(|(d, s)| d.copy_from_slice(s));
+        });
+        best = best.min(t0.elapsed().as_secs_f64());
+    }
+    std::hint::black_box(&dst);
+    2.0 * n as f64 / best / 1e9
+}
+
+/// Best time (ms) of a pass that reads every frame's codes and writes the
+/// map's radiance, variance and mask row by row like the merge, with one
+/// addition per sample instead of the merge's tables.
+fn same_traffic_ms(bracket: &Bracket, map: &mut campanile_process::hdr::merge::RadianceMap, repeats: usize) -> f64 {
+    use rayon::prelude::*;
+    let w = bracket.width();
+    let images: Vec<&[u16]> = bracket.images().iter().map(|im| im.data.as_slice()).collect();
+    let mut best = f64::INFINITY;
+    for _ in 0..repeats {
+        let t0 = Instant::now();
+        map.rgb
+            .par_chunks_mut(w * 3)
+            .zip(map.variance.par_chunks_mut(w * 3))
+            .zip(map.mask.par_chunks_mut(w))
+            .enumerate()
+            .for_each_init(Vec::new, |acc: &mut Vec<u32>, (y, ((rgb, var), mask))| {
+                // Vectorized sums of the frames' rows, then the writes.
+                let base = y * w * 3;
+                acc.clear();
+                acc.resize(w * 3, 0);
+                for im in &images {
+                    for (a, &z) in acc.iter_mut().zip(&im[base..base + w * 3]) {
+                        *a += u32::from(z);
+                    }
+                }
+                for ((r, v), &a) in rgb.iter_mut().zip(var.iter_mut()).zip(acc.iter()) {
+                    *r = a as f32;
+                    *v = (a + 1) as f32;
+                }
+                for (m, a) in mask.iter_mut().zip(acc.chunks_exact(3)) {
+                    *m = (a[0] & 1) as u8;
+                }
+            });
+        best = best.min(t0.elapsed().as_secs_f64());
+    }
+    std::hint::black_box(&map.rgb);
+    best * 1e3
 }

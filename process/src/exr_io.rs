@@ -19,7 +19,7 @@ use crate::camera::image::RadianceImage;
 use crate::hdr::HdrError;
 use crate::hdr::merge::RadianceMap;
 
-/// Writes `map` to `path` as OpenEXR (ZIP-compressed scan lines).
+/// Writes `map` to `path` as OpenEXR (PIZ-compressed scan lines).
 pub fn write_radiance_exr(map: &RadianceMap, path: &Path) -> std::result::Result<(), HdrError> {
     let n = map.width * map.height;
     let plane = |src: &[f32], c: usize| -> Vec<f32> { (0..n).map(|p| src[p * 3 + c]).collect() };
@@ -42,7 +42,7 @@ pub fn write_radiance_exr(map: &RadianceMap, path: &Path) -> std::result::Result
     write_layer(map, LayerAttributes::named("radiance"), channels, path)
 }
 
-/// Writes one ZIP-compressed scan-line layer of `map`'s size.
+/// Writes one PIZ-compressed scan-line layer of `map`'s size.
 fn write_layer(
     map: &RadianceMap,
     attributes: LayerAttributes,
@@ -81,7 +81,7 @@ pub enum ExrPrecision {
     Half,
 }
 
-/// Writes the radiance of `map` alone as a plain RGB OpenEXR (ZIP-compressed
+/// Writes the radiance of `map` alone as a plain RGB OpenEXR (PIZ-compressed
 /// scan lines, channels `R`, `G`, `B`).
 pub fn write_rgb_exr(map: &RadianceMap, path: &Path, precision: ExrPrecision) -> std::result::Result<(), HdrError> {
     let n = map.width * map.height;

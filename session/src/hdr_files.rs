@@ -515,13 +515,20 @@ fn output_format(o: &MergeRequest) -> anyhow::Result<MapFormat> {
 
 /// Writes a merged map as asked.
 fn write_map(o: &MergeRequest, format: MapFormat, map: &RadianceMap) -> anyhow::Result<()> {
-    match format {
+    let started = std::time::Instant::now();
+    let written = match format {
         MapFormat::Hdr => write_rgbe(map, &o.out),
         MapFormat::Exr if o.with_variance => write_radiance_exr(map, &o.out),
         MapFormat::Exr if o.half => write_rgb_exr(map, &o.out, ExrPrecision::Half),
         MapFormat::Exr => write_rgb_exr(map, &o.out, ExrPrecision::Float),
     }
-    .context("writing the radiance map")
+    .context("writing the radiance map");
+    tracing::debug!(
+        file = %o.out.display(),
+        seconds = format!("{:.3}", started.elapsed().as_secs_f64()),
+        "radiance map encoded and written"
+    );
+    written
 }
 
 fn file_name(p: &Path) -> String {

@@ -315,7 +315,16 @@ struct PassContext<'a> {
     height: usize,
 }
 
+/// Pixels merged together in the pass's inner loop.
+const TILE: usize = 2;
+
 /// The single parallel pass over the pixels, for `N = 2^bits` codes.
+///
+/// Row by row, in tiles of [`TILE`] pixels: each exposure's three tables
+/// stay fixed while the tile's `3·TILE` codes are looked up, and the sums
+/// `Σ w_j`, `Σ w_j X_j` stay in registers. Each sum adds the exposures in
+/// order, as a loop per pixel would, so the numbers do not depend on the
+/// tiling.
 fn pass<const N: usize>(ctx: &PassContext, out: &mut RadianceMap) {
     let (w, h) = (ctx.width, ctx.height);
     let t = ctx.tables;
@@ -339,31 +348,63 @@ fn pass<const N: usize>(ctx: &PassContext, out: &mut RadianceMap) {
         .for_each(|(y, ((rgb_row, var_row), mask_row))| {
             let base = y * w * 3;
             let rows: Vec<&[u16]> = ctx.images.iter().map(|im| &im[base..base + w * 3]).collect();
-            for (x, mask_out) in mask_row.iter_mut().enumerate() {
-                // Accumulate in registers: two table lookups per sample.
-                let (mut sw, mut swx) = ([0.0f32; 3], [0.0f32; 3]);
-                for (row, lut) in rows.iter().zip(&luts) {
-                    let z = &row[x * 3..x * 3 + 3];
-                    for c in 0..3 {
-                        let [wj, wxj] = lut[c][usize::from(z[c]) & (N - 1)];
-                        sw[c] += wj;
-                        swx[c] += wxj;
-                    }
-                }
+            let finish = |x: usize, sums: &[[f32; 2]], rgb: &mut [f32], var: &mut [f32]| {
                 let falloff = ctx
                     .falloff
                     .map_or(1.0, |f| f.at_r2(normalized_r2(x, y, w, h)).max(1e-6) as f32);
                 let k = x * 3;
-                let m = finish_pixel(
+                finish_pixel(
                     t,
-                    (sw, swx),
+                    (std::array::from_fn(|c| sums[c][0]), std::array::from_fn(|c| sums[c][1])),
                     std::array::from_fn(|c| shortest[base + k + c] >= ctx.zmax),
                     (gain, var_gain),
                     falloff,
-                    &mut rgb_row[k..k + 3],
-                    &mut var_row[k..k + 3],
-                );
-                *mask_out = m;
+                    rgb,
+                    var,
+                )
+            };
+            let tiled = w - w % TILE;
+            for x0 in (0..tiled).step_by(TILE) {
+                // (Σw, Σw·X) per sample of the tile.
+                let mut acc = [[0.0f32; 2]; 3 * TILE];
+                for (row, lut) in rows.iter().zip(t.lut.chunks_exact(3 * N)) {
+                    let z: &[u16; 3 * TILE] = row[x0 * 3..(x0 + TILE) * 3].try_into().expect("a tile of codes");
+                    for (s, a) in acc.iter_mut().enumerate() {
+                        let [wj, wxj] = lut[(s % 3) * N + (usize::from(z[s]) & (N - 1))];
+                        a[0] += wj;
+                        a[1] += wxj;
+                    }
+                }
+                if ctx.falloff.is_none() && acc.iter().all(|a| a[0] > 0.0) {
+                    // Every sample has weight: the tile's radiance and
+                    // variance in straight-line arithmetic (as finish_pixel
+                    // computes them with falloff 1), mask clear.
+                    let k = x0 * 3;
+                    let rgb: &mut [f32; 3 * TILE] = (&mut rgb_row[k..k + 3 * TILE]).try_into().expect("a tile");
+                    let var: &mut [f32; 3 * TILE] = (&mut var_row[k..k + 3 * TILE]).try_into().expect("a tile");
+                    for (s, [sw, swx]) in acc.iter().enumerate() {
+                        rgb[s] = swx / sw * gain[s % 3];
+                        var[s] = var_gain[s % 3] / sw;
+                    }
+                    mask_row[x0..x0 + TILE].fill(0);
+                } else {
+                    for (i, sums) in acc.chunks_exact(3).enumerate() {
+                        let (x, k) = (x0 + i, (x0 + i) * 3);
+                        mask_row[x] = finish(x, sums, &mut rgb_row[k..k + 3], &mut var_row[k..k + 3]);
+                    }
+                }
+            }
+            for x in tiled..w {
+                let mut acc = [[0.0f32; 2]; 3];
+                for (row, lut) in rows.iter().zip(&luts) {
+                    for (c, a) in acc.iter_mut().enumerate() {
+                        let [wj, wxj] = lut[c][usize::from(row[x * 3 + c]) & (N - 1)];
+                        a[0] += wj;
+                        a[1] += wxj;
+                    }
+                }
+                let k = x * 3;
+                mask_row[x] = finish(x, &acc, &mut rgb_row[k..k + 3], &mut var_row[k..k + 3]);
             }
         });
 }
@@ -433,6 +474,69 @@ pub(crate) mod tests {
             .map(|(j, &t)| cam.photograph(&scene, t, 40 + j as u64))
             .collect();
         (Bracket::new(imgs, SEVEN_STOP_TIMES_S.to_vec()).unwrap(), scene.data)
+    }
+
+    /// The tiled pass is the definition, pixel by pixel: on an odd width
+    /// (a pixel left over after the tiles), with clipped and dark samples,
+    /// with and without falloff, every radiance, variance and mask equals
+    /// the per-pixel sum over exposures through the same tables and
+    /// [`finish_pixel`], bit for bit.
+    #[test]
+    fn the_tiled_pass_is_the_per_pixel_definition() {
+        let cam = CameraModel::typical(8);
+        let (w, h) = (2 * TILE * 12 + 1, 9);
+        let scene = hdr_chart(w, h);
+        let images: Vec<CodeImage> = SEVEN_STOP_TIMES_S
+            .iter()
+            .enumerate()
+            .map(|(j, &t)| {
+                let mut im = cam.photograph(&scene, t, 40 + j as u64);
+                // Two tiles and the last pixel clipped in every exposure,
+                // one tile black in every exposure, one channel of a pixel each.
+                for p in [0, 1, 2, 3, w - 1, 2 * w + 5] {
+                    im.data[p * 3..p * 3 + 3].fill(255);
+                }
+                im.data[(3 * w + 7) * 3 + 1] = 255;
+                for p in [4 * w, 4 * w + 1, w + 2] {
+                    im.data[p * 3..p * 3 + 3].fill(0);
+                }
+                im.data[(5 * w + 3) * 3 + 2] = 0;
+                im
+            })
+            .collect();
+        let b = Bracket::new(images, SEVEN_STOP_TIMES_S.to_vec()).unwrap();
+        let curve = true_curve(&cam);
+        for falloff in [None, Some(RadialPolynomial { a: -0.3, b: 0.05 })] {
+            let opts = MergeOptions {
+                falloff,
+                nd_transmittance: [0.5, 0.25, 0.125],
+                ..Default::default()
+            };
+            let map = merge(&b, &curve, &opts).unwrap();
+            let t = build_tables(8, b.times_s(), &curve, &opts.noise);
+            let g = gains(&t, &opts);
+            let (mut clipped, mut dark) = (0, 0);
+            for p in 0..w * h {
+                let (mut sw, mut swx) = ([0.0f32; 3], [0.0f32; 3]);
+                for (j, im) in b.images().iter().enumerate() {
+                    for c in 0..3 {
+                        let [a, x] = t.lut[(j * 3 + c) * t.codes + usize::from(im.data[p * 3 + c])];
+                        sw[c] += a;
+                        swx[c] += x;
+                    }
+                }
+                let f = falloff.map_or(1.0, |f| f.at_r2(normalized_r2(p % w, p / w, w, h)).max(1e-6) as f32);
+                let (mut rgb, mut var) = ([0.0f32; 3], [0.0f32; 3]);
+                let saturated = std::array::from_fn(|c| b.images()[0].data[p * 3 + c] >= 255);
+                let m = finish_pixel(&t, (sw, swx), saturated, g, f, &mut rgb, &mut var);
+                assert_eq!(map.mask[p], m, "pixel {p}");
+                assert_eq!(&map.rgb[p * 3..p * 3 + 3], &rgb, "pixel {p}");
+                assert_eq!(&map.variance[p * 3..p * 3 + 3], &var, "pixel {p}");
+                clipped += usize::from(m & 0b111 != 0);
+                dark += usize::from(m & 0b111_000 != 0);
+            }
+            assert_eq!((clipped, dark), (7, 4), "pixels clipped and dark in some channel");
+        }
     }
 
     #[test]

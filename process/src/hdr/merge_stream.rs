@@ -87,26 +87,43 @@ impl FrameVisitor for Sums<'_> {
         let luts: [&[[f32; 2]]; 3] =
             std::array::from_fn(|c| &s.tables.lut[(j * 3 + c) * codes..(j * 3 + c + 1) * codes]);
         let w = s.width;
+        let pass = |((sw, swx), sat): ((&mut [f32], &mut [f32]), &mut [u8]), row: &[u16]| {
+            for (((z, sw), swx), sat) in row
+                .chunks_exact(3)
+                .zip(sw.chunks_exact_mut(3))
+                .zip(swx.chunks_exact_mut(3))
+                .zip(sat.iter_mut())
+            {
+                let mut saturated = 0u8;
+                for c in 0..3 {
+                    let waits = PileUpSamples::waits(pile_up[c], z[c], max);
+                    let [wj, wxj] = if waits {
+                        [0.0, 0.0]
+                    } else {
+                        luts[c][usize::from(z[c]).min(codes - 1)]
+                    };
+                    if j == 0 {
+                        // The sums' first write: fresh (untouched) pages are
+                        // written before they are ever read, so each costs one
+                        // page fault and no copy-on-write of the zero page.
+                        saturated |= u8::from(z[c] >= max) << c;
+                        sw[c] = wj;
+                        swx[c] = wxj;
+                    } else if !waits {
+                        sw[c] += wj;
+                        swx[c] += wxj;
+                    }
+                }
+                if j == 0 {
+                    *sat = saturated;
+                }
+            }
+        };
         s.sw.par_chunks_mut(w * 3)
             .zip(s.swx.par_chunks_mut(w * 3))
             .zip(s.saturated.par_chunks_mut(w))
             .zip(image.data.par_chunks(w * 3))
-            .for_each(|(((sw, swx), sat), row)| {
-                for (x, z) in row.chunks_exact(3).enumerate() {
-                    for c in 0..3 {
-                        let k = x * 3 + c;
-                        if j == 0 && z[c] >= max {
-                            sat[x] |= 1 << c;
-                        }
-                        if PileUpSamples::waits(pile_up[c], z[c], max) {
-                            continue;
-                        }
-                        let [wj, wxj] = luts[c][usize::from(z[c]).min(codes - 1)];
-                        sw[k] += wj;
-                        swx[k] += wxj;
-                    }
-                }
-            });
+            .for_each(|(sums, row)| pass(sums, row));
         self.held.hold(j, image, pile_up);
         Ok(())
     }
