@@ -54,9 +54,10 @@ pub enum HdrCommand {
     /// Pixels clipped in every exposure keep the darkest exposure's bound and
     /// are counted in the verdict (OUT's stem + .quality.json).
     ///
-    /// Frames are decoded one at a time into per-pixel sums: memory is about
-    /// 24 bytes a pixel plus two frames (0.8 GB for 21 MP), whatever the
-    /// number of frames; --align and --deghost hold every frame.
+    /// Frames are decoded one at a time into per-pixel sums, the next one
+    /// on its own thread while the last is added: memory is about 24 bytes
+    /// a pixel plus three frames (0.9 GB for 21 MP), whatever the number of
+    /// frames; --align and --deghost hold every frame.
     ///
     /// Example:
     ///   campanile hdr merge IMG_*.JPG --curve curve.csv -o scene.exr
