@@ -329,15 +329,8 @@ fn pass<const N: usize>(ctx: &PassContext, out: &mut RadianceMap) {
     let (w, h) = (ctx.width, ctx.height);
     let t = ctx.tables;
     debug_assert_eq!(t.codes, N);
-    let luts: Vec<[&[[f32; 2]; N]; 3]> = (0..ctx.images.len())
-        .map(|j| {
-            std::array::from_fn(|c| {
-                t.lut[(j * 3 + c) * N..(j * 3 + c + 1) * N]
-                    .try_into()
-                    .expect("tables have N entries")
-            })
-        })
-        .collect();
+    // Exposure j's tables: `[c · N + z]` in the j-th chunk.
+    let luts = || t.lut.chunks_exact(3 * N);
     let shortest = ctx.images[0];
     let (gain, var_gain) = (ctx.gain, ctx.var_gain);
     out.rgb
@@ -367,7 +360,7 @@ fn pass<const N: usize>(ctx: &PassContext, out: &mut RadianceMap) {
             for x0 in (0..tiled).step_by(TILE) {
                 // (Σw, Σw·X) per sample of the tile.
                 let mut acc = [[0.0f32; 2]; 3 * TILE];
-                for (row, lut) in rows.iter().zip(t.lut.chunks_exact(3 * N)) {
+                for (row, lut) in rows.iter().zip(luts()) {
                     let z: &[u16; 3 * TILE] = row[x0 * 3..(x0 + TILE) * 3].try_into().expect("a tile of codes");
                     for (s, a) in acc.iter_mut().enumerate() {
                         let [wj, wxj] = lut[(s % 3) * N + (usize::from(z[s]) & (N - 1))];
@@ -396,9 +389,9 @@ fn pass<const N: usize>(ctx: &PassContext, out: &mut RadianceMap) {
             }
             for x in tiled..w {
                 let mut acc = [[0.0f32; 2]; 3];
-                for (row, lut) in rows.iter().zip(&luts) {
+                for (row, lut) in rows.iter().zip(luts()) {
                     for (c, a) in acc.iter_mut().enumerate() {
-                        let [wj, wxj] = lut[c][usize::from(row[x * 3 + c]) & (N - 1)];
+                        let [wj, wxj] = lut[c * N + (usize::from(row[x * 3 + c]) & (N - 1))];
                         a[0] += wj;
                         a[1] += wxj;
                     }
