@@ -6,7 +6,9 @@ use nalgebra::Vector3;
 
 use super::OccurrenceLight;
 use crate::render::{Sky, SolarDisc};
-use crate::sky::{KnownSky, OvercastSky, PredictError, SUN_ANGULAR_RADIUS_RAD, SkyModel, angle_between, predict_sky};
+use crate::sky::{
+    KnownSky, OvercastSky, PredictError, SUN_ANGULAR_RADIUS_RAD, SkyAngles, SkyModel, angle_between, predict_sky,
+};
 use crate::sun::{Extinction, SunPosition, air_mass, fit_extinction};
 
 /// A sky of three eq. (5.9) models and a solar disc.
@@ -54,10 +56,11 @@ impl Sky for MeasuredSky {
         }
         let d = [d.x, d.y, d.z];
         let (xi, gamma) = (d[2].clamp(-1.0, 1.0).acos(), angle_between(d, self.sun_direction));
-        let clear = [0, 1, 2].map(|c| self.models[c].radiance(xi, gamma).max(0.0));
+        let at = SkyAngles::new(xi, gamma);
+        let clear = [0, 1, 2].map(|c| self.models[c].radiance_at(&at).max(0.0));
         match &self.overcast {
             None => clear,
-            Some((p, o)) => [0, 1, 2].map(|c| (1.0 - p) * clear[c] + p * o[c].radiance(xi, gamma).max(0.0)),
+            Some((p, o)) => [0, 1, 2].map(|c| (1.0 - p) * clear[c] + p * o[c].radiance_at(&at).max(0.0)),
         }
     }
 

@@ -12,7 +12,7 @@ use nalgebra::Vector3;
 use super::cie::{CieSky, CieSkyType};
 use super::geometry::angle_between;
 use super::predict::redden;
-use super::seven_parameter::SkyModel;
+use super::seven_parameter::{SkyAngles, SkyModel};
 use crate::render::sky::{Sky, SolarDisc};
 use crate::sun::air_mass;
 
@@ -128,10 +128,11 @@ impl Daylight {
         }
         let xi = d[2].min(1.0).acos();
         let gamma = angle_between(d, self.sun_direction);
+        let at = SkyAngles::new(xi, gamma);
         [0, 1, 2].map(|c| {
-            let clear = self.sky[c].radiance(xi, gamma);
+            let clear = self.sky[c].radiance_at(&at);
             match &self.overcast {
-                Some((o, p)) => (1.0 - p) * clear + p * o[c].radiance(xi, gamma),
+                Some((o, p)) => (1.0 - p) * clear + p * o[c].radiance_at(&at),
                 None => clear,
             }
         })

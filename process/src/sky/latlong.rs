@@ -4,7 +4,7 @@
 //! the bottom, pixel centres at half-integers.
 
 use super::geometry::angle_between;
-use super::seven_parameter::SkyModel;
+use super::seven_parameter::{SkyAngles, SkyModel};
 
 /// The world direction at the centre of pixel `(x, y)` of a `width ×
 /// height` map.
@@ -24,7 +24,8 @@ pub fn render_latlong(models: &[SkyModel; 3], sun: [f64; 3], width: usize) -> (u
         for x in 0..width {
             let d = latlong_direction(x, y, width, height);
             let (xi, gamma) = (d[2].clamp(-1.0, 1.0).acos(), angle_between(d, sun));
-            rgb.extend(models.iter().map(|m| m.radiance(xi, gamma) as f32));
+            let at = SkyAngles::new(xi, gamma);
+            rgb.extend(models.iter().map(|m| m.radiance_at(&at) as f32));
         }
     }
     (width, height, rgb)

@@ -32,4 +32,4 @@ pub use geometry::{angle_between, direction};
 pub use latlong::{latlong_direction, render_latlong};
 pub use perez::{BRIGHTNESS_RANGE, CLEARNESS_BIN_EDGES, PerezSky, table_extremes};
 pub use predict::{KnownSky, OvercastSky, PredictError, predict_sky, redden};
-pub use seven_parameter::{COS_XI_FLOOR, SkyModel};
+pub use seven_parameter::{COS_XI_FLOOR, SkyAngles, SkyModel};

@@ -15,7 +15,7 @@
 use super::cie::{CieSky, CieSkyType};
 use super::fit::{SkyFit, SkyFitError, SkySample, fit_sky};
 use super::geometry::{angle_between, direction};
-use super::seven_parameter::SkyModel;
+use super::seven_parameter::{SkyAngles, SkyModel};
 
 /// A fitted sky and where its sun was.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -237,7 +237,8 @@ impl OvercastSky {
 
     /// Radiance at (ξ, γ).
     pub fn radiance(&self, xi: f64, gamma: f64) -> f64 {
-        (1.0 - self.blocked) * self.clear.radiance(xi, gamma) + self.blocked * self.overcast.radiance(xi, gamma)
+        let at = SkyAngles::new(xi, gamma);
+        (1.0 - self.blocked) * self.clear.radiance_at(&at) + self.blocked * self.overcast.radiance_at(&at)
     }
 }
 

@@ -37,7 +37,7 @@ use super::day::DayExtinction;
 use super::regions::{REGION_COUNT, region_grid, region_solid_angle, sun_neighbourhood_grid};
 use super::scan::ScanProducts;
 use crate::pipeline::median;
-use crate::sky::{REDDENING_ONSET_AIR_MASS, SkyModel, angle_between, direction, redden};
+use crate::sky::{REDDENING_ONSET_AIR_MASS, SkyAngles, SkyModel, angle_between, direction, redden};
 use crate::sun::{air_mass, line_fit};
 
 /// Largest `|ln(measured/expected)|` of a clear region in any channel
@@ -171,7 +171,8 @@ fn mean_radiance(models: &[SkyModel; 3], dirs: &[[f64; 3]], sun: [f64; 3]) -> Op
     let mut sum = [0.0; 3];
     for &d in dirs {
         let (xi, g) = (d[2].clamp(-1.0, 1.0).acos(), angle_between(d, sun));
-        (0..3).for_each(|c| sum[c] += models[c].radiance(xi, g));
+        let at = SkyAngles::new(xi, g);
+        (0..3).for_each(|c| sum[c] += models[c].radiance_at(&at));
     }
     Some(sum.map(|v| v / dirs.len() as f64))
 }

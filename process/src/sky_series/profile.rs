@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::sky_pixels::for_each_sky_pixel;
 use crate::pipeline::{MergedGroup, SUN_MARGIN_RAD, StationOptics};
-use crate::sky::{SkyModel, angle_between, direction};
+use crate::sky::{SkyAngles, SkyModel, angle_between, direction};
 use crate::sun::SunPosition;
 
 /// Width of a profile bin, degrees.
@@ -84,7 +84,8 @@ pub fn meridian_profile(
             .map(|&s| {
                 let d = plane_direction(s.to_radians(), az);
                 let (xi, gamma) = (d[2].clamp(-1.0, 1.0).acos(), angle_between(d, sun_dir));
-                [0, 1, 2].map(|c| m[c].radiance(xi, gamma))
+                let at = SkyAngles::new(xi, gamma);
+                [0, 1, 2].map(|c| m[c].radiance_at(&at))
             })
             .collect()
     });
