@@ -85,8 +85,9 @@ pub fn predict_sky(known: &[KnownSky], sun: [f64; 3], step_deg: f64) -> Result<S
             let xi = angle_between(v, [0.0, 0.0, 1.0]);
             let gamma = angle_between(v, sun);
             (gamma > 0.5f64.to_radians()).then(|| {
-                let bg: f64 = known.iter().zip(&w).map(|(k, w)| w * k.model.background(xi)).sum();
-                let sa: f64 = known.iter().zip(&w).map(|(k, w)| w * k.model.aureole(gamma)).sum();
+                let at = SkyAngles::new(xi, gamma);
+                let bg: f64 = known.iter().zip(&w).map(|(k, w)| w * k.model.background_at(&at)).sum();
+                let sa: f64 = known.iter().zip(&w).map(|(k, w)| w * k.model.aureole_at(&at)).sum();
                 SkySample {
                     xi,
                     gamma,
@@ -155,7 +156,8 @@ fn zenith_radiance(known: &[KnownSky], w: &[f64], zs: f64) -> Option<f64> {
         Some(0) => (p[0].0 - zs < 1e-9).then_some(p[0].1),
         Some(i) => Some(monotone_cubic(&p, i - 1, zs)),
     }?;
-    let aureole: f64 = known.iter().zip(w).map(|(k, w)| w * k.model.aureole(zs)).sum();
+    let at = SkyAngles::new(0.0, zs);
+    let aureole: f64 = known.iter().zip(w).map(|(k, w)| w * k.model.aureole_at(&at)).sum();
     Some(without_aureole * aureole)
 }
 
