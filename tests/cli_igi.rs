@@ -239,7 +239,8 @@ fn igi_recovers_the_simulated_room_from_its_scene_file_and_relights_it() {
     let (a, b) = (block_average(&relit, 4), block_average(&sim, 4));
     let rmse = relative_rmse(&a, &b, |i| b.data[i * 3] < 20.0).unwrap();
     eprintln!("relit against the simulator: {:.2} % (4x4 blocks)", 100.0 * rmse);
-    // Measured 3.58 % (64 stratified paths per pixel, the albedo maps'
+    // Measured 3.22 % on 2026-11-29; 3.58 % before issue 24's solver
+    // changes (64 stratified paths per pixel, the albedo maps'
     // noise shrinkage aware of the gather's noise, ΔS traced along the
     // lobe, 1 cm texels, the scene file's free-position views of the metal
     // sphere; 3.57 % without those views, 3.96 % before the map's three

@@ -4,7 +4,7 @@
 //! (`validation/igi`).
 //!
 //! `cargo run --release -p campanile-process --example igi_knobs -- SCENE OUT
-//! [cells_per_edge gather_rays lobe_rays iterations seed lobe_ray_factor_max lobe_ray_block correct_noise]`
+//! [cells_per_edge gather_rays lobe_rays iterations seed lobe_ray_factor_max lobe_ray_block correct_noise sparse_samples]`
 //! (`correct_noise` 0 or 1, `IgiOptions::correct_noise`; the command line's
 //! full settings are `12 4096 16 3 SEED 8 1 1`)
 
@@ -16,7 +16,7 @@ use campanile_process::igi::{IgiOptions, recover};
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if args.len() < 3 {
-        eprintln!("usage: igi_knobs SCENE OUT [cells gather lobe iterations seed factor block correct_noise]");
+        eprintln!("usage: igi_knobs SCENE OUT [cells gather lobe iterations seed factor block correct_noise sparse]");
         std::process::exit(2);
     }
     let knob = |i: usize, d: u64| args.get(i).and_then(|a| a.parse().ok()).unwrap_or(d);
@@ -41,6 +41,7 @@ fn main() {
         iterations: knob(6, 4) as u32,
         seed: knob(7, 1),
         correct_noise: knob(10, 0) != 0,
+        sparse_samples: knob(11, 2500) as usize,
         ..IgiOptions::default()
     };
     let r = match recover(&loaded.input, &options) {

@@ -6,7 +6,7 @@
 //! linear step would move ρd and ρs at the true roughness; the median
 //! measured / predicted away from highlights and near them.
 //!
-//! `cargo run --release -p campanile-process --example igi_model_bias -- SCENE TRUTH [cells gather lobe passes seed]`
+//! `cargo run --release -p campanile-process --example igi_model_bias -- SCENE TRUTH [cells gather lobe passes seed factor correct_noise]`
 
 use campanile_process::brdf::{WardLobe, WardMaterial, WardVariant};
 use campanile_process::igi::scene_file::load;
@@ -23,7 +23,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if args.len() < 3 {
-        eprintln!("usage: igi_model_bias SCENE TRUTH [cells gather lobe passes seed]");
+        eprintln!("usage: igi_model_bias SCENE TRUTH [cells gather lobe passes seed factor correct_noise]");
         std::process::exit(2);
     }
     let knob = |i: usize, d: u64| args.get(i).and_then(|a| a.parse().ok()).unwrap_or(d);
@@ -82,6 +82,8 @@ fn main() {
         lobe_rays: knob(5, 16) as u32,
         iterations: knob(6, 4) as u32,
         seed: knob(7, 1),
+        lobe_ray_factor_max: knob(8, 1) as u32,
+        correct_noise: knob(9, 0) != 0,
         ..IgiOptions::default()
     };
     let samples = predict(&loaded.input, &options, &materials).unwrap_or_else(|e| {
