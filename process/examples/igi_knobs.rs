@@ -4,7 +4,7 @@
 //! (`validation/igi`).
 //!
 //! `cargo run --release -p campanile-process --example igi_knobs -- SCENE OUT
-//! [cells_per_edge gather_rays lobe_rays iterations seed lobe_ray_factor_max lobe_ray_block correct_noise sparse_samples]`
+//! [cells_per_edge gather_rays lobe_rays iterations seed lobe_ray_factor_max lobe_ray_block correct_noise sparse_samples point_gather_rays]`
 //! (`correct_noise` 0 or 1, `IgiOptions::correct_noise`; the command line's
 //! full settings are `12 4096 16 3 SEED 8 1 1`)
 
@@ -42,6 +42,7 @@ fn main() {
         seed: knob(7, 1),
         correct_noise: knob(10, 0) != 0,
         sparse_samples: knob(11, 2500) as usize,
+        point_gather_rays: knob(12, 0) as u32,
         ..IgiOptions::default()
     };
     let r = match recover(&loaded.input, &options) {

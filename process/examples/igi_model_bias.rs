@@ -6,7 +6,7 @@
 //! linear step would move ρd and ρs at the true roughness; the median
 //! measured / predicted away from highlights and near them.
 //!
-//! `cargo run --release -p campanile-process --example igi_model_bias -- SCENE TRUTH [cells gather lobe passes seed factor correct_noise]`
+//! `cargo run --release -p campanile-process --example igi_model_bias -- SCENE TRUTH [cells gather lobe passes seed factor correct_noise point_gather_rays]`
 
 use campanile_process::brdf::{WardLobe, WardMaterial, WardVariant};
 use campanile_process::igi::scene_file::load;
@@ -23,7 +23,9 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if args.len() < 3 {
-        eprintln!("usage: igi_model_bias SCENE TRUTH [cells gather lobe passes seed factor correct_noise]");
+        eprintln!(
+            "usage: igi_model_bias SCENE TRUTH [cells gather lobe passes seed factor correct_noise point_gather_rays]"
+        );
         std::process::exit(2);
     }
     let knob = |i: usize, d: u64| args.get(i).and_then(|a| a.parse().ok()).unwrap_or(d);
@@ -84,6 +86,7 @@ fn main() {
         seed: knob(7, 1),
         lobe_ray_factor_max: knob(8, 1) as u32,
         correct_noise: knob(9, 0) != 0,
+        point_gather_rays: knob(10, 0) as u32,
         ..IgiOptions::default()
     };
     let samples = predict(&loaded.input, &options, &materials).unwrap_or_else(|e| {

@@ -83,6 +83,17 @@ pub struct IgiOptions {
     /// At most this many samples per surface in the sparse set the
     /// roughness search uses (§4.5 footnote); the linear step uses all.
     pub sparse_samples: usize,
+    /// Cosine rays gathered at each observation's own point for the
+    /// indirect irradiance the fit and the diffuse estimate use
+    /// (`RadiosityField::gather_points`, on top of the cells' gather, which
+    /// the other surfaces' radiance still reads); 0 (the default): read
+    /// between the cells' gathered values. A diagnostic of the cells'
+    /// resolution, not a cure: on the Mitsuba corridor (`validation/igi`)
+    /// 1024 rays a point left the floor's weak lobe α −3.06, −1.87,
+    /// −4.10 % over solver seeds 1–3 (cells: −2.75, −2.42, −5.57 %) and
+    /// took 19× the gather's time (40 s a pass against 2.1 s); 256 rays gave −6.4 % (BENCHMARKS.md,
+    /// "the corridor floor's α").
+    pub point_gather_rays: u32,
     /// ΔS iterations (§4.5.1, Fig. 4.6): each re-estimates the diffuse
     /// radiance, the indirect light and the BRDFs. Default 3: on the
     /// §4.7.1 cube the first pass (no ΔS correction) leaves 15 % in ρs,
@@ -134,6 +145,7 @@ impl Default for IgiOptions {
             lobe_ray_factor_max: 1,
             lobe_ray_block: 1,
             sparse_samples: 2500,
+            point_gather_rays: 0,
             iterations: 3,
             max_view_angle_rad: 84f64.to_radians(),
             allow_anisotropic: true,

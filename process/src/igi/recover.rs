@@ -283,7 +283,7 @@ pub fn recover_with_progress(
                 .iter()
                 .map(|&i| {
                     let o = &obs[i];
-                    let e = total_irradiance(o, &field, &geometry);
+                    let e = total_irradiance(o, i, &field, &geometry);
                     DetectorSample {
                         view: o.view,
                         radiance: o.radiance.iter().sum::<f64>() / 3.0,
@@ -305,7 +305,7 @@ pub fn recover_with_progress(
                     .iter()
                     .map(|&i| {
                         fit_sample(
-                            &obs[i],
+                            (i, &obs[i]),
                             &field,
                             &geometry,
                             (kind_ind[i], kind_var[i]),
@@ -401,7 +401,7 @@ pub fn recover_with_progress(
                     .iter()
                     .map(|&i| {
                         fit_sample(
-                            &obs[i],
+                            (i, &obs[i]),
                             &field,
                             &geometry,
                             (kind_ind[i], kind_var[i]),
@@ -586,7 +586,7 @@ pub fn predict(
         .enumerate()
         .map(|(i, o)| {
             let m = materials[o.surface].as_ref();
-            let e = total_irradiance(o, &field, &geometry);
+            let e = total_irradiance(o, i, &field, &geometry);
             PredictedSample {
                 surface: o.surface,
                 view: o.view,
@@ -676,8 +676,8 @@ pub fn gather_rays_per_cell(requested: u32, cells: usize) -> u32 {
 
 /// Direct plus indirect irradiance at an observation (the indirect part
 /// interpolated between cells, [`RadiosityField::e_indirect_at`]).
-fn total_irradiance(o: &Observation, field: &RadiosityField, geometry: &Geometry) -> [f64; 3] {
-    let (e, _) = field.e_indirect_at(geometry, o.triangle, &o.point);
+fn total_irradiance(o: &Observation, index: usize, field: &RadiosityField, geometry: &Geometry) -> [f64; 3] {
+    let (e, _) = field.e_indirect_of(geometry, index, o.triangle, &o.point);
     [0, 1, 2].map(|c| o.e_direct[c] + e[c])
 }
 
@@ -738,6 +738,18 @@ fn light_pass(
     let albedos = specular_albedos(materials);
     let rays = gather_rays_per_cell(options.gather_rays, geometry.cell_count());
     field.gather(geometry, input, materials, &albedos, rays, seed);
+    if options.point_gather_rays > 0 {
+        let points: Vec<_> = obs.iter().map(|o| (o.point, o.frame)).collect();
+        field.gather_points(
+            geometry,
+            input,
+            materials,
+            &albedos,
+            &points,
+            options.point_gather_rays,
+            seed,
+        );
+    }
     let gather_seconds = t.elapsed().as_secs_f64();
     let t = Instant::now();
     report("ΔS");
@@ -781,7 +793,7 @@ fn estimate_diffuse(
         let (dm, sm) = (d.iter().sum::<f64>(), s.iter().sum::<f64>());
         let share = if dm + sm > 0.0 { dm / (dm + sm) } else { 1.0 };
         let w = o.wo.z * share * share;
-        let e = total_irradiance(o, field, geometry);
+        let e = total_irradiance(o, i, field, geometry);
         for c in 0..3 {
             sum[o.cell][c] += w * d[c];
             e_sum[o.cell][c] += w * e[c];
@@ -842,7 +854,7 @@ fn estimate_diffuse(
 
 /// An observation as the fit sees it, weighted by `1 / L̂²` (App. A).
 fn fit_sample(
-    o: &Observation,
+    (index, o): (usize, &Observation),
     field: &RadiosityField,
     geometry: &Geometry,
     (kind, kind_variance): ([f64; 3], [f64; 3]),
@@ -850,7 +862,7 @@ fn fit_sample(
     floor: f64,
     group: usize,
 ) -> FitSample {
-    let (e_indirect, e_variance) = field.e_indirect_at(geometry, o.triangle, &o.point);
+    let (e_indirect, e_variance) = field.e_indirect_of(geometry, index, o.triangle, &o.point);
     let e: [f64; 3] = [0, 1, 2].map(|c| o.e_direct[c] + e_indirect[c]);
     let diffuse = e.map(|v| v * std::f64::consts::FRAC_1_PI);
     let predicted = match previous {
