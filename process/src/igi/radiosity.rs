@@ -571,11 +571,6 @@ mod tests {
         let (e, var) = field.e_indirect_at(&geometry, tri, &p);
         assert_eq!((e[0], var[0]), (value(3.5, 4.5), 1.0));
     }
-}
-
-#[cfg(test)]
-mod point_gather_tests {
-    use super::*;
 
     /// A cube whose cells each send out a radiance linear in their
     /// centre's height (`materials` none, so the radiance is the cell's).
