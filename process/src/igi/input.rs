@@ -132,6 +132,26 @@ pub struct IgiOptions {
     /// bound by chance (seeds 2 and 3: 2.2 %, 1.2 %) and does not with it
     /// (3.1 %). On in the command line's full settings.
     pub correct_noise: bool,
+    /// Keep the ΔS rays of the roughness search's samples and weigh them,
+    /// at each roughness the search tries, by that lobe
+    /// (`delta_s::DeltaSRays::estimate`, unbiased for any lobe), instead
+    /// of holding ΔS at the lobe it was drawn with (the previous pass's).
+    /// Held, ΔS pulls the search against it (a sharper ΔS leaves a broader
+    /// direct highlight to fit), and where ΔS is a large part of a
+    /// surface's specular light the passes' roughness oscillates about its
+    /// fixed point: on the Mitsuba corridor (`validation/igi`) the floor's
+    /// weak lobe (ρs 0.02, α 0.15; ΔS two thirds of its specular light)
+    /// went 0.1378, 0.1536, 0.1471, 0.1492, 0.1458, 0.1474 over six passes
+    /// (solver seed 1), and three passes reported α −2.75, −2.42, −5.57 %
+    /// over seeds 1–3; weighed, −1.21, −1.91, −1.36 % (ρs +0.22, −0.59,
+    /// +1.80 %) at the command line's settings, every check of that room
+    /// passing at each seed, for 24.4 s a solve against 16.7 s
+    /// (BENCHMARKS.md, "the corridor floor's α"). Textured surfaces keep
+    /// ΔS as drawn (their per-group fit takes no noise correction). Off in
+    /// the default, whose 256 gather rays leave the gather's noise larger
+    /// than this; on in the command line's full settings, with
+    /// [`Self::correct_noise`].
+    pub reweight_delta_s: bool,
 }
 
 impl Default for IgiOptions {
@@ -152,6 +172,7 @@ impl Default for IgiOptions {
             seed: 1,
             interreflection: true,
             correct_noise: false,
+            reweight_delta_s: false,
         }
     }
 }

@@ -6,12 +6,13 @@
 //! detected, and each surface's model chosen, on every pass (diffuse-only without a seen highlight; isotropic or
 //! anisotropic by BIC).
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
-use super::delta_s::indirect_specular;
+use super::delta_s::{DeltaSRays, indirect_specular};
 use super::error::IgiError;
 use super::geometry::Geometry;
 use super::highlight::{DetectorSample, HighlightReport, detect};
@@ -245,6 +246,18 @@ pub fn recover_with_progress(
         .collect();
     let mut kind_ind: Vec<[f64; 3]> = vec![[0.0; 3]; obs.len()];
     let mut kind_var: Vec<[f64; 3]> = vec![[0.0; 3]; obs.len()];
+    // The observations of each surface's roughness search, whose ΔS rays
+    // are kept to be weighed by the lobe the search tries
+    // (`IgiOptions::reweight_delta_s`).
+    let mut keep = vec![false; obs.len()];
+    if options.reweight_delta_s {
+        for ix in &by_surface {
+            for k in sparse_indices(ix, &obs, options.sparse_samples) {
+                keep[ix[k]] = true;
+            }
+        }
+    }
+    let mut kind_rays: Vec<Option<Arc<DeltaSRays>>> = vec![None; obs.len()];
     let mut highlights: Vec<Vec<HighlightReport>> = vec![Vec::new(); n_surf];
     let mut fits: Vec<SurfaceFit> = Vec::new();
     let mut iterations = Vec::new();
@@ -268,6 +281,9 @@ pub fn recover_with_progress(
             &shapes,
             &textured,
             (&mut kind_ind, &mut kind_var),
+            // The first pass's light is read from the images alone: its
+            // ΔS is too rough to be worth weighing again.
+            (if it > 0 { &keep } else { &[] }, &mut kind_rays),
             it,
             options,
             &mut report,
@@ -304,7 +320,7 @@ pub fn recover_with_progress(
                 let mut samples: Vec<FitSample> = by_surface[s]
                     .iter()
                     .map(|&i| {
-                        fit_sample(
+                        let mut sample = fit_sample(
                             (i, &obs[i]),
                             &field,
                             &geometry,
@@ -312,7 +328,9 @@ pub fn recover_with_progress(
                             materials[s].as_ref(),
                             floor,
                             group_key[i],
-                        )
+                        );
+                        sample.indirect_rays = kind_rays[i].clone();
+                        sample
                     })
                     .collect();
                 let groups = number_groups(&mut samples);
@@ -576,6 +594,7 @@ pub fn predict(
             &shapes,
             &[],
             (&mut kind_ind, &mut kind_var),
+            (&[], &mut Vec::new()),
             it,
             options,
             &mut |_| {},
@@ -723,6 +742,7 @@ fn light_pass(
     shapes: &[Option<WardLobe>],
     textured: &[bool],
     (kind_ind, kind_var): (&mut Vec<[f64; 3]>, &mut Vec<[f64; 3]>),
+    (keep, kind_rays): (&[bool], &mut Vec<Option<Arc<DeltaSRays>>>),
     pass: u32,
     options: &IgiOptions,
     report: &mut dyn FnMut(&'static str),
@@ -753,6 +773,12 @@ fn light_pass(
     let gather_seconds = t.elapsed().as_secs_f64();
     let t = Instant::now();
     report("ΔS");
+    // Textured surfaces' fit (per texel group) takes ΔS as it is drawn.
+    let keep: Vec<bool> = keep
+        .iter()
+        .zip(obs)
+        .map(|(&k, o)| k && !textured.get(o.surface).copied().unwrap_or(false))
+        .collect();
     let delta_s = indirect_specular(
         geometry,
         input,
@@ -766,10 +792,12 @@ fn light_pass(
         options.lobe_ray_factor_max,
         options.lobe_ray_block,
         options.correct_noise,
+        &keep,
         seed ^ 0x5555,
     );
     *kind_ind = delta_s.mean;
     *kind_var = delta_s.variance;
+    *kind_rays = delta_s.rays;
     (gather_seconds, t.elapsed().as_secs_f64())
 }
 
@@ -880,6 +908,7 @@ fn fit_sample(
         wo: o.wo,
         indirect: kind,
         indirect_variance: kind_variance,
+        indirect_rays: None,
         radiance: o.radiance,
         weight: 1.0 / (p * p),
         group,
@@ -890,6 +919,15 @@ fn fit_sample(
 /// thinned evenly so that the set stays near `target`, plus an
 /// even share of the rest.
 fn sparse_set(indices: &[usize], obs: &[Observation], samples: &[FitSample], target: usize) -> Vec<FitSample> {
+    sparse_indices(indices, obs, target)
+        .into_iter()
+        .map(|k| samples[k].clone())
+        .collect()
+}
+
+/// The positions in `indices` (a surface's observations) of
+/// [`sparse_set`]'s samples.
+fn sparse_indices(indices: &[usize], obs: &[Observation], target: usize) -> Vec<usize> {
     let near: Vec<usize> = (0..indices.len())
         .filter(|&k| obs[indices[k]].lights.iter().any(|t| t.delta < SPARSE_HIGHLIGHT_RAD))
         .collect();
@@ -902,7 +940,7 @@ fn sparse_set(indices: &[usize], obs: &[Observation], samples: &[FitSample], tar
     near.iter()
         .step_by(near_stride)
         .chain(far.iter().step_by(far_stride))
-        .map(|&k| samples[k].clone())
+        .copied()
         .collect()
 }
 

@@ -87,7 +87,7 @@ pub(crate) fn variance_groups(n: u32) -> Vec<u32> {
 }
 
 /// The most groups [`variance_groups`] splits rays into.
-const MAX_GROUPS: u32 = 8;
+pub(crate) const MAX_GROUPS: u32 = 8;
 
 /// A Monte Carlo mean per channel accumulated over independent groups of
 /// draws ([`variance_groups`]), with its variance measured from the
@@ -126,32 +126,36 @@ impl GroupedMean {
     /// variance by its square); zeros without draws, variance 0 with
     /// fewer than two groups drawn.
     pub fn mean_and_variance(&self, scale: f64) -> ([f64; 3], [f64; 3]) {
-        let total: u32 = self.counts.iter().sum();
-        if total == 0 {
-            return ([0.0; 3], [0.0; 3]);
-        }
-        let c_all = f64::from(total);
-        let mean = [0, 1, 2].map(|c| self.sums.iter().map(|s| s[c]).sum::<f64>() / c_all);
-        let drawn = self.counts.iter().filter(|&&n| n > 0).count();
-        let variance = if drawn < 2 {
-            [0.0; 3]
-        } else {
-            [0, 1, 2].map(|c| {
-                let spread: f64 = self
-                    .sums
-                    .iter()
-                    .zip(&self.counts)
-                    .filter(|(_, n)| **n > 0)
-                    .map(|(s, &n)| {
-                        let d = s[c] / f64::from(n) - mean[c];
-                        f64::from(n) * d * d
-                    })
-                    .sum();
-                spread / ((drawn - 1) as f64 * c_all)
-            })
-        };
-        (mean.map(|m| m * scale), variance.map(|v| v * scale * scale))
+        grouped_mean_and_variance(&self.sums, &self.counts, scale)
     }
+}
+
+/// [`GroupedMean::mean_and_variance`] of groups' sums and draw counts.
+pub(crate) fn grouped_mean_and_variance(sums: &[[f64; 3]], counts: &[u32], scale: f64) -> ([f64; 3], [f64; 3]) {
+    let total: u32 = counts.iter().sum();
+    if total == 0 {
+        return ([0.0; 3], [0.0; 3]);
+    }
+    let c_all = f64::from(total);
+    let mean = [0, 1, 2].map(|c| sums.iter().map(|s| s[c]).sum::<f64>() / c_all);
+    let drawn = counts.iter().filter(|&&n| n > 0).count();
+    let variance = if drawn < 2 {
+        [0.0; 3]
+    } else {
+        [0, 1, 2].map(|c| {
+            let spread: f64 = sums
+                .iter()
+                .zip(counts)
+                .filter(|(_, n)| **n > 0)
+                .map(|(s, &n)| {
+                    let d = s[c] / f64::from(n) - mean[c];
+                    f64::from(n) * d * d
+                })
+                .sum();
+            spread / ((drawn - 1) as f64 * c_all)
+        })
+    };
+    (mean.map(|m| m * scale), variance.map(|v| v * scale * scale))
 }
 
 #[cfg(test)]

@@ -186,6 +186,7 @@ mod tests {
             wo: Vector3::z(),
             indirect: [0.0; 3],
             indirect_variance: [0.0; 3],
+            indirect_rays: None,
             radiance: [rho_d * d; 3],
             weight: 1.0,
             group,

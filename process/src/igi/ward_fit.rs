@@ -31,7 +31,9 @@
 
 use nalgebra::Vector3;
 
+use super::delta_s::DeltaSRays;
 use crate::brdf::{MIN_ALPHA, WardKernel, WardLobe, WardMaterial, WardVariant};
+use std::sync::Arc;
 
 /// One observation as the fit sees it.
 #[derive(Debug, Clone, PartialEq)]
@@ -50,6 +52,12 @@ pub(crate) struct FitSample {
     /// The variance of [`Self::indirect`]'s Monte Carlo estimate, per
     /// channel: the noise [`linear_fit`] takes out of its normal equations.
     pub indirect_variance: [f64; 3],
+    /// The rays [`Self::indirect`] was estimated from, when kept
+    /// (`IgiOptions::reweight_delta_s`): the fit then weighs them by the
+    /// lobe it tries ([`DeltaSRays::estimate`]), so that the roughness
+    /// search sees ΔS under each roughness it tries, not under the previous
+    /// pass's.
+    pub indirect_rays: Option<Arc<DeltaSRays>>,
     /// Measured radiance per channel.
     pub radiance: [f64; 3],
     /// Weight of the squared residual.
@@ -128,16 +136,22 @@ pub(crate) struct LinearFit {
     pub error: f64,
 }
 
-/// The specular coefficient of each sample for a lobe, per channel.
-fn specular_coefficients(samples: &[FitSample], lobe: Option<&WardLobe>) -> Vec<[f64; 3]> {
+/// Each sample's specular coefficient under `lobe` (per unit ρs: the
+/// lights' kernel terms plus ΔS) and the variance of its ΔS part, per
+/// channel; zeros without a lobe. ΔS is the sample's stored estimate, or,
+/// when its rays were kept, their estimate under `lobe` itself.
+fn specular_coefficients(samples: &[FitSample], lobe: Option<&WardLobe>) -> Vec<([f64; 3], [f64; 3])> {
     let kernel = lobe.map(WardKernel::new);
     samples
         .iter()
         .map(|s| {
             let Some(kernel) = kernel else {
-                return [0.0; 3];
+                return ([0.0; 3], [0.0; 3]);
             };
-            let mut k = s.indirect;
+            let (mut k, variance) = match &s.indirect_rays {
+                Some(rays) => rays.estimate(&kernel, &s.wo),
+                None => (s.indirect, s.indirect_variance),
+            };
             for (wi, e) in &s.lights {
                 let kern = kernel.eval(wi, &s.wo);
                 if kern > 0.0 {
@@ -146,7 +160,7 @@ fn specular_coefficients(samples: &[FitSample], lobe: Option<&WardLobe>) -> Vec<
                     }
                 }
             }
-            k
+            (k, variance)
         })
         .collect()
 }
@@ -159,7 +173,7 @@ pub(crate) fn diffuse_radiance(samples: &[FitSample], material: Option<&WardMate
     samples
         .iter()
         .zip(&spec)
-        .map(|(s, k)| [0, 1, 2].map(|c| s.radiance[c] - lobe.map_or(0.0, |l| l.rho_s[c]) * k[c]))
+        .map(|(s, (k, _))| [0, 1, 2].map(|c| s.radiance[c] - lobe.map_or(0.0, |l| l.rho_s[c]) * k[c]))
         .collect()
 }
 
@@ -203,10 +217,10 @@ pub(crate) fn linear_fit(samples: &[FitSample], lobe: Option<&WardLobe>, albedo:
     for c in 0..3 {
         let mut sums = TwoTermSums::default();
         let (mut noise_d, mut noise_s) = (0.0, 0.0);
-        for (s, k) in samples.iter().zip(&spec) {
+        for (s, (k, k_variance)) in samples.iter().zip(&spec) {
             sums.add(s.weight, s.diffuse[c], k[c], s.radiance[c]);
             noise_d += s.weight * s.diffuse_variance[c];
-            noise_s += s.weight * s.indirect_variance[c];
+            noise_s += s.weight * k_variance[c];
         }
         sums.xx -= noise_d.min(MAX_NOISE_SHARE * sums.xx);
         if lobe.is_some() {
@@ -257,7 +271,7 @@ pub(crate) fn linear_fit(samples: &[FitSample], lobe: Option<&WardLobe>, albedo:
 /// adds nothing. The ρd returned is the surface's mean albedo under that
 /// ρs (the uniform fit of `l − ρs k`), which is what the radiosity solve
 /// and the albedo maps start from.
-fn within_groups(samples: &[FitSample], spec: &[[f64; 3]], lobe: bool, groups: usize) -> LinearFit {
+fn within_groups(samples: &[FitSample], spec: &[([f64; 3], [f64; 3])], lobe: bool, groups: usize) -> LinearFit {
     let mut rho_d = [0.0; 3];
     let mut rho_s = [0.0; 3];
     let mut error = 0.0;
@@ -265,7 +279,7 @@ fn within_groups(samples: &[FitSample], spec: &[[f64; 3]], lobe: bool, groups: u
     for c in 0..3 {
         acc.fill([0.0; 3]);
         let mut sums = TwoTermSums::default();
-        for (s, k) in samples.iter().zip(spec) {
+        for (s, (k, _)) in samples.iter().zip(spec) {
             let (d, k, l, w) = (s.diffuse[c], k[c], s.radiance[c], s.weight);
             let g = &mut acc[s.group];
             g[0] += w * d * d;
@@ -511,6 +525,7 @@ mod tests {
                     wo: Vector3::z(),
                     indirect: [kn; 3],
                     indirect_variance: [0.0; 3],
+                    indirect_rays: None,
                     radiance: [0.5 * d + 0.3 * k; 3],
                     weight: 1.0,
                     group: 0,
@@ -586,6 +601,7 @@ mod tests {
                     wo,
                     indirect: [0.1; 3],
                     indirect_variance: [0.0; 3],
+                    indirect_rays: None,
                     radiance: [l; 3],
                     weight: 1.0 / (l * l),
                     group: 0,
