@@ -6,7 +6,7 @@
 //! `cargo run --release -p campanile-process --example igi_knobs -- SCENE OUT
 //! [cells_per_edge gather_rays lobe_rays iterations seed lobe_ray_factor_max lobe_ray_block correct_noise sparse_samples point_gather_rays reweight_delta_s]`
 //! (`correct_noise` and `reweight_delta_s` 0 or 1, `IgiOptions::correct_noise`, `IgiOptions::reweight_delta_s`; the command line's
-//! full settings are `12 4096 16 3 SEED 8 1 1`)
+//! full settings are `12 4096 16 3 SEED 8 1 1 2500 0 1`)
 
 use campanile_process::brdf::WardVariant;
 use campanile_process::igi::material_record::{records, variant_name};
@@ -43,7 +43,7 @@ fn main() {
         correct_noise: knob(10, 0) != 0,
         sparse_samples: knob(11, 2500) as usize,
         point_gather_rays: knob(12, 0) as u32,
-        reweight_delta_s: knob(13, 1) != 0,
+        reweight_delta_s: knob(13, 0) != 0,
         ..IgiOptions::default()
     };
     let r = match recover(&loaded.input, &options) {
