@@ -84,7 +84,8 @@ pub fn settings(quick: bool) -> (IgiOptions, AlbedoMapOptions, RelightSettings) 
         // The roughness search weighs each of its samples' ΔS rays by the
         // lobe it tries (IgiOptions::reweight_delta_s): the Mitsuba
         // corridor floor's weak lobe α −2.4 to −5.6 % → within 1.91 %
-        // (seeds 1–3), for 24 s a solve against 17 s.
+        // (seeds 1–3), for 20–23 s a solve against 17 s (24–26 s before
+        // the kept rays were scored through igi::delta_s::LobeTerms).
         reweight_delta_s: !quick,
         ..IgiOptions::default()
     };

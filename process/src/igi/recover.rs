@@ -329,7 +329,11 @@ pub fn recover_with_progress(
                             floor,
                             group_key[i],
                         );
-                        sample.indirect_rays = kind_rays[i].clone();
+                        // The kept ΔS rays toward this pixel, once for the whole
+                        // roughness search (`LobeTerms`).
+                        sample.indirect_rays = kind_rays[i]
+                            .as_ref()
+                            .map(|rays| std::sync::Arc::new(rays.toward(&obs[i].wo, options.variant)));
                         sample
                     })
                     .collect();

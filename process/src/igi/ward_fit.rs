@@ -31,7 +31,7 @@
 
 use nalgebra::Vector3;
 
-use super::delta_s::DeltaSRays;
+use super::delta_s::LobeTerms;
 use crate::brdf::{MIN_ALPHA, WardKernel, WardLobe, WardMaterial, WardVariant};
 use std::sync::Arc;
 
@@ -53,11 +53,12 @@ pub(crate) struct FitSample {
     /// channel: the noise [`linear_fit`] takes out of its normal equations.
     pub indirect_variance: [f64; 3],
     /// The rays [`Self::indirect`] was estimated from, when kept
-    /// (`IgiOptions::reweight_delta_s`): the fit then weighs them by the
-    /// lobe it tries ([`DeltaSRays::estimate`]), so that the roughness
+    /// (`IgiOptions::reweight_delta_s`), worked out toward [`Self::wo`]
+    /// in the fit's variant: the fit then weighs them by the lobe it
+    /// tries ([`LobeTerms::estimate`]), so that the roughness
     /// search sees ΔS under each roughness it tries, not under the previous
     /// pass's.
-    pub indirect_rays: Option<Arc<DeltaSRays>>,
+    pub indirect_rays: Option<Arc<LobeTerms>>,
     /// Measured radiance per channel.
     pub radiance: [f64; 3],
     /// Weight of the squared residual.
@@ -149,7 +150,7 @@ fn specular_coefficients(samples: &[FitSample], lobe: Option<&WardLobe>) -> Vec<
                 return ([0.0; 3], [0.0; 3]);
             };
             let (mut k, variance) = match &s.indirect_rays {
-                Some(rays) => rays.estimate(&kernel, &s.wo),
+                Some(rays) => rays.estimate(&kernel),
                 None => (s.indirect, s.indirect_variance),
             };
             for (wi, e) in &s.lights {

@@ -3,9 +3,14 @@
 //! by its PID when dropped: how the tests meet real INDI software, and how
 //! a user can try a station on INDI's simulators.
 
+use std::collections::BTreeSet;
 use std::net::TcpListener;
 use std::process::{Child, Command, Stdio};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
+
+/// The ports [`LocalServer::start`] has handed out in this process.
+static HANDED_OUT: Mutex<BTreeSet<u16>> = Mutex::new(BTreeSet::new());
 
 /// A running `indiserver`, killed (by PID) and reaped on drop.
 #[derive(Debug)]
@@ -17,12 +22,34 @@ pub struct LocalServer {
 impl LocalServer {
     /// Starts `indiserver` with `drivers` (e.g. `indi_simulator_ccd`) on a
     /// free loopback port, waiting until it listens.
+    ///
+    /// The port is one the system reports free and that no other server
+    /// of this process has had: a port is free again once its server is
+    /// stopped, and a test that stops a server and starts it again on the
+    /// same port (`start_on`) would otherwise race a server started
+    /// meanwhile on that port. If the server still exits on start (another
+    /// process took the port between the check and its bind), another
+    /// port is tried, three times at most.
     pub fn start(drivers: &[&str]) -> Result<LocalServer, String> {
-        let port = TcpListener::bind("127.0.0.1:0")
-            .and_then(|l| l.local_addr())
-            .map_err(|e| format!("finding a free port: {e}"))?
-            .port();
-        LocalServer::start_on(port, drivers)
+        let mut last = String::new();
+        for _ in 0..3 {
+            let port = loop {
+                let port = TcpListener::bind("127.0.0.1:0")
+                    .and_then(|l| l.local_addr())
+                    .map_err(|e| format!("finding a free port: {e}"))?
+                    .port();
+                let mut handed_out = HANDED_OUT.lock().unwrap_or_else(|e| e.into_inner());
+                if handed_out.insert(port) {
+                    break port;
+                }
+            };
+            match LocalServer::start_on(port, drivers) {
+                Ok(server) => return Ok(server),
+                Err(e) if e.contains("exited") => last = e,
+                Err(e) => return Err(e),
+            }
+        }
+        Err(last)
     }
 
     /// Starts `indiserver` with `drivers` on `port`.
@@ -49,14 +76,24 @@ impl LocalServer {
             port,
         };
         let deadline = Instant::now() + Duration::from_secs(15);
+        let exited = |server: &mut LocalServer| match server.child.as_mut().map(Child::try_wait) {
+            Some(Ok(Some(status))) => Some(format!("indiserver on port {port} exited at once ({status})")),
+            _ => None,
+        };
         while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
-            if let Some(Ok(Some(status))) = server.child.as_mut().map(Child::try_wait) {
-                return Err(format!("indiserver on port {port} exited at once ({status})"));
+            if let Some(e) = exited(&mut server) {
+                return Err(e);
             }
             if Instant::now() > deadline {
                 return Err(format!("indiserver did not listen on port {port} within 15 s"));
             }
             std::thread::sleep(Duration::from_millis(50));
+        }
+        // Something listens; it must be this server, not one that held the
+        // port before (this one would then exit on its failed bind).
+        std::thread::sleep(Duration::from_millis(100));
+        if let Some(e) = exited(&mut server) {
+            return Err(e);
         }
         Ok(server)
     }
