@@ -16,6 +16,8 @@
 //! measurement exceeds its prediction. On RADIANCE's metal wall (ρs 0.56,
 //! ρd 0.24) 16 rays a pixel put ρd 2.5–3 % high, 64 rays 1.1–1.7 %.
 
+use std::sync::Arc;
+
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -70,7 +72,7 @@ const KEPT_RAY_FACTOR: u32 = 8;
 /// Each pixel's rays are drawn in independently stratified groups
 /// (`stratified::variance_groups`), so that the estimate's variance is
 /// measured without bias from the groups' spread (returned beside it, per
-/// channel; [`DeltaSRays::estimate`]). The fit needs it: ΔS is a regressor of
+/// channel; [`LobeTerms::estimate`]). The fit needs it: ΔS is a regressor of
 /// the linear step (`ward_fit`), and noise in a regressor pulls its
 /// coefficient toward zero (regression dilution). On the Mitsuba corridor
 /// (`validation/igi`) the floor's weak lobe (ρs 0.02, α 0.15) came out
@@ -212,17 +214,13 @@ pub(crate) fn indirect_specular(
                     })
                     .collect(),
             };
-            let stored = kept.then(|| std::sync::Arc::new(block_rays.clone()));
             members
                 .iter()
                 .map(|&i| {
-                    let (mean, variance) = block_rays.estimate(kernel, &observations[i].wo);
-                    let rays = if keep.get(i).copied().unwrap_or(false) {
-                        stored.clone()
-                    } else {
-                        None
-                    };
-                    (i, mean, variance, rays)
+                    let terms = block_rays.toward(&observations[i].wo, kernel.variant());
+                    let (mean, variance) = terms.estimate(kernel);
+                    let kept = keep.get(i).copied().unwrap_or(false);
+                    (i, mean, variance, kept.then(|| Arc::new(terms)))
                 })
                 .collect()
         })
@@ -241,8 +239,8 @@ pub(crate) fn indirect_specular(
 }
 
 /// One pixel's ΔS estimate: its observation, mean, variance and, when
-/// kept, the rays it was estimated from.
-type PixelEstimate = (usize, [f64; 3], [f64; 3], Option<std::sync::Arc<DeltaSRays>>);
+/// kept, the terms of the rays it was estimated from.
+type PixelEstimate = (usize, [f64; 3], [f64; 3], Option<Arc<LobeTerms>>);
 
 /// One traced ΔS ray: its variance group, its direction in the pixel's
 /// local frame, and the radiance it brought back times cos θi over its
@@ -254,12 +252,9 @@ pub(crate) struct DeltaSRay {
     l_cos_over_pdf: [f64; 3],
 }
 
-/// The rays of one block of pixels ([`indirect_specular`]), which score
-/// them under their own lobe; kept for the roughness search's samples, so
-/// that the search weighs them by the lobe it tries
-/// ([`DeltaSRays::estimate`]) rather than by the lobe they were drawn
-/// with.
-#[derive(Debug, Clone, Default, PartialEq)]
+/// The rays of one block of pixels ([`indirect_specular`]), which each
+/// pixel scores toward its own `ωo` ([`DeltaSRays::toward`]).
+#[derive(Debug)]
 pub(crate) struct DeltaSRays {
     /// Rays drawn per variance group (those that met nothing included).
     drawn: Vec<u32>,
@@ -267,16 +262,6 @@ pub(crate) struct DeltaSRays {
 }
 
 impl DeltaSRays {
-    /// ΔS per unit ρs toward `wo` (local) under `kernel`, and its
-    /// variance, per channel: `Σ K(ωr, ωo) cos θr L(r) / p(ωr)` over the
-    /// rays r, an unbiased estimate for any lobe wherever the drawing
-    /// lobe's density is not zero (everywhere above the horizon), with the
-    /// variance measured from the groups' spread
-    /// ([`grouped_mean_and_variance`]).
-    pub fn estimate(&self, kernel: &WardKernel, wo: &nalgebra::Vector3<f64>) -> ([f64; 3], [f64; 3]) {
-        self.toward(wo, kernel.variant()).estimate(kernel)
-    }
-
     /// The rays' terms toward `wo` (local) in `variant`: everything of
     /// each ray's score `K(ωr, ωo) cos θr L(r) / p(ωr)` but the roughness
     /// ([`LobeTerms`]). Rays at or below the horizon score zero under any
@@ -337,9 +322,14 @@ pub(crate) struct LobeTerms {
 }
 
 impl LobeTerms {
-    /// [`DeltaSRays::estimate`] toward the terms' `ωo` under `kernel`,
-    /// which must be of the terms' variant (the fit's; a kernel of
-    /// another variant would be scored with this one's factor).
+    /// ΔS per unit ρs toward the terms' `ωo` under `kernel`, and its
+    /// variance, per channel: `Σ K(ωr, ωo) cos θr L(r) / p(ωr)` over the
+    /// rays r, an unbiased estimate for any lobe wherever the drawing
+    /// lobe's density is not zero (everywhere above the horizon), with the
+    /// variance measured from the groups' spread
+    /// ([`grouped_mean_and_variance`]). `kernel` must be of the terms'
+    /// variant (the fit's; a kernel of another variant would be scored
+    /// with this one's factor).
     pub fn estimate(&self, kernel: &WardKernel) -> ([f64; 3], [f64; 3]) {
         debug_assert_eq!(kernel.variant(), self.variant, "ΔS terms scored under another variant");
         let form = kernel.slope_form();
@@ -364,8 +354,10 @@ pub(crate) struct IndirectSpecular {
     /// The variance of `mean`'s Monte Carlo estimate, measured from its two
     /// halves (0 where a half drew no ray).
     pub variance: Vec<[f64; 3]>,
-    /// The rays of the observations asked for (`keep`), else `None`.
-    pub rays: Vec<Option<std::sync::Arc<DeltaSRays>>>,
+    /// The terms of the rays of the observations asked for (`keep`),
+    /// toward each one's `ωo`, else `None`: the roughness search scores
+    /// them under every lobe it tries.
+    pub rays: Vec<Option<Arc<LobeTerms>>>,
 }
 
 /// The factor on the base ΔS rays for a surface with material `m`: its
@@ -498,7 +490,7 @@ mod tests {
         }
     }
 
-    /// The kept rays weighed again ([`DeltaSRays::estimate`]) under a
+    /// The kept rays weighed again ([`LobeTerms::estimate`]) under a
     /// broader lobe than they were drawn with (α 0.14 from rays drawn at
     /// 0.1) still find that lobe's integral B a(ωo), with the kept pixels'
     /// 8 × 16 rays, within 1 % over 64 pixels.
@@ -532,7 +524,7 @@ mod tests {
         for (i, o) in observations.iter().enumerate() {
             let rays = s.rays[i].as_ref().expect("kept");
             assert!(s.variance[i].iter().all(|v| *v > 0.0), "{:?}", s.variance[i]);
-            let (mean, variance) = rays.estimate(&at_tried, &o.wo);
+            let (mean, variance) = rays.estimate(&at_tried);
             assert!(mean.iter().chain(&variance).all(|v| v.is_finite()));
             let a = tried.directional_albedo(&o.wo, 256, 512)[0];
             for c in 0..3 {

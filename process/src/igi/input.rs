@@ -134,7 +134,7 @@ pub struct IgiOptions {
     pub correct_noise: bool,
     /// Keep the ΔS rays of the roughness search's samples and weigh them,
     /// at each roughness the search tries, by that lobe
-    /// (`delta_s::DeltaSRays::estimate`, unbiased for any lobe), instead
+    /// (`delta_s::LobeTerms::estimate`, unbiased for any lobe), instead
     /// of holding ΔS at the lobe it was drawn with (the previous pass's).
     /// Held, ΔS pulls the search against it (a sharper ΔS leaves a broader
     /// direct highlight to fit), and where ΔS is a large part of a
@@ -145,7 +145,7 @@ pub struct IgiOptions {
     /// (solver seed 1), and three passes reported α −2.75, −2.42, −5.57 %
     /// over seeds 1–3; weighed, −1.21, −1.91, −1.36 % (ρs +0.22, −0.59,
     /// +1.80 %) at the command line's settings, every check of that room
-    /// passing at each seed, for 24.4 s a solve against 16.7 s
+    /// passing at each seed, for 20.4–22.9 s a solve against 16.7 s
     /// (BENCHMARKS.md, "the corridor floor's α"). Textured surfaces keep
     /// ΔS as drawn (their per-group fit takes no noise correction). Off in
     /// the default, whose 256 gather rays leave the gather's noise larger

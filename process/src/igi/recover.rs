@@ -12,7 +12,7 @@ use std::time::Instant;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 
-use super::delta_s::{DeltaSRays, indirect_specular};
+use super::delta_s::{LobeTerms, indirect_specular};
 use super::error::IgiError;
 use super::geometry::Geometry;
 use super::highlight::{DetectorSample, HighlightReport, detect};
@@ -257,7 +257,7 @@ pub fn recover_with_progress(
             }
         }
     }
-    let mut kind_rays: Vec<Option<Arc<DeltaSRays>>> = vec![None; obs.len()];
+    let mut kind_rays: Vec<Option<Arc<LobeTerms>>> = vec![None; obs.len()];
     let mut highlights: Vec<Vec<HighlightReport>> = vec![Vec::new(); n_surf];
     let mut fits: Vec<SurfaceFit> = Vec::new();
     let mut iterations = Vec::new();
@@ -329,11 +329,7 @@ pub fn recover_with_progress(
                             floor,
                             group_key[i],
                         );
-                        // The kept ΔS rays toward this pixel, once for the whole
-                        // roughness search (`LobeTerms`).
-                        sample.indirect_rays = kind_rays[i]
-                            .as_ref()
-                            .map(|rays| std::sync::Arc::new(rays.toward(&obs[i].wo, options.variant)));
+                        sample.indirect_rays = kind_rays[i].clone();
                         sample
                     })
                     .collect();
@@ -746,7 +742,7 @@ fn light_pass(
     shapes: &[Option<WardLobe>],
     textured: &[bool],
     (kind_ind, kind_var): (&mut Vec<[f64; 3]>, &mut Vec<[f64; 3]>),
-    (keep, kind_rays): (&[bool], &mut Vec<Option<Arc<DeltaSRays>>>),
+    (keep, kind_rays): (&[bool], &mut Vec<Option<Arc<LobeTerms>>>),
     pass: u32,
     options: &IgiOptions,
     report: &mut dyn FnMut(&'static str),

@@ -12,6 +12,14 @@ use std::time::{Duration, Instant};
 /// The ports [`LocalServer::start`] has handed out in this process.
 static HANDED_OUT: Mutex<BTreeSet<u16>> = Mutex::new(BTreeSet::new());
 
+/// Why [`LocalServer::launch`] failed.
+enum StartError {
+    /// The server exited on start: another process holds the port.
+    Exited(String),
+    /// Anything else.
+    Other(String),
+}
+
 /// A running `indiserver`, killed (by PID) and reaped on drop.
 #[derive(Debug)]
 pub struct LocalServer {
@@ -43,10 +51,10 @@ impl LocalServer {
                     break port;
                 }
             };
-            match LocalServer::start_on(port, drivers) {
+            match LocalServer::launch(port, drivers) {
                 Ok(server) => return Ok(server),
-                Err(e) if e.contains("exited") => last = e,
-                Err(e) => return Err(e),
+                Err(StartError::Exited(e)) => last = e,
+                Err(StartError::Other(e)) => return Err(e),
             }
         }
         Err(last)
@@ -54,6 +62,14 @@ impl LocalServer {
 
     /// Starts `indiserver` with `drivers` on `port`.
     pub fn start_on(port: u16, drivers: &[&str]) -> Result<LocalServer, String> {
+        LocalServer::launch(port, drivers).map_err(|e| match e {
+            StartError::Exited(e) | StartError::Other(e) => e,
+        })
+    }
+
+    /// [`LocalServer::start_on`], telling a server that exited on start
+    /// (its port taken) from the other failures.
+    fn launch(port: u16, drivers: &[&str]) -> Result<LocalServer, StartError> {
         // Its own local (abstract) socket too: every indiserver binds
         // /tmp/indiserver by default, so a second one would exit at once.
         let child = Command::new("indiserver")
@@ -66,10 +82,10 @@ impl LocalServer {
             .stderr(Stdio::null())
             .spawn()
             .map_err(|e| {
-                format!(
+                StartError::Other(format!(
                     "cannot start indiserver ({e}): INDI's server and simulators come with Debian's indi-bin \
                      (`sudo apt-get install indi-bin`; .ci/run installs it)"
-                )
+                ))
             })?;
         let mut server = LocalServer {
             child: Some(child),
@@ -77,7 +93,9 @@ impl LocalServer {
         };
         let deadline = Instant::now() + Duration::from_secs(15);
         let exited = |server: &mut LocalServer| match server.child.as_mut().map(Child::try_wait) {
-            Some(Ok(Some(status))) => Some(format!("indiserver on port {port} exited at once ({status})")),
+            Some(Ok(Some(status))) => Some(StartError::Exited(format!(
+                "indiserver on port {port} exited at once ({status})"
+            ))),
             _ => None,
         };
         while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
@@ -85,7 +103,9 @@ impl LocalServer {
                 return Err(e);
             }
             if Instant::now() > deadline {
-                return Err(format!("indiserver did not listen on port {port} within 15 s"));
+                return Err(StartError::Other(format!(
+                    "indiserver did not listen on port {port} within 15 s"
+                )));
             }
             std::thread::sleep(Duration::from_millis(50));
         }
