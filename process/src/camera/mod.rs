@@ -8,6 +8,7 @@
 //! 8, 12 or 16 bits ([`sensor::CameraModel`]).
 
 pub mod bayer;
+pub mod code_table;
 pub mod image;
 pub mod response;
 pub mod sensor;

@@ -5,6 +5,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
+use super::code_table::code_tables;
 use super::image::{CodeImage, RadianceImage, max_code};
 use super::response::ParametricResponse;
 
@@ -77,7 +78,10 @@ impl CameraModel {
     /// stream of `seed`, so the result is the same for the same seed on any
     /// number of threads.
     pub fn photograph(&self, scene: &RadianceImage, exposure_time_s: f64, seed: u64) -> CodeImage {
-        self.expose(scene, exposure_time_s, seed, |c, x| self.response[c].code_fraction(x))
+        // The response's codes tabulated: the same codes as
+        // `round(top · f(x))`, without a power and a sine per sample.
+        let tables = code_tables(&self.response, self.sensor.bits);
+        self.expose(scene, exposure_time_s, seed, |c, x| tables[c].code(x))
     }
 
     /// Photographs `scene` as [`CameraModel::photograph`] does, but read out
@@ -85,20 +89,21 @@ impl CameraModel {
     /// code is `(2^bits − 1) · x` (the white level is the full well), no
     /// response curve.
     pub fn photograph_linear(&self, scene: &RadianceImage, exposure_time_s: f64, seed: u64) -> CodeImage {
-        self.expose(scene, exposure_time_s, seed, |_, x| x)
+        let top = f64::from(max_code(self.sensor.bits));
+        self.expose(scene, exposure_time_s, seed, |_, x| (top * x).round() as u16)
     }
 
     /// Exposure, noise and clipping as [`CameraModel::photograph`]
-    /// describes, then `transfer(channel, x)` as a fraction of the top code.
+    /// describes, then `quantize(channel, x)`: the code of the clipped
+    /// normalized exposure `x`.
     fn expose(
         &self,
         scene: &RadianceImage,
         exposure_time_s: f64,
         seed: u64,
-        transfer: impl Fn(usize, f64) -> f64 + Sync,
+        quantize: impl Fn(usize, f64) -> u16 + Sync,
     ) -> CodeImage {
         let s = self.sensor;
-        let maxc = f64::from(max_code(s.bits));
         let width = scene.width;
         let mut data = vec![0u16; scene.data.len()];
         data.par_chunks_mut(width * 3).enumerate().for_each(|(y, row)| {
@@ -112,7 +117,7 @@ impl CameraModel {
                 let (n1, n2) = standard_normal_pair(&mut rng);
                 let noisy = e + e.max(0.0).sqrt() * n1 + s.read_noise_electrons * n2;
                 let xn = (noisy / s.full_well_electrons).clamp(0.0, 1.0);
-                *out = (maxc * transfer(c, xn)).round() as u16;
+                *out = quantize(c, xn);
             }
         });
         CodeImage {
