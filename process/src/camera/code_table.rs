@@ -109,8 +109,13 @@ pub fn code_tables(responses: &[ParametricResponse; 3], bits: u8) -> Arc<[CodeTa
     {
         return t.clone();
     }
+    // Built outside the lock: another thread may have kept the same
+    // camera's tables meanwhile, and then those are handed out.
     let tables = Arc::new(responses.map(|r| CodeTable::new(r, bits)));
     let mut kept = KEPT.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, t)) = kept.iter().find(|(k, _)| *k == key) {
+        return t.clone();
+    }
     if kept.len() >= 8 {
         kept.remove(0);
     }
