@@ -27,4 +27,4 @@ pub use material::Material;
 pub use mesh::{Ray, Triangle};
 pub use scene::{Scene, SceneError, SurfaceHit};
 pub use sky::{Sky, SolarDisc, UniformSky};
-pub use texture::Texture;
+pub use texture::{TexelImage, Texture};

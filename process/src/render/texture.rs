@@ -85,6 +85,40 @@ pub enum Texture {
         /// Albedo of the plate around it.
         outside: [f64; 3],
     },
+    /// A measured albedo image on a plane: square texels of `texel_m`
+    /// from the corner `origin_st`, row-major along s; `mean` beyond the
+    /// image. Inverse global illumination puts a face's first albedo map
+    /// here to gather the light its own texture sends back to it.
+    Texels(TexelImage),
+}
+
+/// The image of [`Texture::Texels`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct TexelImage {
+    /// Texture coordinates of the image's corner, metres.
+    pub origin_st: [f64; 2],
+    /// Texel side, metres.
+    pub texel_m: f64,
+    /// Texels along s and t.
+    pub size: [usize; 2],
+    /// Albedo per texel, `size[0] × size[1]`, shared between clones.
+    pub texels: std::sync::Arc<[[f32; 3]]>,
+    /// The albedo beyond the image, and its mean.
+    pub mean: [f64; 3],
+}
+
+impl TexelImage {
+    fn at(&self, st: [f64; 2]) -> [f64; 3] {
+        let i = ((st[0] - self.origin_st[0]) / self.texel_m).floor();
+        let j = ((st[1] - self.origin_st[1]) / self.texel_m).floor();
+        if !(i >= 0.0 && j >= 0.0 && i < self.size[0] as f64 && j < self.size[1] as f64) {
+            return self.mean;
+        }
+        match self.texels.get(j as usize * self.size[0] + i as usize) {
+            Some(v) => v.map(f64::from),
+            None => self.mean,
+        }
+    }
 }
 
 /// A uniform number in [−1, 1] for integer cell `(i, j)` and `seed`
@@ -185,6 +219,7 @@ impl Texture {
                     *outside
                 }
             }
+            Texture::Texels(image) => image.at(st),
         }
     }
 
@@ -224,6 +259,7 @@ impl Texture {
                 let f = (std::f64::consts::PI * radius_m * radius_m / (plate_m * plate_m).max(1e-300)).min(1.0);
                 [0, 1, 2].map(|c| f * inside[c] + (1.0 - f) * outside[c])
             }
+            Texture::Texels(image) => image.mean,
         }
     }
 }
@@ -307,6 +343,33 @@ mod tests {
         assert_eq!(t.albedo([2.08, 1.08]), [0.05; 3]);
         let f = std::f64::consts::PI * 0.01 / 0.16;
         assert!((t.mean_albedo()[0] - (f * 0.9 + (1.0 - f) * 0.05)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_texel_image_is_read_texel_by_texel_and_its_mean_beyond_it() {
+        // 3 × 2 texels of 10 cm from (1.0, -0.5): texel (i, j) holds i + 10 j.
+        let texels: Vec<[f32; 3]> = (0..6).map(|k| [(k % 3 + 10 * (k / 3)) as f32; 3]).collect();
+        let t = Texture::Texels(TexelImage {
+            origin_st: [1.0, -0.5],
+            texel_m: 0.1,
+            size: [3, 2],
+            texels: texels.into(),
+            mean: [0.25; 3],
+        });
+        assert_eq!(t.albedo([1.05, -0.45]), [0.0; 3]);
+        assert_eq!(t.albedo([1.25, -0.45]), [2.0; 3]);
+        assert_eq!(t.albedo([1.15, -0.35]), [11.0; 3]);
+        assert_eq!(t.albedo([1.299, -0.301]), [12.0; 3]);
+        for outside in [
+            [0.99, -0.45],
+            [1.31, -0.45],
+            [1.05, -0.51],
+            [1.05, -0.29],
+            [f64::NAN, 0.0],
+        ] {
+            assert_eq!(t.albedo(outside), [0.25; 3], "{outside:?}");
+        }
+        assert_eq!(t.mean_albedo(), [0.25; 3]);
     }
 
     #[test]
