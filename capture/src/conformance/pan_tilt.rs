@@ -189,7 +189,13 @@ async fn check_stop<P: PanTilt>(head: &mut P, o: &Options) -> Result<(), String>
         ));
     }
     let (lo, hi) = (a.pan.radians() - t.radians(), b.pan.radians() + t.radians());
-    if !(lo..=hi).contains(&s.pose.pan.radians()) {
+    let pan = s.pose.pan.radians();
+    // A head whose pan range is a whole turn may take the other arc,
+    // across the wrap (a Pelco-D head told 18° → 342° on a 0–360° station
+    // turns down through 0°, and a stop that lands late leaves it at 17°).
+    let full_turn = l.pan.max.radians() - l.pan.min.radians() >= std::f64::consts::TAU - 2.0 * t.radians();
+    let other_arc = full_turn && (pan <= a.pan.radians() + t.radians() || pan >= b.pan.radians() - t.radians());
+    if !((lo..=hi).contains(&pan) || other_arc) {
         return Err(format!(
             "stopped at {}, off the path from {} to {}",
             show(&s.pose),
@@ -274,6 +280,9 @@ mod tests {
         NoLimitCheck,
         /// Jumps to its target at once, so stop has no effect.
         NoStop,
+        /// Turns the other way round (down through the wrap), so a stop
+        /// halts it 1° below where it started.
+        OtherArc,
     }
 
     /// Moves complete in `wait_idle`; a stop halts halfway.
@@ -313,7 +322,12 @@ mod tests {
             Ok(())
         }
         async fn stop(&mut self) -> Result<Pose, DeviceError> {
-            if !matches!(self.defect, Defect::NoStop) {
+            if let Defect::OtherArc = self.defect {
+                self.target = Pose {
+                    pan: Angle::from_degrees(self.pose.pan.degrees() - 1.0),
+                    tilt: self.pose.tilt,
+                };
+            } else if !matches!(self.defect, Defect::NoStop) {
                 self.target = Pose {
                     pan: lerp(self.pose.pan, self.target.pan, 0.5),
                     tilt: lerp(self.pose.tilt, self.target.tilt, 0.5),
@@ -325,10 +339,14 @@ mod tests {
     }
 
     async fn failures_of(defect: Defect) -> Vec<&'static str> {
+        failures_over(defect, (-170.0, 170.0)).await
+    }
+
+    async fn failures_over(defect: Defect, (pan_min, pan_max): (f64, f64)) -> Vec<&'static str> {
         let limits = PanTiltLimits {
             pan: crate::device::AxisRange {
-                min: Angle::from_degrees(-170.0),
-                max: Angle::from_degrees(170.0),
+                min: Angle::from_degrees(pan_min),
+                max: Angle::from_degrees(pan_max),
             },
             tilt: crate::device::AxisRange {
                 min: Angle::from_degrees(-30.0),
@@ -354,6 +372,13 @@ mod tests {
             ["out of range: refused with OutOfRange, head stays"]
         );
         assert_eq!(failures_of(Defect::NoStop).await, ["stop: halts on the path and stays"]);
+        // Stopped 1° short of where it set out: off the path on a head of
+        // 340°, on the other arc of one that turns a whole way round.
+        assert_eq!(
+            failures_of(Defect::OtherArc).await,
+            ["stop: halts on the path and stays"]
+        );
+        assert!(failures_over(Defect::OtherArc, (0.0, 359.99)).await.is_empty());
         let drift = failures_of(Defect::Drift).await;
         assert!(drift.contains(&"move: reaches requested poses"), "{drift:?}");
         assert!(drift.contains(&"limits: reaches every corner"), "{drift:?}");
