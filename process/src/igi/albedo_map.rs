@@ -466,11 +466,13 @@ impl AlbedoMap {
             if textured.iter().any(|t| *t) {
                 let first = AlbedoMap {
                     texel_m: options.texel_m,
-                    triangles: triangles.clone(),
+                    triangles: std::mem::take(&mut triangles),
                     fallback: fallback.clone(),
                     samples: (used, dropped),
                 };
-                let lit = textured_scene(&scene, &first, &textured, &input.surfaces)?;
+                let lit = textured_scene(&scene, &first, &textured, &input.surfaces);
+                triangles = first.triangles;
+                let lit = lit?;
                 let select: Vec<bool> = material.iter().map(|m| textured[*m]).collect();
                 let field = IndirectField::gather_on(&lit, &points, &sides, options, &select);
                 for (t, samples) in per_triangle.iter_mut().enumerate() {
@@ -486,10 +488,6 @@ impl AlbedoMap {
                             s.relit(e, var)
                         }
                     });
-                }
-                for grid in &mut triangles {
-                    grid.albedo.fill([0.0; 3]);
-                    grid.weight.fill(0.0);
                 }
                 (used, dropped, spread) = combine(&mut triangles, &mut per_triangle, options.remove_specular);
             }
@@ -508,8 +506,8 @@ impl AlbedoMap {
 
 /// Each texel's weighted mean of its samples (sorted in place by texel,
 /// brightest first; with `drop_brightest`, the brightest of three or more
-/// dropped, §4.6), and the samples used and dropped and each seen texel's
-/// spread.
+/// dropped, §4.6), written over the grids (a texel without samples left
+/// unseen), and the samples used and dropped and each seen texel's spread.
 fn combine(
     triangles: &mut [TriangleTexels],
     per_triangle: &mut [Vec<Sample>],
@@ -519,6 +517,8 @@ fn combine(
     let mut dropped = 0usize;
     let mut spread: Vec<TexelSpread> = Vec::new();
     for (t, (grid, samples)) in triangles.iter_mut().zip(per_triangle.iter_mut()).enumerate() {
+        grid.albedo.fill([0.0; 3]);
+        grid.weight.fill(0.0);
         samples.sort_by(|a, b| a.texel.cmp(&b.texel).then(b.brightness.total_cmp(&a.brightness)));
         let mut k = 0;
         while k < samples.len() {
@@ -921,8 +921,9 @@ fn shrink_noise(
 ) {
     for s in 0..surfaces {
         let texels: Vec<&TexelSpread> = spread.iter().filter(|e| material.get(e.triangle) == Some(&s)).collect();
+        let stats = [0, 1, 2].map(|c| TextureStats::of(triangles, &texels, c));
         if textured.get(s).copied().unwrap_or(false)
-            && let [Some(r), Some(g), Some(b)] = [0, 1, 2].map(|c| TextureStats::of(triangles, &texels, c))
+            && let [Some(r), Some(g), Some(b)] = &stats
         {
             let local: Vec<([f64; 3], f64)> = texels
                 .iter()
@@ -941,8 +942,8 @@ fn shrink_noise(
                 continue;
             }
         }
-        for c in 0..3 {
-            let Some(stats) = TextureStats::of(triangles, &texels, c) else {
+        for (c, stats) in stats.iter().enumerate() {
+            let Some(stats) = stats else {
                 continue;
             };
             for (t, nt) in texels.iter().zip(&stats.noise) {
