@@ -260,7 +260,19 @@ fn radiance_rooms_rendered_direct_are_recovered_within_the_issue_bounds() {
 }
 
 #[test]
-fn the_radiance_studio_with_interreflection_is_recovered_within_the_measured_bounds() {
+fn the_radiance_studio_with_interreflection_is_recovered_within_the_issue_bounds() {
+    // Held to ρd 1.5 %, ρs and α 3 %, γ 1° until session 41, its checker
+    // wall's lobe lost (ρs 0.02: it explained 4.9 % of the diffuse fit's
+    // residual, under the 5 % asked) and its squares 3.6–9.4 % high with
+    // the specular light left in them. 5 % of the wall's texel groups lie
+    // across the squares' borders and held 97 % of that residual; they
+    // are now left out of the fit (`texel_groups::straddling`), the lobe
+    // is kept, and with it in the room the other faces come within the
+    // issue's bounds too (solver seeds 1–3, `igi_knobs`). The wall's lobe:
+    // ρs +0.41, +1.27, +1.27 % (the channels' mean; here, seed 1, the
+    // worst channel 1.85 %), α +1.48, +2.06, +2.17 % over seeds 1–3, so α
+    // is held to 2.5 %; its squares within 0.40 %. The untextured faces
+    // here: worst ρd 0.67 %, ρs 1.93 %, α 1.08 %, γ 0.45°.
     let dir = tempfile::tempdir().unwrap();
     let room = "studio-interreflection";
     let out = dir.path().join(room);
@@ -282,7 +294,9 @@ fn the_radiance_studio_with_interreflection_is_recovered_within_the_measured_bou
             .unwrap();
         assert_eq!(s["model"], model, "{name}: {s}");
     }
-    report(room, check_room(room, &out, [0.015, 0.03, 0.03, 1.0]));
+    report(room, check_room(room, &out, ISSUE_BOUNDS));
+    check_textured_lobe(room, &out, "wall_east", [ISSUE_BOUNDS[1], 0.025]);
+    check_checker_levels(room, &out, "wall_east", ISSUE_BOUNDS[0]);
 }
 
 #[test]
@@ -316,15 +330,18 @@ fn exact_glossy_interreflection_rendered_by_mitsuba_is_recovered_within_the_issu
     //
     // The checker walls' lobes, fitted with one ρd per texel group
     // (`texel_groups`; before it the studio's was lost, ρs 0): the
-    // corridor's (ρs 0.04, α 0.10) within the issue's bounds; the
-    // studio's weak wide one (ρs 0.02, α 0.15) within them in α and held
-    // to 3 % in ρs (measured +0.55 to +2.16 % over solver seeds 1–3 with
-    // the indirect light interpolated between cells, +1.8 to +3.4 %
-    // before).
+    // corridor's (ρs 0.04, α 0.10) and the studio's weak wide one (ρs
+    // 0.02, α 0.15) within the issue's bounds. The studio's ρs was +0.55
+    // to +2.16 % over solver seeds 1–3 (held to 3 %) until the texel
+    // groups across the squares' borders were left out of the fit
+    // (`texel_groups::straddling`): −0.13, −0.34, −0.39 %.
     //
     // The checker walls' squares, each colour's median texel in the
-    // albedo map, within the issue's 1 % (measured: studio 0.69 %,
-    // corridor 0.51 %). Before session 40 the corridor's blue squares
+    // albedo map, within the issue's 1 % (measured in the release build:
+    // studio 0.21 %, corridor 0.76 %; the corridor's dark squares moved
+    // 0.57–1.72 % over map seeds 3–5 with the second gather's 6.25 cm
+    // cells of 128 rays, −0.25 to +0.08 % on 12.5 cm cells of 512 rays,
+    // `AlbedoMapOptions::texture_light_rays`). Before session 40 the corridor's blue squares
     // were −2.7 % and +2.4 %: the map's shrinkage toward the wall's mean
     // pulled them together, and under it the indirect light gathered
     // through a uniform wall missed what the checker sends back to itself
@@ -339,7 +356,7 @@ fn exact_glossy_interreflection_rendered_by_mitsuba_is_recovered_within_the_issu
         room,
         check_room_except(room, &out, ISSUE_BOUNDS, &[("wall_west", metal)]),
     );
-    check_textured_lobe(room, &out, "wall_east", [0.03, ISSUE_BOUNDS[2]]);
+    check_textured_lobe(room, &out, "wall_east", [ISSUE_BOUNDS[1], ISSUE_BOUNDS[2]]);
     check_checker_levels(room, &out, "wall_east", ISSUE_BOUNDS[0]);
     let room = "corridor-mitsuba-interreflection";
     let out = dir.path().join(room);

@@ -312,6 +312,54 @@ fn within_groups(samples: &[FitSample], spec: &[([f64; 3], [f64; 3])], lobe: boo
     LinearFit { rho_d, rho_s, error }
 }
 
+/// Each sample's weighted squared residual (summed over the channels)
+/// under [`linear_fit`]'s answer for `lobe`, with each group's own ρd
+/// under [`Albedo::PerGroup`].
+pub(crate) fn sample_residuals(samples: &[FitSample], lobe: Option<&WardLobe>, albedo: Albedo) -> Vec<f64> {
+    let spec = specular_coefficients(samples, lobe);
+    let fit = linear_fit(samples, lobe, albedo);
+    let rho_s = if lobe.is_some() { fit.rho_s } else { [0.0; 3] };
+    let group_rho: Option<Vec<[f64; 3]>> = match albedo {
+        Albedo::Uniform => None,
+        Albedo::PerGroup(n) => {
+            let mut acc = vec![[[0.0f64; 2]; 3]; n];
+            for (s, (k, _)) in samples.iter().zip(&spec) {
+                for c in 0..3 {
+                    let d = s.diffuse[c];
+                    acc[s.group][c][0] += s.weight * d * d;
+                    acc[s.group][c][1] += s.weight * d * (s.radiance[c] - rho_s[c] * k[c]);
+                }
+            }
+            Some(
+                acc.iter()
+                    .map(|g| {
+                        [0, 1, 2].map(|c| {
+                            if g[c][0] > 0.0 {
+                                (g[c][1] / g[c][0]).max(0.0)
+                            } else {
+                                0.0
+                            }
+                        })
+                    })
+                    .collect(),
+            )
+        }
+    };
+    samples
+        .iter()
+        .zip(&spec)
+        .map(|(s, (k, _))| {
+            let rho_d = group_rho.as_ref().map_or(fit.rho_d, |g| g[s.group]);
+            (0..3)
+                .map(|c| {
+                    let r = s.radiance[c] - rho_d[c] * s.diffuse[c] - rho_s[c] * k[c];
+                    s.weight * r * r
+                })
+                .sum()
+        })
+        .collect()
+}
+
 /// The roughness range searched, ln α.
 const LN_ALPHA_MIN: f64 = -6.907_755_278_982_137; // ln 0.001
 const LN_ALPHA_MAX: f64 = 0.0; // ln 1
