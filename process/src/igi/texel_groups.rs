@@ -42,7 +42,7 @@ use nalgebra::Vector3;
 
 use super::geometry::Geometry;
 use super::observation::Observation;
-use super::ward_fit::{Albedo, FitSample, diffuse_radiance, sample_residuals};
+use super::ward_fit::{FitSample, diffuse_radiance, group_residuals};
 use crate::brdf::{WardLobe, WardMaterial};
 
 /// Texel side over the median pixel footprint. On the checker walls of
@@ -195,7 +195,7 @@ pub(crate) fn texture_spread(samples: &[FitSample], groups: usize, material: Opt
 }
 
 /// The groups that straddle a texture edge: a group's samples share one
-/// ρd ([`Albedo::PerGroup`]), which a group lying across the border of two
+/// ρd (`Albedo::PerGroup`), which a group lying across the border of two
 /// colours breaks, so its views disagree by far more than noise. Each
 /// group of two or more samples is scored by its samples' weighted squared
 /// residual under `lobe` (the fit's answer, each group with its own ρd)
@@ -203,7 +203,7 @@ pub(crate) fn texture_spread(samples: &[FitSample], groups: usize, material: Opt
 /// [`STRADDLE_FACTOR`] times the median group is flagged. `samples` carry
 /// numbered groups (`0..groups`).
 pub(crate) fn straddling(samples: &[FitSample], groups: usize, lobe: Option<&WardLobe>) -> Vec<bool> {
-    let residual = sample_residuals(samples, lobe, Albedo::PerGroup(groups));
+    let residual = group_residuals(samples, lobe, groups);
     let mut sum = vec![0.0; groups];
     let mut count = vec![0u32; groups];
     for (s, r) in samples.iter().zip(&residual) {

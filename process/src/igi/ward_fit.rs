@@ -313,46 +313,38 @@ fn within_groups(samples: &[FitSample], spec: &[([f64; 3], [f64; 3])], lobe: boo
 }
 
 /// Each sample's weighted squared residual (summed over the channels)
-/// under [`linear_fit`]'s answer for `lobe`, with each group's own ρd
-/// under [`Albedo::PerGroup`].
-pub(crate) fn sample_residuals(samples: &[FitSample], lobe: Option<&WardLobe>, albedo: Albedo) -> Vec<f64> {
+/// under [`within_groups`]' answer for `lobe`, each of the `groups` groups
+/// with its own ρd, `Σ w d (l − ρs k) / Σ w d²` over its samples.
+pub(crate) fn group_residuals(samples: &[FitSample], lobe: Option<&WardLobe>, groups: usize) -> Vec<f64> {
     let spec = specular_coefficients(samples, lobe);
-    let fit = linear_fit(samples, lobe, albedo);
-    let rho_s = if lobe.is_some() { fit.rho_s } else { [0.0; 3] };
-    let group_rho: Option<Vec<[f64; 3]>> = match albedo {
-        Albedo::Uniform => None,
-        Albedo::PerGroup(n) => {
-            let mut acc = vec![[[0.0f64; 2]; 3]; n];
-            for (s, (k, _)) in samples.iter().zip(&spec) {
-                for c in 0..3 {
-                    let d = s.diffuse[c];
-                    acc[s.group][c][0] += s.weight * d * d;
-                    acc[s.group][c][1] += s.weight * d * (s.radiance[c] - rho_s[c] * k[c]);
-                }
-            }
-            Some(
-                acc.iter()
-                    .map(|g| {
-                        [0, 1, 2].map(|c| {
-                            if g[c][0] > 0.0 {
-                                (g[c][1] / g[c][0]).max(0.0)
-                            } else {
-                                0.0
-                            }
-                        })
-                    })
-                    .collect(),
-            )
+    let rho_s = within_groups(samples, &spec, lobe.is_some(), groups).rho_s;
+    let mut acc = vec![[[0.0f64; 2]; 3]; groups];
+    for (s, (k, _)) in samples.iter().zip(&spec) {
+        for c in 0..3 {
+            let d = s.diffuse[c];
+            acc[s.group][c][0] += s.weight * d * d;
+            acc[s.group][c][1] += s.weight * d * (s.radiance[c] - rho_s[c] * k[c]);
         }
-    };
+    }
+    let rho_d: Vec<[f64; 3]> = acc
+        .iter()
+        .map(|g| {
+            [0, 1, 2].map(|c| {
+                if g[c][0] > 0.0 {
+                    (g[c][1] / g[c][0]).max(0.0)
+                } else {
+                    0.0
+                }
+            })
+        })
+        .collect();
     samples
         .iter()
         .zip(&spec)
         .map(|(s, (k, _))| {
-            let rho_d = group_rho.as_ref().map_or(fit.rho_d, |g| g[s.group]);
             (0..3)
                 .map(|c| {
-                    let r = s.radiance[c] - rho_d[c] * s.diffuse[c] - rho_s[c] * k[c];
+                    let r = s.radiance[c] - rho_d[s.group][c] * s.diffuse[c] - rho_s[c] * k[c];
                     s.weight * r * r
                 })
                 .sum()
